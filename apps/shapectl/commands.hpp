@@ -1,0 +1,18 @@
+#pragma once
+// Each subcommand lives in its own file and registers itself on the app.
+#include <CLI/CLI.hpp>
+#include <stdexcept>
+#include <string>
+
+namespace shapectl::cli {
+
+// A computation that ran but failed (not converged, inverted, singular): exit code 2.
+class SolverFailure : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+void add_statics_command(CLI::App& app);
+void add_kinematics_command(CLI::App& app);
+
+}  // namespace shapectl::cli

@@ -1,0 +1,120 @@
+// shapectl kinematics ROBOT.urdf [--joints JOINTS.json] [--spheres SPHERES.json] --out OUT.json
+// Link poses at one configuration, and optionally self-collision clearances and limit checks.
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_input.hpp>
+#include <shapectl/robot/collision_spheres.hpp>
+#include <shapectl/robot/joint_limits.hpp>
+#include <shapectl/robot/kinematics.hpp>
+#include <shapectl/robot/robot_model.hpp>
+
+#include "commands.hpp"
+
+namespace shapectl::cli {
+
+namespace {
+
+struct KinematicsOptions {
+  std::string urdf;
+  std::string joints;
+  std::string spheres;
+  std::string out;
+};
+
+// {"joints": {"name": radians, ...}}; the model checks the names.
+std::map<std::string, double> read_joint_values(const std::string& file) {
+  const JsonInput json = JsonInput::load(file);
+  json.expect_only({"joints"});
+  std::map<std::string, double> values;
+  if (!json.has("joints")) return values;
+  const JsonInput joints = json.at("joints");
+  for (const auto& name : joints.keys()) values[name] = joints.at(name).number();
+  return values;
+}
+
+nlohmann::ordered_json pose_json(const Eigen::Isometry3d& T) {
+  nlohmann::ordered_json rotation = nlohmann::ordered_json::array();
+  for (int r = 0; r < 3; ++r) rotation.push_back({T(r, 0), T(r, 1), T(r, 2)});
+  return {{"position", {T.translation().x(), T.translation().y(), T.translation().z()}},
+          {"rotation", rotation}};
+}
+
+nlohmann::ordered_json collision_json(const RobotModel& robot, const CollisionModel& collision,
+                                      const KinematicsState& state) {
+  // A sphere is named by its link and its position in that link's list.
+  std::vector<int> index_in_link(collision.spheres().size());
+  std::map<int, int> seen;
+  for (std::size_t s = 0; s < collision.spheres().size(); ++s)
+    index_in_link[s] = seen[collision.spheres()[s].link]++;
+  nlohmann::ordered_json closest = nlohmann::ordered_json::array();
+  for (const auto& pair : collision.closest_pairs(state, 10)) {
+    const auto a = static_cast<std::size_t>(pair.first);
+    const auto b = static_cast<std::size_t>(pair.second);
+    closest.push_back(
+        {{"links", {robot.links()[static_cast<std::size_t>(collision.spheres()[a].link)].name,
+                    robot.links()[static_cast<std::size_t>(collision.spheres()[b].link)].name}},
+         {"spheres", {index_in_link[a], index_in_link[b]}},
+         {"clearance", pair.clearance}});
+  }
+  nlohmann::ordered_json out;
+  const double min_clearance = collision.min_clearance(state);
+  out["min_clearance"] = std::isfinite(min_clearance) ? nlohmann::ordered_json(min_clearance)
+                                                      : nlohmann::ordered_json(nullptr);
+  out["margin"] = collision.margin();
+  out["closest_pairs"] = closest;
+  return out;
+}
+
+void run(const KinematicsOptions& options) {
+  RobotModel robot = RobotModel::load_urdf_file(options.urdf);
+  for (const auto& warning : robot.warnings()) std::cerr << "warning: " << warning << "\n";
+  const Eigen::VectorXd active =
+      options.joints.empty()
+          ? Eigen::VectorXd::Zero(robot.active_count()).eval()
+          : robot.active_joints_from_map(read_joint_values(options.joints), options.joints);
+  const KinematicsState state = forward_kinematics(robot, active);
+
+  nlohmann::ordered_json out;
+  nlohmann::ordered_json links = nlohmann::ordered_json::object();
+  for (int link = 0; link < robot.link_count(); ++link)
+    links[robot.links()[static_cast<std::size_t>(link)].name] =
+        pose_json(state.T_world_link[static_cast<std::size_t>(link)]);
+  out["links"] = links;
+  if (!options.spheres.empty()) {
+    const CollisionModel collision = CollisionModel::load_json_file(robot, options.spheres);
+    const nlohmann::ordered_json clearances = collision_json(robot, collision, state);
+    for (const auto& [key, value] : clearances.items()) out[key] = value;
+  }
+  nlohmann::ordered_json violations = nlohmann::ordered_json::array();
+  for (const auto& v : limit_violations(robot, state.joints))
+    violations.push_back({{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
+  out["limit_violations"] = violations;
+
+  std::ofstream file(options.out);
+  if (!file) throw InputError(options.out, "", "cannot write file");
+  file << out.dump(2) << "\n";
+  if (!file) throw InputError(options.out, "", "cannot write file");
+}
+
+}  // namespace
+
+void add_kinematics_command(CLI::App& app) {
+  auto options = std::make_shared<KinematicsOptions>();
+  CLI::App* command = app.add_subcommand(
+      "kinematics", "Link poses of a URDF robot at given joint values; clearances with --spheres");
+  command->add_option("robot", options->urdf, "Robot description (URDF)")->required();
+  command->add_option("--joints", options->joints,
+                      "JSON {\"joints\": {\"name\": radians}}; missing joints are 0");
+  command->add_option("--spheres", options->spheres, "Collision spheres JSON (see docs/robot.md)");
+  command->add_option("--out", options->out, "Output JSON: link poses in the URDF root frame")
+      ->required();
+  command->callback([options] { run(*options); });
+}
+
+}  // namespace shapectl::cli

@@ -1,0 +1,28 @@
+// shapectl: find robot joint angles that give an elastic object the shape you ask for.
+#include <iostream>
+
+#include <shapectl/io/input_error.hpp>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"shapectl: interactive robotic shape control of elastic objects"};
+  app.require_subcommand(1);
+  shapectl::cli::add_statics_command(app);
+  shapectl::cli::add_kinematics_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;
+  } catch (const shapectl::InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  } catch (const shapectl::cli::SolverFailure& e) {
+    std::cerr << "solver failure: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "internal error: " << e.what() << "\n";
+    return 3;
+  }
+  return 0;
+}

@@ -1,0 +1,94 @@
+// Statics benchmarks: the default foam bar (1,536 tets) clamped at both ends, solved from rest
+// and re-solved warm after one clamp moves by 1 mm; larger boxes for scaling; both Cholesky
+// backends side by side to pick the crossover.
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+
+#include <shapectl/mesh/box_mesh.hpp>
+#include <shapectl/sim/object_statics.hpp>
+
+namespace shapectl {
+namespace {
+
+// A bar of cells (n, n/4, n/4)... clamped 10 mm deep at both ends.
+Scene clamped_bar(const std::array<int, 3>& cells) {
+  Scene s;
+  s.object_mesh = std::make_shared<const TetMesh>(make_box_mesh({0.32, 0.03, 0.03}, cells));
+  s.material = material_from_youngs(2e5, 0.3, 40);
+  NodeSelection fixed;
+  for (int i = 0; i < s.object_mesh->node_count(); ++i)
+    if (std::abs(s.object_mesh->rest_positions()[i].x()) > 0.16 - 0.011) fixed.nodes.push_back(i);
+  s.fixed = fixed;
+  return s;
+}
+
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;
+}
+
+void full_solve(benchmark::State& state, std::array<int, 3> cells,
+                std::optional<SparseCholesky::Backend> backend) {
+  Scene scene = clamped_bar(cells);
+  scene.statics.backend = backend;
+  ObjectStatics statics(scene);
+  int iterations = 0;
+  for (auto _ : state) {
+    ObjectStatics fresh(scene);  // symbolic analysis included: a full solve from scratch
+    Positions x = scene.world_rest_positions();
+    const StaticsResult r = fresh.solve(x);
+    if (!r.converged()) state.SkipWithError(r.reason.c_str());
+    iterations = r.iterations;
+  }
+  state.counters["tets"] = statics.mesh().tet_count();
+  state.counters["newton_iterations"] = iterations;
+  state.counters["peak_rss_MB"] = peak_rss_mb();
+}
+
+void BM_StaticsFullSolve(benchmark::State& state) { full_solve(state, {16, 4, 4}, std::nullopt); }
+BENCHMARK(BM_StaticsFullSolve)->Unit(benchmark::kMillisecond);
+
+void BM_StaticsWarmResolve(benchmark::State& state) {
+  const Scene scene = clamped_bar({16, 4, 4});
+  ObjectStatics statics(scene);
+  Positions x = scene.world_rest_positions();
+  if (!statics.solve(x).converged()) state.SkipWithError("initial solve failed");
+  // Nodes of the +x clamp: move them 1 mm along x and back, alternately.
+  std::vector<int> clamp;
+  for (int i = 0; i < statics.mesh().node_count(); ++i)
+    if (statics.fixed_node()[i] && statics.mesh().rest_positions()[i].x() > 0) clamp.push_back(i);
+  double direction = 1;
+  int iterations = 0;
+  for (auto _ : state) {
+    for (int i : clamp) x[3 * i] += direction * 1e-3;
+    direction = -direction;
+    const StaticsResult r = statics.solve(x);
+    if (!r.converged()) state.SkipWithError(r.reason.c_str());
+    iterations = r.iterations;
+  }
+  state.counters["newton_iterations"] = iterations;
+}
+BENCHMARK(BM_StaticsWarmResolve)->Unit(benchmark::kMillisecond);
+
+void BM_StaticsFullSolve10k(benchmark::State& state) { full_solve(state, {40, 8, 5}, std::nullopt); }
+void BM_StaticsFullSolve50k(benchmark::State& state) { full_solve(state, {64, 12, 11}, std::nullopt); }
+BENCHMARK(BM_StaticsFullSolve10k)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_StaticsFullSolve50k)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+// Backend crossover: the same solve with each Cholesky.
+void BM_BackendLDLT(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  full_solve(state, {4 * n, n, n}, SparseCholesky::Backend::SimplicialLDLT);
+}
+void BM_BackendCholmod(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  full_solve(state, {4 * n, n, n}, SparseCholesky::Backend::CholmodSupernodal);
+}
+BENCHMARK(BM_BackendLDLT)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_BackendCholmod)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(2);
+
+}  // namespace
+}  // namespace shapectl
+
+BENCHMARK_MAIN();

@@ -1,0 +1,32 @@
+#pragma once
+// Runs an optimizer to convergence (or an iteration/time budget) from a start state.
+#include <vector>
+
+#include <shapectl/control/optimizer.hpp>
+
+namespace shapectl {
+
+struct OptimizeOptions {
+  int max_iterations = 100;
+  double max_seconds = 60;
+};
+
+struct HistoryEntry {
+  int iteration = 0;
+  double time = 0;  // seconds since the start
+  double error_mean = 0;
+  double objective = 0;
+};
+
+struct OptimizeResult {
+  Evaluation best;        // the state reached (safe if the start was)
+  bool converged = false;  // stationary, not merely out of budget
+  std::string reason;
+  int iterations = 0;
+  std::vector<HistoryEntry> history;  // entry 0 is the start
+};
+
+OptimizeResult optimize(ReducedObjective& objective, Optimizer& optimizer, Evaluation start,
+                        const OptimizeOptions& options);
+
+}  // namespace shapectl

@@ -1,0 +1,132 @@
+#include <shapectl/control/optimizer.hpp>
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+namespace shapectl {
+
+const char* to_string(StepOutcome outcome) {
+  switch (outcome) {
+    case StepOutcome::Improved: return "improved";
+    case StepOutcome::Converged: return "converged";
+    case StepOutcome::Stuck: return "stuck";
+  }
+  return "?";
+}
+
+namespace {
+// A trial may replace the current state if it is at least as safe and strictly better.
+bool acceptable(const Evaluation& trial, const Evaluation& current, double required_objective) {
+  if (!trial.statics.converged()) return false;
+  if (current.safe() && !trial.safe()) return false;
+  return trial.objective < required_objective;
+}
+
+// Relative decrease too small to matter: stop instead of polishing round-off.
+bool negligible(double before, double after) {
+  return before - after <= 1e-12 * std::abs(before) + 1e-18;
+}
+}  // namespace
+
+Evaluation evaluate_predicted(ReducedObjective& objective, const Eigen::VectorXd& joints,
+                              const Positions& warm, const Positions& predicted) {
+  Evaluation e = objective.evaluate(joints, predicted);
+  if (!e.statics.converged()) e = objective.evaluate(joints, warm);
+  return e;
+}
+
+StepOutcome GaussNewton::step(ReducedObjective& objective, Evaluation& current) {
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J, dx;
+  objective.least_squares(current, r, J, &dx);
+  const Eigen::VectorXd g = J.transpose() * r;
+  if (g.cwiseAbs().maxCoeff() <= 1e-14 + 1e-10 * r.squaredNorm()) return StepOutcome::Converged;
+  const Eigen::MatrixXd A = J.transpose() * J;
+  const Eigen::VectorXd scaling = A.diagonal().cwiseMax(1e-12 * A.diagonal().maxCoeff() + 1e-18);
+  for (int attempt = 0; attempt < 10; ++attempt) {
+    Eigen::MatrixXd damped = A;
+    damped.diagonal() += damping_ * scaling;
+    Eigen::VectorXd delta = damped.ldlt().solve(-g);
+    const double largest = delta.cwiseAbs().maxCoeff();
+    if (largest > max_step) delta *= max_step / largest;
+    if (largest < 1e-12) return StepOutcome::Converged;
+    const Eigen::VectorXd theta = current.joints + delta;
+    const Evaluation trial =
+        evaluate_predicted(objective, theta, current.positions, current.positions + dx * delta);
+    if (acceptable(trial, current, current.objective)) {
+      const bool tiny = negligible(current.objective, trial.objective);
+      current = trial;
+      damping_ = std::max(damping_ / 4, 1e-9);
+      return tiny ? StepOutcome::Converged : StepOutcome::Improved;
+    }
+    damping_ = std::max(damping_ * 8, 1e-6);
+  }
+  return StepOutcome::Stuck;
+}
+
+void Lbfgs::reset() {
+  s_.clear();
+  y_.clear();
+  gradient_.resize(0);
+}
+
+StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
+  if (gradient_.size() == 0 || gradient_at_ != current.joints) {
+    gradient_ = objective.gradient(current, method_);
+    gradient_at_ = current.joints;
+  }
+  const Eigen::VectorXd& g = gradient_;
+  if (g.cwiseAbs().maxCoeff() <= 1e-14) return StepOutcome::Converged;
+  // Two-loop recursion: d = −H g.
+  Eigen::VectorXd q = g;
+  std::vector<double> alpha(s_.size());
+  for (int k = static_cast<int>(s_.size()) - 1; k >= 0; --k) {
+    alpha[k] = s_[k].dot(q) / y_[k].dot(s_[k]);
+    q -= alpha[k] * y_[k];
+  }
+  if (!s_.empty()) q *= s_.back().dot(y_.back()) / y_.back().squaredNorm();
+  else q *= max_step / g.cwiseAbs().maxCoeff();  // first step: at most max_step rad
+  for (std::size_t k = 0; k < s_.size(); ++k) {
+    const double beta = y_[k].dot(q) / y_[k].dot(s_[k]);
+    q += (alpha[k] - beta) * s_[k];
+  }
+  Eigen::VectorXd d = -q;
+  if (!(g.dot(d) < 0)) {  // not a descent direction: restart from steepest descent
+    reset();
+    gradient_ = g;
+    gradient_at_ = current.joints;
+    d = -g * (max_step / g.cwiseAbs().maxCoeff());
+  }
+  const double slope = g.dot(d);
+  double t = 1.0;
+  for (int k = 0; k < 16; ++k, t *= 0.5) {
+    const Eigen::VectorXd theta = current.joints + t * d;
+    const Evaluation trial = objective.evaluate(theta, current.positions);
+    if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
+    const bool tiny = negligible(current.objective, trial.objective);
+    const Eigen::VectorXd g_new = objective.gradient(trial, method_);
+    const Eigen::VectorXd s = trial.joints - current.joints, y = g_new - g;
+    if (s.dot(y) > 1e-12 * s.norm() * y.norm()) {
+      s_.push_back(s);
+      y_.push_back(y);
+      if (static_cast<int>(s_.size()) > memory) {
+        s_.pop_front();
+        y_.pop_front();
+      }
+    }
+    current = trial;
+    gradient_ = g_new;
+    gradient_at_ = current.joints;
+    return tiny ? StepOutcome::Converged : StepOutcome::Improved;
+  }
+  if (s_.empty()) return StepOutcome::Stuck;
+  reset();  // the curvature model misled the search: retry once along the steepest descent
+  return step(objective, current);
+}
+
+std::unique_ptr<Optimizer> make_optimizer(OptimizerKind kind, GradientMethod gradient) {
+  if (kind == OptimizerKind::Lbfgs) return std::make_unique<Lbfgs>(gradient);
+  return std::make_unique<GaussNewton>();
+}
+
+}  // namespace shapectl

@@ -1,0 +1,69 @@
+#pragma once
+// Joint-space optimizers for the reduced objective, one iteration at a time so a controller
+// can interleave target edits. Every trial θ re-solves statics warm-started from the current
+// (accepted) state, which keeps the object on its equilibrium branch (paper Fig. 8). Starting
+// from a safe state (converged, collision-free, within limits), only safe states are accepted.
+#include <deque>
+#include <memory>
+#include <string>
+
+#include <shapectl/control/reduced_objective.hpp>
+
+namespace shapectl {
+
+enum class StepOutcome {
+  Improved,   // a better θ was accepted into `current`
+  Converged,  // stationary: no further progress expected
+  Stuck,      // no acceptable step found (e.g. every trial collides or statics failed)
+};
+const char* to_string(StepOutcome outcome);
+
+class Optimizer {
+ public:
+  virtual ~Optimizer() = default;
+  virtual std::string name() const = 0;
+  virtual StepOutcome step(ReducedObjective& objective, Evaluation& current) = 0;
+  // Forget accumulated curvature/damping, e.g. after the targets changed.
+  virtual void reset() = 0;
+};
+
+enum class OptimizerKind { GaussNewton, Lbfgs };
+
+// Levenberg–Marquardt on the residual form; J from direct sensitivities plus the barrier
+// residual Jacobians. The next equilibrium is predicted with dx̂/dθ·Δθ before Newton starts.
+class GaussNewton : public Optimizer {
+ public:
+  std::string name() const override { return "gauss-newton"; }
+  StepOutcome step(ReducedObjective& objective, Evaluation& current) override;
+  void reset() override { damping_ = 1e-6; }
+  double max_step = 0.5;  // rad, largest joint change per trial
+
+ private:
+  double damping_ = 1e-6;
+};
+
+// L-BFGS with a backtracking (Armijo) line search, as in the paper.
+class Lbfgs : public Optimizer {
+ public:
+  explicit Lbfgs(GradientMethod method) : method_(method) {}
+  std::string name() const override { return "lbfgs"; }
+  StepOutcome step(ReducedObjective& objective, Evaluation& current) override;
+  void reset() override;
+  int memory = 8;
+  double max_step = 0.2;  // rad, largest joint change of a first (unscaled) step
+
+ private:
+  GradientMethod method_;
+  std::deque<Eigen::VectorXd> s_, y_;
+  Eigen::VectorXd gradient_;  // at the current point, if known
+  Eigen::VectorXd gradient_at_;
+};
+
+std::unique_ptr<Optimizer> make_optimizer(OptimizerKind kind, GradientMethod gradient);
+
+// Solves statics at `joints` from `x`, trying the prediction first and falling back to the
+// plain warm start if the predicted state is inverted or does not converge.
+Evaluation evaluate_predicted(ReducedObjective& objective, const Eigen::VectorXd& joints,
+                              const Positions& warm, const Positions& predicted);
+
+}  // namespace shapectl

@@ -1,0 +1,30 @@
+#pragma once
+// Compressible neo-Hookean elasticity on linear tetrahedra (paper eq. 2):
+// Ψ(F) = μ/2 (tr(FᵀF) − 3) − μ ln J + κ/2 (ln J)², J = det F, energy = Σ rest volume · Ψ.
+#include <shapectl/fem/energy_term.hpp>
+#include <shapectl/fem/material.hpp>
+#include <shapectl/mesh/tet_mesh.hpp>
+
+namespace shapectl {
+
+// Energy of one tet at corner positions x = [x0 x1 x2 x3]; +inf when J <= 0 (then gradient
+// and Hessian are left untouched) so no line search accepts an inverted state.
+// `project_psd` clamps the negative eigenvalues of ∂²Ψ/∂F² so the Hessian is PSD.
+double neo_hookean_tet(const TetRest& rest, const Material& m, const Vec12& x,
+                       Vec12* gradient = nullptr, Mat12* hessian = nullptr,
+                       bool project_psd = false);
+
+class NeoHookean : public EnergyTerm {
+ public:
+  NeoHookean(const TetMesh& mesh, const Material& material) : mesh_(mesh), material_(material) {}
+  std::string_view name() const override { return "neo_hookean"; }
+  double value(const Positions& x) const override;
+  void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
+  void add_hessian(const Positions& x, Triplets& hessian, bool project_psd) const override;
+
+ private:
+  const TetMesh& mesh_;
+  Material material_;
+};
+
+}  // namespace shapectl

@@ -1,0 +1,64 @@
+#pragma once
+// Strict reading of JSON input files: every value knows its file and path
+// ("scene.json: object.material.mu"), so errors say where and what was expected.
+#include <Eigen/Core>
+#include <filesystem>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <shapectl/io/input_error.hpp>
+
+namespace shapectl {
+
+class JsonInput {
+ public:
+  // Reads and parses a file; a missing file or a syntax error is an InputError naming it.
+  static JsonInput load(const std::filesystem::path& file);
+  JsonInput(nlohmann::json value, std::string source, std::string path = "");
+
+  const nlohmann::json& raw() const { return value_; }
+  const std::string& source() const { return source_; }
+  const std::string& path() const { return path_; }
+  // The directory of the file this came from, for resolving relative paths.
+  std::filesystem::path directory() const;
+
+  bool is_object() const { return value_.is_object(); }
+  bool is_array() const { return value_.is_array(); }
+  bool is_string() const { return value_.is_string(); }
+  bool is_number() const { return value_.is_number(); }
+
+  bool has(std::string_view key) const;
+  JsonInput at(std::string_view key) const;   // required member of an object
+  JsonInput at(std::size_t index) const;      // element of an array
+  std::size_t size() const;                   // length of an array (error if not an array)
+  std::vector<std::string> keys() const;      // members of an object, in file order
+  // Every member must be one of `known`; a typo must never silently change the physics.
+  void expect_only(std::initializer_list<std::string_view> known) const;
+  void expect_only(const std::vector<std::string>& known) const;
+
+  double number() const;        // finite
+  double positive() const;      // finite, > 0
+  double non_negative() const;  // finite, >= 0
+  long integer() const;         // a whole number
+  long integer_in(long lo, long hi) const;  // lo <= value <= hi
+  bool boolean() const;
+  std::string string() const;
+  Eigen::Vector3d vec3() const;             // [x, y, z], finite
+  std::vector<double> numbers() const;      // array of finite numbers
+
+  // Throws InputError "<source>: <path>: expected <expected>, got <what is there>".
+  [[noreturn]] void fail(const std::string& expected) const;
+  [[noreturn]] void fail_problem(const std::string& problem) const;
+
+ private:
+  std::string child_path(std::string_view key) const;
+  std::string shown() const;
+  nlohmann::json value_;
+  std::string source_;
+  std::string path_;
+};
+
+}  // namespace shapectl

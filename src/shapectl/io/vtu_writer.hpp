@@ -1,0 +1,26 @@
+#pragma once
+// Writes tetrahedral meshes as VTK XML UnstructuredGrid (.vtu) files for ParaView.
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <shapectl/types.hpp>
+
+namespace shapectl {
+
+struct VtuNodeField {
+  std::string name;  // e.g. "displacement"
+  Positions values;  // one 3-vector per node, stacked [v0; v1; ...], size 3n
+};
+
+// Writes an ASCII .vtu of linear tets: `positions` stacked [x0; x1; ...] in metres (size 3n),
+// `tets` indexing them, and per-node vector fields. The file is written beside its target and
+// renamed over it, so a failure never leaves a half-written or damaged file behind.
+// Throws InputError naming the file if it cannot be written (e.g. its directory is missing),
+// std::invalid_argument if sizes or indices do not match.
+void write_vtu(const std::filesystem::path& file, const Positions& positions,
+               const std::vector<std::array<int, 4>>& tets,
+               const std::vector<VtuNodeField>& node_fields = {});
+
+}  // namespace shapectl

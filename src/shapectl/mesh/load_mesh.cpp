@@ -1,0 +1,24 @@
+#include <shapectl/mesh/load_mesh.hpp>
+
+#include <cctype>
+#include <string>
+
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/mesh/msh_reader.hpp>
+#include <shapectl/mesh/tetgen_reader.hpp>
+
+namespace shapectl {
+
+TetMesh load_mesh(const std::filesystem::path& file, const SurfaceMeshOptions& surface_options) {
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".msh") return read_msh(file);
+  if (extension == ".node" || extension == ".ele") return read_tetgen(file);
+  if (extension == ".obj" || extension == ".stl" || extension == ".off")
+    return mesh_surface(file, surface_options);
+  throw InputError(file.string(), "",
+                   "unknown mesh format '" + extension +
+                       "' (supported: .msh, .node/.ele, and surfaces .obj, .stl, .off)");
+}
+
+}  // namespace shapectl

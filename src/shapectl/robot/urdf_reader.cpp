@@ -1,0 +1,315 @@
+// RobotModel from URDF text: urdfdom parses, this file checks and flattens the tree.
+#include <console_bridge/console.h>
+#include <urdf_parser/urdf_parser.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <regex>
+#include <set>
+#include <sstream>
+
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/robot/robot_model.hpp>
+
+namespace shapectl {
+
+namespace {
+
+// urdfdom reports problems through console_bridge; collect them so the InputError can say why.
+class CapturedLog : public console_bridge::OutputHandler {
+ public:
+  void log(const std::string& text, console_bridge::LogLevel level, const char*, int) override {
+    if (level >= console_bridge::CONSOLE_BRIDGE_LOG_WARN) lines.push_back(text);
+  }
+  std::vector<std::string> lines;
+};
+
+// First line of each top-level <tag name="..."> element, for messages and sibling order.
+// <joint> elements inside <transmission> carry no type attribute, so joints need `type=`.
+std::map<std::string, int> element_lines(const std::string& xml, const std::string& tag,
+                                         bool need_type) {
+  std::map<std::string, int> lines;
+  const std::string open = "<" + tag;
+  for (std::size_t at = xml.find(open); at != std::string::npos; at = xml.find(open, at + 1)) {
+    const char next = at + open.size() < xml.size() ? xml[at + open.size()] : '>';
+    if (!std::isspace(static_cast<unsigned char>(next))) continue;
+    const std::size_t end = xml.find('>', at);
+    const std::string head = xml.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    if (need_type && head.find("type") == std::string::npos) continue;
+    static const std::regex name_attribute(R"(\sname\s*=\s*["']([^"']*)["'])");
+    std::smatch match;
+    if (!std::regex_search(head, match, name_attribute)) continue;
+    const std::string name = match[1];
+    const int line = 1 + static_cast<int>(std::count(xml.begin(), xml.begin() + static_cast<long>(at), '\n'));
+    lines.emplace(name, line);  // keeps the first
+  }
+  return lines;
+}
+
+}  // namespace
+
+class UrdfReader {
+ public:
+  UrdfReader(const std::string& xml, const std::string& source)
+      : source_(source),
+        joint_lines_(element_lines(xml, "joint", true)),
+        link_lines_(element_lines(xml, "link", false)) {}
+
+  RobotModel read(const std::string& xml) {
+    const urdf::ModelInterfaceSharedPtr urdf = parse(xml);
+    check_single_parents(*urdf);
+    RobotModel model;
+    model.name_ = urdf->getName();
+    model.source_ = source_;
+    add_subtree(*urdf, urdf->getRoot(), -1, model);
+    for (const auto& [name, link] : urdf->links_)
+      if (!model.find_link(name))
+        throw InputError(where_link(name), "link '" + name + "'",
+                         "not reachable from the root link '" + urdf->getRoot()->name +
+                             "' (a kinematic loop?)");
+    resolve_mimics(*urdf, model);
+    if (skipped_meshes_ > 0)
+      model.warnings_.push_back(source_ + ": " + std::to_string(skipped_meshes_) +
+                                " mesh geometries skipped (meshes are not loaded), first: " +
+                                first_skipped_);
+    model.fixed_values_ = Eigen::VectorXd::Zero(model.joint_count());
+    std::vector<std::string> movable;
+    for (const Joint& joint : model.joints_)
+      if (joint.movable() && joint.mimic_master < 0) movable.push_back(joint.name);
+    model.set_active_joints(movable);
+    return model;
+  }
+
+ private:
+  urdf::ModelInterfaceSharedPtr parse(const std::string& xml) {
+    static std::mutex log_mutex;  // console_bridge's handler is process-wide
+    std::lock_guard lock(log_mutex);
+    CapturedLog log;
+    console_bridge::useOutputHandler(&log);
+    urdf::ModelInterfaceSharedPtr urdf;
+    std::string thrown;
+    try {
+      urdf = urdf::parseURDF(xml);
+    } catch (const std::exception& e) {
+      thrown = e.what();
+    }
+    console_bridge::restorePreviousOutputHandler();
+    if (urdf) return urdf;
+    std::string why = thrown;
+    for (const auto& line : log.lines) why += (why.empty() ? "" : "; ") + line;
+    throw InputError(source_, "", "not a valid URDF: " + (why.empty() ? "parse failed" : why));
+  }
+
+  // urdfdom silently keeps the last parent when a link is the child of two joints.
+  void check_single_parents(const urdf::ModelInterface& urdf) const {
+    std::map<std::string, std::string> parent_joint;
+    for (const auto& [name, joint] : urdf.joints_) {
+      const auto [it, fresh] = parent_joint.emplace(joint->child_link_name, name);
+      if (!fresh)
+        throw InputError(where_joint(name), "joint '" + name + "'",
+                         "link '" + joint->child_link_name + "' already has parent joint '" +
+                             it->second + "' (kinematic loop; URDF must be a tree)");
+    }
+  }
+
+  void add_subtree(const urdf::ModelInterface& urdf, const urdf::LinkConstSharedPtr& link,
+                   int parent_joint, RobotModel& model) {
+    const int index = model.link_count();
+    Link out;
+    out.name = link->name;
+    out.parent_joint = parent_joint;
+    for (const auto& visual : link->visual_array)
+      if (visual) add_shape(link->name, "visual", visual->geometry, visual->origin, out.visual_shapes);
+    for (const auto& collision : link->collision_array)
+      if (collision)
+        add_shape(link->name, "collision", collision->geometry, collision->origin,
+                  out.collision_shapes);
+    model.links_.push_back(std::move(out));
+    model.link_by_name_[link->name] = index;
+    if (parent_joint >= 0) model.joints_[static_cast<std::size_t>(parent_joint)].child_link = index;
+
+    std::vector<urdf::JointSharedPtr> children = link->child_joints;
+    std::sort(children.begin(), children.end(), [&](const auto& a, const auto& b) {
+      return std::pair(line_of(joint_lines_, a->name), a->name) <
+             std::pair(line_of(joint_lines_, b->name), b->name);
+    });
+    for (const auto& joint : children) {
+      const int j = model.joint_count();
+      model.joints_.push_back(convert_joint(*joint, index));
+      model.joint_by_name_[joint->name] = j;
+      add_subtree(urdf, urdf.getLink(joint->child_link_name), j, model);
+    }
+  }
+
+  Joint convert_joint(const urdf::Joint& in, int parent_link) const {
+    const std::string where = where_joint(in.name);
+    const std::string element = "joint '" + in.name + "'";
+    Joint out;
+    out.name = in.name;
+    out.parent_link = parent_link;
+    out.T_parent_child = pose(in.parent_to_joint_origin_transform, where, element + ": origin");
+    const double inf = std::numeric_limits<double>::infinity();
+    switch (in.type) {
+      case urdf::Joint::FIXED: out.type = JointType::Fixed; return out;
+      case urdf::Joint::REVOLUTE: out.type = JointType::Revolute; break;
+      case urdf::Joint::CONTINUOUS: out.type = JointType::Continuous; break;
+      case urdf::Joint::PRISMATIC: out.type = JointType::Prismatic; break;
+      default:
+        throw InputError(where, element,
+                         "unsupported joint type; expected revolute, continuous, prismatic or fixed");
+    }
+    const Vec3 axis(in.axis.x, in.axis.y, in.axis.z);
+    if (!axis.allFinite() || !(axis.norm() > 1e-12))
+      throw InputError(where, element + ": axis", "a finite non-zero vector",
+                       vec_text(axis));
+    out.axis = axis.normalized();
+    out.lower = -inf;
+    out.upper = inf;
+    out.velocity = inf;
+    if (in.limits) {
+      if (!std::isfinite(in.limits->velocity) || in.limits->velocity < 0)
+        throw InputError(where, element + ": limit velocity", "a finite non-negative number",
+                         in.limits->velocity);
+      if (in.limits->velocity > 0) out.velocity = in.limits->velocity;
+      if (out.type != JointType::Continuous) {
+        if (!std::isfinite(in.limits->lower) || !std::isfinite(in.limits->upper))
+          throw InputError(where, element + ": limit", "finite lower and upper",
+                           std::to_string(in.limits->lower) + " / " + std::to_string(in.limits->upper));
+        if (in.limits->lower > in.limits->upper)
+          throw InputError(where, element,
+                           "limit lower " + number_text(in.limits->lower) + " > upper " +
+                               number_text(in.limits->upper));
+        out.lower = in.limits->lower;
+        out.upper = in.limits->upper;
+      }
+    } else if (out.type != JointType::Continuous) {
+      throw InputError(where, element, "a <limit> element (required for revolute and prismatic)");
+    }
+    return out;
+  }
+
+  // Mimic chains end at a joint that mimics nothing; factors compose along the way.
+  void resolve_mimics(const urdf::ModelInterface& urdf, RobotModel& model) const {
+    for (Joint& joint : model.joints_) {
+      const auto in = urdf.getJoint(joint.name);
+      if (!in->mimic || !joint.movable()) continue;
+      const std::string where = where_joint(joint.name);
+      const std::string element = "joint '" + joint.name + "': mimic";
+      double multiplier = 1, offset = 0;
+      urdf::JointConstSharedPtr current = in;
+      std::set<std::string> seen{joint.name};
+      while (current->mimic) {
+        const std::string& master = current->mimic->joint_name;
+        if (!std::isfinite(current->mimic->multiplier) || !std::isfinite(current->mimic->offset))
+          throw InputError(where, element, "finite multiplier and offset");
+        offset = current->mimic->multiplier * offset + current->mimic->offset;
+        multiplier *= current->mimic->multiplier;
+        if (!seen.insert(master).second)
+          throw InputError(where, element, "mimic joints form a cycle through '" + master + "'");
+        current = urdf.getJoint(master);
+        if (!current) throw InputError(where, element, "unknown joint '" + master + "'");
+        if (current->type == urdf::Joint::FIXED)
+          throw InputError(where, element, "joint '" + master + "' is fixed");
+      }
+      joint.mimic_master = model.joint_index(current->name);
+      joint.mimic_multiplier = multiplier;
+      joint.mimic_offset = offset;
+    }
+  }
+
+  void add_shape(const std::string& link, const std::string& kind,
+                 const urdf::GeometrySharedPtr& geometry, const urdf::Pose& origin,
+                 std::vector<Shape>& shapes) {
+    if (!geometry) return;
+    const std::string where = where_link(link);
+    const std::string element = "link '" + link + "': " + kind;
+    Shape shape;
+    shape.T_link_shape = pose(origin, where, element + " origin");
+    auto positive = [&](double v, const std::string& what) {
+      if (!std::isfinite(v) || !(v > 0)) throw InputError(where, element + " " + what, "a positive number", v);
+      return v;
+    };
+    switch (geometry->type) {
+      case urdf::Geometry::SPHERE: {
+        shape.kind = Shape::Kind::Sphere;
+        shape.radius = positive(static_cast<const urdf::Sphere&>(*geometry).radius, "sphere radius");
+        break;
+      }
+      case urdf::Geometry::BOX: {
+        const auto& dim = static_cast<const urdf::Box&>(*geometry).dim;
+        shape.kind = Shape::Kind::Box;
+        shape.box_size = {positive(dim.x, "box size x"), positive(dim.y, "box size y"),
+                          positive(dim.z, "box size z")};
+        break;
+      }
+      case urdf::Geometry::CYLINDER: {
+        const auto& cylinder = static_cast<const urdf::Cylinder&>(*geometry);
+        shape.kind = Shape::Kind::Cylinder;
+        shape.radius = positive(cylinder.radius, "cylinder radius");
+        shape.length = positive(cylinder.length, "cylinder length");
+        break;
+      }
+      default: {
+        if (skipped_meshes_++ == 0)
+          first_skipped_ = element + " mesh '" +
+                           static_cast<const urdf::Mesh&>(*geometry).filename + "'";
+        return;
+      }
+    }
+    shapes.push_back(shape);
+  }
+
+  Eigen::Isometry3d pose(const urdf::Pose& p, const std::string& where,
+                         const std::string& element) const {
+    const Vec3 t(p.position.x, p.position.y, p.position.z);
+    const Eigen::Quaterniond q(p.rotation.w, p.rotation.x, p.rotation.y, p.rotation.z);
+    if (!t.allFinite() || !q.coeffs().allFinite())
+      throw InputError(where, element, "finite numbers", vec_text(t));
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = q.normalized().toRotationMatrix();
+    T.translation() = t;
+    return T;
+  }
+
+  static int line_of(const std::map<std::string, int>& lines, const std::string& name) {
+    const auto it = lines.find(name);
+    return it == lines.end() ? std::numeric_limits<int>::max() : it->second;
+  }
+  std::string where_joint(const std::string& name) const { return located(joint_lines_, name); }
+  std::string where_link(const std::string& name) const { return located(link_lines_, name); }
+  std::string located(const std::map<std::string, int>& lines, const std::string& name) const {
+    const auto it = lines.find(name);
+    return it == lines.end() ? source_ : source_ + ":" + std::to_string(it->second);
+  }
+  static std::string number_text(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
+  static std::string vec_text(const Vec3& v) {
+    return number_text(v.x()) + " " + number_text(v.y()) + " " + number_text(v.z());
+  }
+
+  std::string source_;
+  std::map<std::string, int> joint_lines_;
+  std::map<std::string, int> link_lines_;
+  int skipped_meshes_ = 0;
+  std::string first_skipped_;
+};
+
+RobotModel RobotModel::from_urdf_string(const std::string& xml, const std::string& source_name) {
+  return UrdfReader(xml, source_name).read(xml);
+}
+
+RobotModel RobotModel::load_urdf_file(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError(file.string(), "", "cannot open file");
+  std::stringstream text;
+  text << in.rdbuf();
+  return from_urdf_string(text.str(), file.string());
+}
+
+}  // namespace shapectl

@@ -1,0 +1,94 @@
+#pragma once
+// The immutable description of a scene, read from SCENE.json: the object (mesh, material,
+// placement), gravity and what holds it (fixed nodes). Paths are relative to the scene file.
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include <shapectl/fem/material.hpp>
+#include <shapectl/io/json_input.hpp>
+#include <shapectl/mesh/tet_mesh.hpp>
+#include <shapectl/robot/collision_spheres.hpp>
+#include <shapectl/robot/robot_model.hpp>
+#include <shapectl/sim/sparse_cholesky.hpp>
+
+namespace shapectl {
+
+struct AlignedBox {
+  Vec3 min, max;
+  bool contains(const Vec3& p) const {
+    return (p - min).minCoeff() >= 0 && (max - p).minCoeff() >= 0;
+  }
+};
+
+// A set of mesh nodes chosen by an object-space box and/or explicit indices.
+struct NodeSelection {
+  std::optional<AlignedBox> box;
+  std::vector<int> nodes;
+  // Indices of the selected nodes of `mesh` (rest positions in object coordinates).
+  std::vector<int> resolve(const TetMesh& mesh) const;
+};
+
+struct StaticsSettings {
+  int max_iterations = 100;
+  double relative_tolerance = 1e-6;  // force tolerance as a fraction of the object's weight
+  std::optional<SparseCholesky::Backend> backend;  // "ldlt" | "cholmod"; default by size
+};
+
+struct EndEffector {
+  std::string name;
+  int link = -1;
+  Vec3 tcp_link = Vec3::Zero();  // tool centre point in the link frame, metres
+};
+
+// The robot part of a scene: model, reference configuration θ⁰ and what it grips with.
+struct RobotSetup {
+  std::shared_ptr<RobotModel> model;
+  Eigen::VectorXd reference_joints;  // θ⁰, active joints, rad
+  std::vector<EndEffector> end_effectors;
+  std::shared_ptr<const CollisionModel> collisions;  // may be null: no self-collision term
+  double joint_limit_margin = 0.05;      // rad (m for prismatic)
+  double joint_limit_stiffness = 1e3;    // k of the cubic barrier
+};
+
+struct Grip {
+  int end_effector = -1;  // index into RobotSetup::end_effectors
+  std::vector<int> nodes;
+};
+
+struct ObjectiveWeights {
+  double shape = 1.0;         // × ½ Σ |pᵢ − p'ᵢ|²  (m²)
+  double collision = 1.0;     // × collision barrier
+  double joint_limits = 1.0;  // × joint-limit barrier
+};
+
+struct Scene {
+  std::filesystem::path source;                // the scene file
+  std::shared_ptr<const TetMesh> object_mesh;  // rest mesh in object coordinates
+  Material material;
+  Eigen::Isometry3d T_world_object = Eigen::Isometry3d::Identity();
+  Vec3 gravity{0, 0, -9.81};
+  std::optional<NodeSelection> fixed;
+  StaticsSettings statics;
+  std::optional<RobotSetup> robot;
+  std::vector<Grip> grips;
+  double grip_stiffness = 1e4;  // K, N/m
+  ObjectiveWeights weights;
+
+  // Rest positions placed in the world, stacked (3n).
+  Positions world_rest_positions() const;
+};
+
+// Reads and validates a scene; throws InputError naming the file and field.
+Scene load_scene(const std::filesystem::path& file);
+
+// Parsers shared by scene-like files.
+AlignedBox read_box(const JsonInput& j);
+NodeSelection read_node_selection(const JsonInput& j, int node_count);
+Eigen::Isometry3d read_pose(const JsonInput& j);
+
+}  // namespace shapectl

@@ -1,0 +1,191 @@
+#include <shapectl/sim/statics.hpp>
+
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace shapectl {
+
+const char* to_string(StaticsStatus status) {
+  switch (status) {
+    case StaticsStatus::Converged: return "converged";
+    case StaticsStatus::NotConverged: return "not converged";
+    case StaticsStatus::Inverted: return "inverted";
+    case StaticsStatus::Singular: return "singular";
+  }
+  return "?";
+}
+
+namespace {
+std::vector<char> dof_mask(const std::vector<char>& fixed_node) {
+  std::vector<char> dof(3 * fixed_node.size());
+  for (std::size_t i = 0; i < fixed_node.size(); ++i)
+    for (int k = 0; k < 3; ++k) dof[3 * i + k] = fixed_node[i];
+  return dof;
+}
+std::string sci(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+}  // namespace
+
+StaticsSolver::StaticsSolver(int node_count, std::vector<const EnergyTerm*> terms,
+                             std::vector<char> fixed_node, StaticsOptions options)
+    : node_count_(node_count),
+      terms_(std::move(terms)),
+      options_(options),
+      assembler_(3 * node_count, dof_mask(fixed_node)),
+      cholesky_(options.backend.value_or(SparseCholesky::choose(3 * node_count))) {}
+
+double StaticsSolver::energy(const Positions& x) const {
+  double e = 0;
+  for (const auto* t : terms_) e += t->value(x);
+  return std::isnan(e) ? std::numeric_limits<double>::infinity() : e;
+}
+
+Eigen::VectorXd StaticsSolver::gradient(const Positions& x) const {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+  for (const auto* t : terms_) t->add_gradient(x, g);
+  const auto& fixed = assembler_.fixed_dof();
+  for (int d = 0; d < g.size(); ++d)
+    if (fixed[d]) g[d] = 0;
+  return g;
+}
+
+double StaticsSolver::max_force(const Eigen::VectorXd& g) const {
+  double m = 0;
+  for (int i = 0; i < node_count_; ++i) m = std::max(m, g.segment<3>(3 * i).norm());
+  return std::isfinite(m) ? m : std::numeric_limits<double>::infinity();
+}
+
+bool StaticsSolver::factor_at(const Positions& x, bool projected) {
+  triplets_.clear();
+  for (const auto* t : terms_) t->add_hessian(x, triplets_, projected);
+  const SparseMatrix& H = assembler_.assemble(triplets_);
+  if (!analyzed_ || assembler_.pattern_changed()) {
+    cholesky_.analyze(H);
+    analyzed_ = true;
+  }
+  ++factorizations_;
+  const bool ok = cholesky_.factorize(H);
+  factor_is_true_ = ok && !projected;
+  if (factor_is_true_) factor_x_ = x;
+  return ok;
+}
+
+SparseMatrix StaticsSolver::hessian(const Positions& x) {
+  triplets_.clear();
+  for (const auto* t : terms_) t->add_hessian(x, triplets_, false);
+  return assembler_.assemble(triplets_);
+}
+
+Eigen::MatrixXd StaticsSolver::solve_hessian(const Positions& x, const Eigen::MatrixXd& rhs,
+                                             double stale_step) {
+  const bool exact = factor_is_true_ && factor_x_.size() == x.size() && factor_x_ == x;
+  const bool close = factor_is_true_ && stale_step > 0 && solved_x_.size() == x.size() &&
+                     solved_x_ == x && last_step_from_factor_ <= stale_step;
+  const bool reusable = exact || close;
+  if (!reusable && !factor_at(x, false))
+    throw std::runtime_error("the Hessian at the equilibrium is not positive definite");
+  Eigen::MatrixXd masked = rhs;
+  const auto& fixed = assembler_.fixed_dof();
+  for (int d = 0; d < masked.rows(); ++d)
+    if (fixed[d]) masked.row(d).setZero();
+  return cholesky_.solve(masked);
+}
+
+StaticsResult StaticsSolver::solve(Positions& x) {
+  StaticsResult result = newton(x);
+  solved_x_ = x;
+  last_step_from_factor_ = std::numeric_limits<double>::infinity();
+  if (!result.log.empty() && !result.log.back().projected && factor_is_true_)
+    last_step_from_factor_ = result.log.back().step;
+  return result;
+}
+
+StaticsResult StaticsSolver::newton(Positions& x) {
+  StaticsResult result;
+  double e = energy(x);
+  if (!std::isfinite(e)) {
+    result.status = StaticsStatus::Inverted;
+    result.reason = "the starting state has an inverted element";
+    return result;
+  }
+  Eigen::VectorXd g = gradient(x);
+  double residual = max_force(g);
+  for (int it = 0;; ++it) {
+    result.iterations = it;
+    result.residual = residual;
+    result.energy = e;
+    if (residual <= options_.force_tolerance) {
+      result.status = StaticsStatus::Converged;
+      result.reason = "residual " + sci(residual) + " N after " + std::to_string(it) + " iterations";
+      return result;
+    }
+    if (it == options_.max_iterations) {
+      result.status = StaticsStatus::NotConverged;
+      result.reason = "not converged: residual " + sci(residual) + " N after " +
+                      std::to_string(it) + " iterations";
+      return result;
+    }
+    NewtonIterate log{.iteration = it, .residual = residual, .energy = e};
+    // True Hessian first; it must also give a descent direction.
+    Eigen::VectorXd dx;
+    if (factor_at(x, false)) {
+      dx = -cholesky_.solve(g);
+      if (!(g.dot(dx) < 0)) dx.resize(0);
+    }
+    if (dx.size() == 0) {
+      log.projected = true;
+      if (!factor_at(x, true)) {
+        result.status = StaticsStatus::Singular;
+        result.reason =
+            "singular system: the Hessian is singular even after projection (is the object "
+            "held? every part of it needs fixed or gripped nodes)";
+        return result;
+      }
+      dx = -cholesky_.solve(g);
+    }
+    // Backtracking line search on the energy (Armijo). Inverted trial states have E = +inf.
+    const double slope = g.dot(dx);
+    double alpha = 1.0;
+    Positions trial;
+    double e_trial = 0;
+    Eigen::VectorXd g_trial;
+    double r_trial = 0;
+    bool accepted = false;
+    for (int k = 0; k < 40 && !accepted; ++k, alpha *= 0.5) {
+      trial = x + alpha * dx;
+      e_trial = energy(trial);
+      if (!std::isfinite(e_trial)) continue;
+      const bool armijo = e_trial <= e + 1e-4 * alpha * slope;
+      // Near the solution the energy change drowns in round-off: then accept a step that
+      // does not raise the energy beyond round-off and lowers the force.
+      const bool roundoff = e_trial <= e + 1e-12 * std::abs(e) + 1e-300;
+      if (!armijo && !roundoff) continue;
+      g_trial = gradient(trial);
+      r_trial = max_force(g_trial);
+      accepted = armijo || r_trial < residual;
+    }
+    if (!accepted) {
+      result.status = StaticsStatus::NotConverged;
+      result.reason = "line search failed at residual " + sci(residual) + " N after " +
+                      std::to_string(it) + " iterations";
+      return result;
+    }
+    alpha *= 2;  // undo the last halving of the loop
+    log.step_length = alpha;
+    double step = 0;
+    for (int i = 0; i < node_count_; ++i) step = std::max(step, alpha * dx.segment<3>(3 * i).norm());
+    log.step = step;
+    result.log.push_back(log);
+    x = trial;
+    e = e_trial;
+    g = g_trial;
+    residual = r_trial;
+  }
+}
+
+}  // namespace shapectl

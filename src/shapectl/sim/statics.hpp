@@ -1,0 +1,95 @@
+#pragma once
+// Quasi-static equilibrium x̂ = argmin_x E(x) (paper eq. 1) by Newton's method with a
+// backtracking line search. Newton factors the true Hessian; only a step where that fails
+// (indefinite far from equilibrium) falls back to element-wise PSD-projected Hessians.
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <shapectl/fem/energy_term.hpp>
+#include <shapectl/sim/hessian_assembler.hpp>
+#include <shapectl/sim/sparse_cholesky.hpp>
+
+namespace shapectl {
+
+enum class StaticsStatus { Converged, NotConverged, Inverted, Singular };
+const char* to_string(StaticsStatus status);
+
+struct StaticsOptions {
+  double force_tolerance = 1e-6;  // N: converged when every free node's force is below this
+  int max_iterations = 100;
+  // Which sparse Cholesky; by default chosen by system size (SparseCholesky::choose).
+  std::optional<SparseCholesky::Backend> backend;
+};
+
+struct NewtonIterate {
+  int iteration = 0;
+  double residual = 0;       // largest nodal force norm at the start of the iteration, N
+  double energy = 0;         // J
+  double step = 0;           // largest nodal displacement of the accepted step, m
+  double step_length = 0;    // line-search factor α
+  bool projected = false;    // the PSD-projected Hessian was used
+};
+
+struct StaticsResult {
+  StaticsStatus status = StaticsStatus::NotConverged;
+  std::string reason;  // why it stopped, e.g. "residual 3e-2 N after 50 iterations"
+  int iterations = 0;
+  double residual = 0;  // largest nodal force norm at the returned state, N
+  double energy = 0;
+  std::vector<NewtonIterate> log;
+  bool converged() const { return status == StaticsStatus::Converged; }
+};
+
+class StaticsSolver {
+ public:
+  // terms: the energy (not owned; must outlive the solver). fixed_node[i]: node i keeps the
+  // position it has in x (Dirichlet). Sizes: n nodes, 3n unknowns.
+  StaticsSolver(int node_count, std::vector<const EnergyTerm*> terms, std::vector<char> fixed_node,
+                StaticsOptions options = {});
+  // Starts from x (warm start) and overwrites it with the equilibrium or the last iterate.
+  StaticsResult solve(Positions& x);
+
+  // Total energy and its gradient (fixed dofs zeroed) at x.
+  double energy(const Positions& x) const;
+  Eigen::VectorXd gradient(const Positions& x) const;
+  // Solves H(x) Y = rhs with the true Hessian at x, rows of fixed dofs zero. Reuses the
+  // factorization when it is of the true Hessian at exactly this x, or — when x is the result
+  // of the last solve and `stale_step` > 0 — at the start of that solve's last Newton step,
+  // provided that step moved no node more than `stale_step` metres (an error of that order
+  // in H; it saves a factorization per optimizer iteration).
+  Eigen::MatrixXd solve_hessian(const Positions& x, const Eigen::MatrixXd& rhs,
+                                double stale_step = 0);
+  // The true Hessian at x, lower triangle, fixed dofs eliminated (for tests and tools).
+  SparseMatrix hessian(const Positions& x);
+
+  const std::vector<char>& fixed_dof() const { return assembler_.fixed_dof(); }
+  const StaticsOptions& options() const { return options_; }
+  void set_force_tolerance(double tolerance) { options_.force_tolerance = tolerance; }
+  int factorizations() const { return factorizations_; }
+
+ private:
+  StaticsResult newton(Positions& x);
+  double max_force(const Eigen::VectorXd& gradient) const;
+  // Assembles and factors at x; projected = use PSD-projected element Hessians.
+  bool factor_at(const Positions& x, bool projected);
+
+  int node_count_;
+  std::vector<const EnergyTerm*> terms_;
+  StaticsOptions options_;
+  HessianAssembler assembler_;
+  SparseCholesky cholesky_;
+  Triplets triplets_;
+  bool analyzed_ = false;
+  // What the current factor is of: the true Hessian at factor_x_, or not usable.
+  bool factor_is_true_ = false;
+  Positions factor_x_;
+  int factorizations_ = 0;
+  // The result of the last solve and how far its last Newton step (from factor_x_) moved.
+  Positions solved_x_;
+  double last_step_from_factor_ = std::numeric_limits<double>::infinity();
+};
+
+}  // namespace shapectl

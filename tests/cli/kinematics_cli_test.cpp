@@ -1,0 +1,161 @@
+// shapectl kinematics: output contract and every class of bad input.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/test_support.hpp"
+
+namespace shapectl {
+namespace {
+
+using test::run_cli;
+using test::source_path;
+using test::TempDir;
+
+const std::string kYumi = source_path("data/robots/yumi/yumi.urdf").string();
+const std::string kYumiSpheres = source_path("data/robots/yumi/yumi_spheres.json").string();
+
+// Two links, one revolute joint; the link carries a ROS package mesh that is not there.
+const char* const kArmUrdf = R"(<?xml version="1.0"?>
+<robot name="arm">
+  <link name="base"/>
+  <joint name="shoulder" type="revolute">
+    <parent link="base"/><child link="upper"/>
+    <origin xyz="0 0 0.5"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/>
+  </joint>
+  <link name="upper">
+    <visual><geometry><mesh filename="package://arm_description/meshes/upper.stl"/></geometry></visual>
+  </link>
+</robot>
+)";
+
+void expect_error(const std::vector<std::string>& args, const std::string& message) {
+  const test::CliRun run = run_cli(args);
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find(message), std::string::npos) << "stderr: " << run.err << "\nexpected: " << message;
+}
+
+TEST(KinematicsCli, WritesLinkPosesClearancesAndLimitViolations) {
+  const TempDir dir;
+  const auto joints = dir.write("joints.json", R"({"joints": {"yumi_joint_2_r": 1.0}})");
+  const auto out = dir.path() / "out.json";
+  const test::CliRun run = run_cli({"kinematics", kYumi, "--joints", joints.string(), "--spheres",
+                                    kYumiSpheres, "--out", out.string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto json = nlohmann::json::parse(test::read_text(out));
+  // All-zero left arm: the known flange pose of kinematics.md §6.3.
+  const auto& flange = json["links"]["gripper_l_base"];
+  EXPECT_NEAR(flange["position"][0].get<double>(), 0.56860, 1e-5);
+  EXPECT_NEAR(flange["position"][1].get<double>(), -0.00497, 1e-5);
+  EXPECT_NEAR(flange["position"][2].get<double>(), 0.51362, 1e-5);
+  EXPECT_EQ(flange["rotation"].size(), 3u);
+  EXPECT_EQ(json["links"]["world"]["position"], nlohmann::json({0.0, 0.0, 0.0}));
+  EXPECT_EQ(json["links"].size(), 25u);
+  EXPECT_LT(json["min_clearance"].get<double>(), 0.0);
+  ASSERT_EQ(json["closest_pairs"].size(), 10u);
+  EXPECT_EQ(json["closest_pairs"][0]["clearance"], json["min_clearance"]);
+  EXPECT_EQ(json["closest_pairs"][0]["links"].size(), 2u);
+  // 1.0 rad is beyond joint 2's upper limit of 43.5°.
+  ASSERT_EQ(json["limit_violations"].size(), 1u);
+  EXPECT_EQ(json["limit_violations"][0]["joint"], "yumi_joint_2_r");
+  EXPECT_EQ(json["limit_violations"][0]["value"], 1.0);
+}
+
+TEST(KinematicsCli, MissingMeshesAreSkippedWithAWarning) {
+  const TempDir dir;
+  const auto urdf = dir.write("arm.urdf", kArmUrdf);
+  const auto joints = dir.write("joints.json", R"({"joints": {"shoulder": 1.5707963267948966}})");
+  const auto out = dir.path() / "out.json";
+  const test::CliRun run = run_cli({"kinematics", urdf.string(), "--joints", joints.string(), "--out", out.string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("warning: " + urdf.string() + ": 1 mesh geometries skipped"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("package://arm_description/meshes/upper.stl"), std::string::npos);
+  const auto json = nlohmann::json::parse(test::read_text(out));
+  const auto& rotation = json["links"]["upper"]["rotation"];
+  EXPECT_NEAR(rotation[0][1].get<double>(), -1.0, 1e-12);  // 90° about z
+  EXPECT_NEAR(rotation[1][0].get<double>(), 1.0, 1e-12);
+  EXPECT_EQ(json["links"]["upper"]["position"], nlohmann::json({0.0, 0.0, 0.5}));
+  EXPECT_TRUE(json["limit_violations"].empty());
+  EXPECT_FALSE(json.contains("min_clearance"));
+}
+
+TEST(KinematicsCli, MissingFilesAreNamed) {
+  const TempDir dir;
+  const auto urdf = dir.write("arm.urdf", kArmUrdf);
+  const std::string out = (dir.path() / "out.json").string();
+  expect_error({"kinematics", (dir.path() / "nope.urdf").string(), "--out", out},
+               (dir.path() / "nope.urdf").string() + ": cannot open file");
+  expect_error({"kinematics", urdf.string(), "--joints", (dir.path() / "j.json").string(), "--out", out},
+               (dir.path() / "j.json").string() + ": cannot open file");
+  expect_error({"kinematics", urdf.string(), "--spheres", (dir.path() / "s.json").string(), "--out", out},
+               (dir.path() / "s.json").string() + ": cannot open file");
+}
+
+TEST(KinematicsCli, UrdfErrorsNameTheFileAndTheElement) {
+  const TempDir dir;
+  const std::string out = (dir.path() / "out.json").string();
+  const auto broken = dir.write("broken.urdf", "<robot name=\"x\"><link name=\"a\"></robot>");
+  expect_error({"kinematics", broken.string(), "--out", out}, broken.string() + ": not a valid URDF");
+
+  std::string bad_limit = kArmUrdf;
+  bad_limit.replace(bad_limit.find("lower=\"-1\""), 10, "lower=\"2.1\"");
+  const auto limit = dir.write("limit.urdf", bad_limit);
+  expect_error({"kinematics", limit.string(), "--out", out},
+               limit.string() + ":4: joint 'shoulder': limit lower 2.1 > upper 1");
+
+  std::string nan_origin = kArmUrdf;
+  nan_origin.replace(nan_origin.find("xyz=\"0 0 0.5\""), 13, "xyz=\"0 0 nan\"");
+  const auto nan = dir.write("nan.urdf", nan_origin);
+  expect_error({"kinematics", nan.string(), "--out", out}, nan.string() + ": not a valid URDF");
+}
+
+TEST(KinematicsCli, KinematicLoopsAreRejected) {
+  const TempDir dir;
+  const std::string out = (dir.path() / "out.json").string();
+  std::string two_parents = kArmUrdf;
+  two_parents.replace(two_parents.find("</robot>"), 8, R"(  <joint name="elbow" type="fixed">
+    <parent link="base"/><child link="upper"/>
+  </joint>
+</robot>)");
+  const auto loop = dir.write("loop.urdf", two_parents);
+  expect_error({"kinematics", loop.string(), "--out", out}, "(kinematic loop; URDF must be a tree)");
+  expect_error({"kinematics", loop.string(), "--out", out}, "already has parent joint");
+
+  std::string detached_cycle = kArmUrdf;
+  detached_cycle.replace(detached_cycle.find("</robot>"), 8, R"(  <link name="p"/><link name="q"/>
+  <joint name="pq" type="fixed"><parent link="p"/><child link="q"/></joint>
+  <joint name="qp" type="fixed"><parent link="q"/><child link="p"/></joint>
+</robot>)");
+  const auto cycle = dir.write("cycle.urdf", detached_cycle);
+  expect_error({"kinematics", cycle.string(), "--out", out}, "not reachable from the root link 'base'");
+}
+
+TEST(KinematicsCli, JointFileErrorsNameTheFileAndTheJoint) {
+  const TempDir dir;
+  const auto urdf = dir.write("arm.urdf", kArmUrdf);
+  const std::string out = (dir.path() / "out.json").string();
+  const auto unknown = dir.write("unknown.json", R"({"joints": {"elbow": 0.1}})");
+  expect_error({"kinematics", urdf.string(), "--joints", unknown.string(), "--out", out},
+               unknown.string() + ": joint 'elbow': unknown joint in " + urdf.string());
+  const auto huge = dir.write("huge.json", R"({"joints": {"shoulder": 1e999}})");
+  expect_error({"kinematics", urdf.string(), "--joints", huge.string(), "--out", out},
+               huge.string() + ": invalid JSON");  // nlohmann rejects 1e999 (number overflow)
+  const auto typo = dir.write("typo.json", R"({"joint": {"shoulder": 0.1}})");
+  expect_error({"kinematics", urdf.string(), "--joints", typo.string(), "--out", out},
+               typo.string() + ": joint: unknown key; known: joints");
+}
+
+TEST(KinematicsCli, SphereFileErrorsNameTheFileAndTheLink) {
+  const TempDir dir;
+  const std::string out = (dir.path() / "out.json").string();
+  const auto spheres = dir.write("spheres.json", R"({"spheres": {"yumi_link_9_l": []}})");
+  expect_error({"kinematics", kYumi, "--spheres", spheres.string(), "--out", out},
+               spheres.string() + ": spheres.yumi_link_9_l: unknown link 'yumi_link_9_l'");
+  const auto ignore = dir.write("ignore.json", R"({"spheres": {}, "ignore_pairs": [["yumi_body"]]})");
+  expect_error({"kinematics", kYumi, "--spheres", ignore.string(), "--out", out},
+               ignore.string() + ": ignore_pairs[0]: expected a pair of link names");
+}
+
+}  // namespace
+}  // namespace shapectl

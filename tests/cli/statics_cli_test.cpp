@@ -1,0 +1,163 @@
+// The `shapectl statics` contract: result file, exit codes and error messages.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/test_support.hpp"
+
+namespace shapectl {
+namespace {
+
+using test::run_cli;
+using test::TempDir;
+
+const char* kBarScene = R"({
+  "object": {
+    "mesh": {"box": {"size": [0.32, 0.03, 0.03], "cells": [8, 2, 2]}},
+    "material": {"youngs_modulus": 2e5, "poisson_ratio": 0.3, "density": 40}
+  },
+  "gravity": [0, 0, -9.81],
+  "fixed": {"box": {"min": [-0.17, -1, -1], "max": [-0.15, 1, 1]}}
+})";
+
+// A single tet (nodes 1..4) in MSH 2.2; `element` is the $Elements body line.
+std::string msh22(const std::string& element, const std::string& count = "1") {
+  return "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 0.1 0 0\n3 0 0.1 0\n"
+         "4 0 0 0.1\n$EndNodes\n$Elements\n" + count + "\n" + element + "\n$EndElements\n";
+}
+
+std::string scene_with_mesh(const std::string& mesh_file) {
+  return R"({"object": {"mesh": ")" + mesh_file +
+         R"(", "material": {"mu": 1e4, "kappa": 5e4, "density": 40}}, "fixed": {"nodes": [0, 1, 2]}})";
+}
+
+TEST(StaticsCli, WritesAConvergedResultInMeshOrder) {
+  TempDir dir;
+  const auto scene = dir.write("bar.json", kBarScene);
+  const auto out = dir.path() / "result.json";
+  const auto vtu = dir.path() / "bar.vtu";
+  const auto run = run_cli({"statics", scene.string(), "--out", out.string(), "--vtu", vtu.string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto result = nlohmann::json::parse(test::read_text(out));
+  EXPECT_TRUE(result["converged"].get<bool>());
+  EXPECT_GT(result["iterations"].get<int>(), 0);
+  EXPECT_LT(result["residual"].get<double>(), 1e-6);
+  ASSERT_EQ(result["positions"].size(), 9u * 3u * 3u);
+  // Node 0 is in the clamp: it stays at its rest position (the box corner).
+  EXPECT_DOUBLE_EQ(result["positions"][0][0].get<double>(), -0.16);
+  // The free end sags.
+  EXPECT_LT(result["positions"][8][2].get<double>(), -0.015 - 1e-4);
+  EXPECT_NE(test::read_text(vtu).find("UnstructuredGrid"), std::string::npos);
+}
+
+TEST(StaticsCli, MissingSceneFileIsBadInput) {
+  const auto run = run_cli({"statics", "/nonexistent/scene.json", "--out", "/tmp/x.json"});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("/nonexistent/scene.json"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("cannot open"), std::string::npos) << run.err;
+}
+
+TEST(StaticsCli, MissingMeshFileIsNamed) {
+  TempDir dir;
+  const auto scene = dir.write("s.json", scene_with_mesh("nothere.msh"));
+  const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("nothere.msh"), std::string::npos) << run.err;
+}
+
+TEST(StaticsCli, TruncatedMshNamesTheFile) {
+  TempDir dir;
+  dir.write("t.msh", "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 0.1 0 0\n");
+  const auto scene = dir.write("s.json", scene_with_mesh("t.msh"));
+  const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("t.msh"), std::string::npos) << run.err;
+}
+
+TEST(StaticsCli, WrongElementCountInMshIsReportedWithItsLine) {
+  TempDir dir;
+  dir.write("c.msh", msh22("1 4 2 0 1 1 2 3 4", "3"));
+  const auto scene = dir.write("s.json", scene_with_mesh("c.msh"));
+  const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("c.msh:"), std::string::npos) << run.err;
+}
+
+TEST(StaticsCli, ElementNodeOutOfRangeInMshNamesLineAndNode) {
+  TempDir dir;
+  dir.write("b.msh", msh22("1 4 2 0 1 1 2 3 99"));
+  const auto scene = dir.write("s.json", scene_with_mesh("b.msh"));
+  const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("b.msh:13"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("99"), std::string::npos) << run.err;
+}
+
+TEST(StaticsCli, InvertedElementIsNamedWithItsVolume) {
+  TempDir dir;
+  dir.write("i.msh", msh22("1 4 2 0 1 1 3 2 4"));  // two corners swapped
+  const auto scene = dir.write("s.json", scene_with_mesh("i.msh"));
+  const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("inverted"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("volume -0.000166"), std::string::npos) << run.err;
+}
+
+TEST(StaticsCli, UnknownKeyIsNamedWithTheKnownOnes) {
+  TempDir dir;
+  std::string text = kBarScene;
+  text.replace(text.find("\"material\""), 10, "\"materail\"");
+  const auto scene = dir.write("typo.json", text);
+  const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("typo.json: object.materail: unknown key; known: mesh, material"),
+            std::string::npos)
+      << run.err;
+}
+
+TEST(StaticsCli, NonFiniteAndUnphysicalNumbersAreRejected) {
+  TempDir dir;
+  for (const auto& [from, to, where] :
+       {std::tuple<std::string, std::string, std::string>{"\"density\": 40", "\"density\": 0, \"mu\": 1", "object.material.mu"},
+        {"\"density\": 40", "\"density\": -1", "object.material.density"},
+        {"[8, 2, 2]", "[8, 0, 2]", "object.mesh.box.cells[1]"}}) {
+    std::string text = kBarScene;
+    text.replace(text.find(from), from.size(), to);
+    const auto scene = dir.write("bad.json", text);
+    const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+    EXPECT_EQ(run.exit_code, 1) << to;
+    EXPECT_NE(run.err.find("bad.json: " + where + ": "), std::string::npos) << run.err;
+  }
+  // JSON has no NaN or infinity; a number too large for a double is caught while parsing.
+  std::string text = kBarScene;
+  text.replace(text.find("2e5"), 3, "1e999");
+  const auto scene = dir.write("huge.json", text);
+  const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("huge.json"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("1e999"), std::string::npos) << run.err;
+}
+
+TEST(StaticsCli, UnheldObjectIsASolverFailure) {
+  TempDir dir;
+  std::string text = kBarScene;
+  text = text.substr(0, text.find(",\n  \"fixed\"")) + "\n}";
+  const auto scene = dir.write("free.json", text);
+  const auto out = dir.path() / "r.json";
+  const auto run = run_cli({"statics", scene.string(), "--out", out.string()});
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_NE(run.err.find("singular system: nothing holds the object"), std::string::npos) << run.err;
+  const auto result = nlohmann::json::parse(test::read_text(out));
+  EXPECT_FALSE(result["converged"].get<bool>());
+}
+
+TEST(StaticsCli, FailedRunLeavesAnExistingResultIntact) {
+  TempDir dir;
+  const auto out = dir.write("r.json", "precious");
+  const auto run = run_cli({"statics", (dir.path() / "missing.json").string(), "--out", out.string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(test::read_text(out), "precious");
+}
+
+}  // namespace
+}  // namespace shapectl

@@ -1,0 +1,100 @@
+#include <shapectl/control/optimize.hpp>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include "support/two_arm_scene.hpp"
+
+namespace shapectl {
+namespace {
+
+// Targets taken from the equilibrium at some other joint angles: reachable by construction.
+ShapeTargets targets_from_shape(const Positions& x, int count, std::mt19937& rng) {
+  ShapeTargets t;
+  std::vector<int> nodes(x.size() / 3);
+  std::iota(nodes.begin(), nodes.end(), 0);
+  std::shuffle(nodes.begin(), nodes.end(), rng);
+  for (int k = 0; k < count; ++k) {
+    t.nodes.push_back(nodes[k]);
+    t.positions.push_back(x.segment<3>(3 * nodes[k]));
+  }
+  return t;
+}
+
+class OptimizeTest : public ::testing::TestWithParam<OptimizerKind> {};
+
+TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
+  const Scene scene = test::two_arm_scene({24, 2, 2});
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  for (unsigned seed : {1u, 2u, 3u, 4u}) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-0.25, 0.25);
+    Eigen::VectorXd goal = object.reference_joints();
+    for (int j = 0; j < goal.size(); ++j) goal[j] += u(rng);
+    const Evaluation at_goal = objective.evaluate(goal, object.reference_positions());
+    ASSERT_TRUE(at_goal.statics.converged());
+    objective.set_targets(targets_from_shape(at_goal.positions, 10 + seed * 5, rng));
+
+    const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
+    ASSERT_GT(start.error.mean, 3e-3) << "the targets should be a real change";
+    auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
+    const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 200});
+    EXPECT_LT(result.best.error.mean, 1e-3) << "seed " << seed << ": " << result.reason;
+    EXPECT_TRUE(result.best.safe());
+  }
+}
+
+TEST_P(OptimizeTest, TargetsThroughEachOtherEndSafe) {
+  // Pull the left end to the right of the right end and vice versa: the arms would cross.
+  const Scene scene = test::two_arm_scene();
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  const Positions x0 = object.reference_positions();
+  ShapeTargets t;
+  for (int e = 0; e < 2; ++e)
+    for (int i : scene.grips[e].nodes) {
+      t.nodes.push_back(i);
+      t.positions.push_back(x0.segment<3>(3 * i) + Vec3(0, e == 0 ? -0.4 : 0.4, 0));
+    }
+  objective.set_targets(t);
+  const Evaluation start = objective.evaluate(object.reference_joints(), x0);
+  ASSERT_TRUE(start.safe());
+  auto optimizer = make_optimizer(GetParam(), GradientMethod::Adjoint);
+  const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 100});
+  EXPECT_GE(result.best.min_clearance, 0.0);
+  EXPECT_TRUE(result.best.within_limits);
+  EXPECT_TRUE(result.best.safe());
+  EXPECT_LT(result.best.error.mean, start.error.mean);  // it did try
+  EXPECT_GT(result.best.error.mean, 0.05);              // but could not get there
+}
+
+TEST_P(OptimizeTest, UnreachableTargetsGiveAnHonestBestEffort) {
+  const Scene scene = test::two_arm_scene();
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  ShapeTargets t;
+  t.nodes = {0, 10, 20};
+  t.positions = {Vec3(5, 5, 5), Vec3(5, 5, 6), Vec3(-5, 5, 5)};
+  objective.set_targets(t);
+  const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
+  auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
+  const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 60});
+  EXPECT_TRUE(result.best.safe());
+  EXPECT_TRUE(result.best.positions.allFinite());
+  EXPECT_GT(result.best.error.mean, 4.0);
+  EXPECT_LE(result.best.objective, start.objective);
+  EXPECT_FALSE(result.reason.empty());
+}
+
+INSTANTIATE_TEST_SUITE_P(BothOptimizers, OptimizeTest,
+                         ::testing::Values(OptimizerKind::GaussNewton, OptimizerKind::Lbfgs),
+                         [](const auto& info) {
+                           return info.param == OptimizerKind::GaussNewton ? "GaussNewton" : "Lbfgs";
+                         });
+
+}  // namespace
+}  // namespace shapectl

@@ -1,0 +1,92 @@
+#include <shapectl/control/reduced_objective.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "support/derivative_check.hpp"
+#include "support/two_arm_scene.hpp"
+
+namespace shapectl {
+namespace {
+
+ShapeTargets some_targets(const GrippedObject& object, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  ShapeTargets t;
+  const Positions x0 = object.reference_positions();
+  for (int i = 0; i < object.node_count(); i += 5) {
+    t.nodes.push_back(i);
+    t.positions.push_back(x0.segment<3>(3 * i) + Vec3(u(rng), u(rng), u(rng)));
+  }
+  return t;
+}
+
+TEST(ReducedObjective, GradientAgreesAllThreeWaysWithCentralDifferences) {
+  Scene scene = test::two_arm_scene();
+  scene.statics.relative_tolerance = 1e-11;
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  objective.stale_factor_step = 0;  // exact sensitivities for this comparison
+  objective.finite_difference_step = 1e-6;
+  std::mt19937 rng(11);
+  objective.set_targets(some_targets(object, rng));
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  for (int trial = 0; trial < 3; ++trial) {
+    Eigen::VectorXd theta = object.reference_joints();
+    for (int j = 0; j < theta.size(); ++j) theta[j] += u(rng);
+    theta[1] = 1.97;  // inside the joint-limit margin: the barrier contributes
+    const Evaluation at = objective.evaluate(theta, object.reference_positions());
+    ASSERT_TRUE(at.statics.converged());
+    ASSERT_GT(at.joint_limits, 0);
+    Eigen::VectorXd central(theta.size());
+    const double h = 1e-5;
+    for (int j = 0; j < theta.size(); ++j) {
+      Eigen::VectorXd tp = theta, tm = theta;
+      tp[j] += h;
+      tm[j] -= h;
+      central[j] = (objective.evaluate(tp, at.positions).objective -
+                    objective.evaluate(tm, at.positions).objective) / (2 * h);
+    }
+    const Eigen::VectorXd sensitivity = objective.gradient(at, GradientMethod::Sensitivity);
+    const Eigen::VectorXd adjoint = objective.gradient(at, GradientMethod::Adjoint);
+    const Eigen::VectorXd forward = objective.gradient(at, GradientMethod::FiniteDifference);
+    EXPECT_LT(test::relative_error(sensitivity, central), 1e-5) << "trial " << trial;
+    EXPECT_LT(test::relative_error(adjoint, central), 1e-5) << "trial " << trial;
+    // Forward differences carry an O(h) error: the baseline is less exact by nature.
+    EXPECT_LT(test::relative_error(forward, central), 1e-3) << "trial " << trial;
+  }
+}
+
+TEST(ReducedObjective, LeastSquaresFormMatchesObjectiveAndGradient) {
+  Scene scene = test::two_arm_scene();
+  scene.statics.relative_tolerance = 1e-11;
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  objective.stale_factor_step = 0;
+  std::mt19937 rng(12);
+  objective.set_targets(some_targets(object, rng));
+  Eigen::VectorXd theta = object.reference_joints();
+  theta[4] = -1.97;  // near the lower limit
+  const Evaluation at = objective.evaluate(theta, object.reference_positions());
+  Eigen::VectorXd r;
+  Eigen::MatrixXd J;
+  objective.least_squares(at, r, J);
+  EXPECT_NEAR(0.5 * r.squaredNorm(), at.objective, 1e-12 * at.objective);
+  EXPECT_LT(test::relative_error(J.transpose() * r, objective.gradient(at, GradientMethod::Sensitivity)), 1e-9);
+  // The Jacobian itself against central differences of the residuals.
+  Eigen::MatrixXd J_fd(J.rows(), J.cols());
+  const double h = 1e-6;
+  for (int j = 0; j < theta.size(); ++j) {
+    Eigen::VectorXd tp = theta, tm = theta, rp, rm;
+    Eigen::MatrixXd unused;
+    tp[j] += h;
+    tm[j] -= h;
+    objective.least_squares(objective.evaluate(tp, at.positions), rp, unused);
+    objective.least_squares(objective.evaluate(tm, at.positions), rm, unused);
+    J_fd.col(j) = (rp - rm) / (2 * h);
+  }
+  EXPECT_LT(test::relative_error(J, J_fd), 1e-5);
+}
+
+}  // namespace
+}  // namespace shapectl

@@ -1,0 +1,88 @@
+#include <shapectl/robot/joint_limits.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+namespace shapectl {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+JointLimits test_limits() {
+  // Third joint continuous: no barrier.
+  return JointLimits(Eigen::Vector3d(-1, 0, -kInf), Eigen::Vector3d(1, 0.5, kInf), 0.1, 10.0);
+}
+
+TEST(CubicBarrier, IsTwiceContinuousAtZeroAndSquaresFromItsResidual) {
+  const CubicBarrier barrier{4.0};
+  EXPECT_EQ(barrier.value(-0.3), 0.0);
+  EXPECT_EQ(barrier.value(0.0), 0.0);
+  EXPECT_EQ(barrier.derivative(0.0), 0.0);
+  EXPECT_DOUBLE_EQ(barrier.value(0.5), 0.5);
+  EXPECT_DOUBLE_EQ(barrier.derivative(0.5), 3.0);
+  EXPECT_DOUBLE_EQ(0.5 * std::pow(barrier.residual(0.5), 2), barrier.value(0.5));
+  const double h = 1e-6;
+  EXPECT_NEAR(barrier.residual_derivative(0.5),
+              (barrier.residual(0.5 + h) - barrier.residual(0.5 - h)) / (2 * h), 1e-8);
+}
+
+TEST(JointLimits, ZeroInsideTheMarginAndGrowingOutside) {
+  const JointLimits limits = test_limits();
+  EXPECT_EQ(limits.value(Eigen::Vector3d(0.85, 0.25, 1e6)), 0.0);
+  EXPECT_NEAR(limits.value(Eigen::Vector3d(0.95, 0.25, 0)), 10 * std::pow(0.05, 3), 1e-15);
+  EXPECT_NEAR(limits.value(Eigen::Vector3d(-1.2, 0.25, 0)), 10 * std::pow(0.3, 3), 1e-14);
+  // A range narrower than twice the margin pushes from both sides.
+  const JointLimits narrow(Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Constant(1, 0.1), 0.1, 10.0);
+  EXPECT_NEAR(narrow.value(Eigen::VectorXd::Constant(1, 0.05)), 2 * 10 * std::pow(0.05, 3), 1e-15);
+}
+
+TEST(JointLimits, GradientAndResidualJacobianMatchCentralDifferences) {
+  const JointLimits limits = test_limits();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> angle(-1.5, 1.5);
+  const double h = 1e-6;
+  int compared = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const Eigen::Vector3d theta(angle(rng), angle(rng) * 0.5, angle(rng));
+    Eigen::VectorXd gradient, r;
+    Eigen::MatrixXd jacobian;
+    const double value = limits.value(theta, &gradient);
+    limits.residuals(theta, r, &jacobian);
+    EXPECT_NEAR(0.5 * r.squaredNorm(), value, 1e-12 * std::max(value, 1.0));
+    Eigen::VectorXd numeric_gradient(3);
+    Eigen::MatrixXd numeric_jacobian(6, 3);
+    for (int i = 0; i < 3; ++i) {
+      Eigen::VectorXd plus = theta, minus = theta, r_plus, r_minus;
+      plus[i] += h;
+      minus[i] -= h;
+      numeric_gradient[i] = (limits.value(plus) - limits.value(minus)) / (2 * h);
+      limits.residuals(plus, r_plus);
+      limits.residuals(minus, r_minus);
+      numeric_jacobian.col(i) = (r_plus - r_minus) / (2 * h);
+    }
+    EXPECT_LE((gradient - numeric_gradient).norm(), 1e-6 * std::max(numeric_gradient.norm(), 1e-6));
+    EXPECT_LE((jacobian - numeric_jacobian).norm(), 1e-6 * std::max(numeric_jacobian.norm(), 1e-6));
+    compared += numeric_gradient.norm() > 0;
+  }
+  EXPECT_GE(compared, 10);  // most trials leave some range
+}
+
+TEST(JointLimits, ViolationsListJointsOutsideTheirHardLimits) {
+  const RobotModel model = RobotModel::from_urdf_string(R"(<robot name="r">
+    <link name="a"/><link name="b"/><link name="c"/>
+    <joint name="j1" type="revolute"><parent link="a"/><child link="b"/>
+      <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+    <joint name="j2" type="continuous"><parent link="b"/><child link="c"/></joint>
+  </robot>)", "r.urdf");
+  const auto violations = limit_violations(model, Eigen::Vector2d(1.5, 100));
+  ASSERT_EQ(violations.size(), 1u);
+  EXPECT_EQ(violations[0].joint, "j1");
+  EXPECT_EQ(violations[0].value, 1.5);
+  EXPECT_TRUE(limit_violations(model, Eigen::Vector2d(0.5, -100)).empty());
+}
+
+}  // namespace
+}  // namespace shapectl
