@@ -14,5 +14,9 @@ class SolverFailure : public std::runtime_error {
 
 void add_statics_command(CLI::App& app);
 void add_kinematics_command(CLI::App& app);
+void add_solve_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
+void add_serve_command(CLI::App& app);    // server area (GUI)
+void add_link_commands(CLI::App& app);    // link area: run, egm-sim, replay
 
 }  // namespace shapectl::cli

@@ -10,6 +10,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   shapectl::cli::add_statics_command(app);
   shapectl::cli::add_kinematics_command(app);
+  shapectl::cli::add_solve_command(app);
+  shapectl::cli::add_bench_command(app);
+  shapectl::cli::add_serve_command(app);
+  shapectl::cli::add_link_commands(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

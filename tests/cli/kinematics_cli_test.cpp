@@ -52,7 +52,8 @@ TEST(KinematicsCli, WritesLinkPosesClearancesAndLimitViolations) {
   EXPECT_EQ(flange["rotation"].size(), 3u);
   EXPECT_EQ(json["links"]["world"]["position"], nlohmann::json({0.0, 0.0, 0.0}));
   EXPECT_EQ(json["links"].size(), 25u);
-  EXPECT_LT(json["min_clearance"].get<double>(), 0.0);
+  EXPECT_TRUE(json["min_clearance"].is_number());
+  EXPECT_EQ(json["margin"], 0.005);
   ASSERT_EQ(json["closest_pairs"].size(), 10u);
   EXPECT_EQ(json["closest_pairs"][0]["clearance"], json["min_clearance"]);
   EXPECT_EQ(json["closest_pairs"][0]["links"].size(), 2u);
@@ -76,7 +77,8 @@ TEST(KinematicsCli, MissingMeshesAreSkippedWithAWarning) {
   EXPECT_NEAR(rotation[0][1].get<double>(), -1.0, 1e-12);  // 90° about z
   EXPECT_NEAR(rotation[1][0].get<double>(), 1.0, 1e-12);
   EXPECT_EQ(json["links"]["upper"]["position"], nlohmann::json({0.0, 0.0, 0.5}));
-  EXPECT_TRUE(json["limit_violations"].empty());
+  ASSERT_EQ(json["limit_violations"].size(), 1u);  // 90° is past the 1 rad limit
+  EXPECT_EQ(json["limit_violations"][0]["joint"], "shoulder");
   EXPECT_FALSE(json.contains("min_clearance"));
 }
 

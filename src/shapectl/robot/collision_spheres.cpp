@@ -57,13 +57,29 @@ CollisionModel::CollisionModel(const RobotModel& robot, std::vector<CollisionSph
                                const std::vector<std::pair<int, int>>& ignore_pairs)
     : spheres_(std::move(spheres)), margin_(margin), barrier_{stiffness} {
   assert(margin >= 0 && stiffness >= 0);
+  std::stable_sort(spheres_.begin(), spheres_.end(),
+                   [](const auto& a, const auto& b) { return a.link < b.link; });
+  for (const auto& s : spheres_) radii_.push_back(s.radius);
+  // Sphere range of every link.
+  std::vector<std::pair<int, int>> range(static_cast<std::size_t>(robot.link_count()), {0, 0});
+  for (int s = static_cast<int>(spheres_.size()) - 1; s >= 0; --s) {
+    auto& r = range[static_cast<std::size_t>(spheres_[static_cast<std::size_t>(s)].link)];
+    if (r.second == 0) r.second = s + 1;
+    r.first = s;
+  }
   const auto checked = checked_link_pairs(robot, ignore_pairs);
-  for (std::size_t a = 0; a < spheres_.size(); ++a)
-    for (std::size_t b = a + 1; b < spheres_.size(); ++b)
-      if (checked[static_cast<std::size_t>(spheres_[a].link)][static_cast<std::size_t>(spheres_[b].link)]) {
-        pairs_.emplace_back(static_cast<int>(a), static_cast<int>(b));
-        reach_.push_back(spheres_[a].radius + spheres_[b].radius + margin_);
+  for (int a = 0; a < static_cast<int>(spheres_.size()); ++a) {
+    const auto link_a = static_cast<std::size_t>(spheres_[static_cast<std::size_t>(a)].link);
+    for (std::size_t link_b = link_a + 1; link_b < range.size(); ++link_b) {
+      const auto [begin, end] = range[link_b];
+      if (begin == end || !checked[link_a][link_b]) continue;
+      blocks_.push_back({a, begin, end});
+      for (int b = begin; b < end; ++b) {
+        pairs_.emplace_back(a, b);
+        reach_.push_back(radii_[static_cast<std::size_t>(a)] + radii_[static_cast<std::size_t>(b)] + margin_);
       }
+    }
+  }
 }
 
 void CollisionModel::sphere_centers(const KinematicsState& state, std::vector<Vec3>& centers) const {
@@ -97,33 +113,53 @@ std::vector<SphereClearance> CollisionModel::closest_pairs(const KinematicsState
 
 double CollisionModel::value(const RobotModel& robot, const KinematicsState& state,
                              Eigen::VectorXd* gradient) const {
-  std::vector<Vec3> centers;
-  sphere_centers(state, centers);
+  const std::size_t n = spheres_.size();
+  std::vector<double> xyz(3 * n);  // all x, then all y, then all z
+  double* x = xyz.data();
+  double* y = x + n;
+  double* z = y + n;
+  for (std::size_t s = 0; s < n; ++s) {
+    const Vec3 c = state.T_world_link[static_cast<std::size_t>(spheres_[s].link)] * spheres_[s].center_link;
+    x[s] = c.x();
+    y[s] = c.y();
+    z[s] = c.z();
+  }
   // dB/ds per sphere, accumulated over its violated pairs, then mapped to θ once per sphere.
   std::vector<Vec3> forces;
-  if (gradient) forces.assign(spheres_.size(), Vec3::Zero());
+  if (gradient) forces.assign(n, Vec3::Zero());
+  const double* radius = radii_.data();
   double total = 0;
-  for (std::size_t p = 0; p < pairs_.size(); ++p) {
-    const auto a = static_cast<std::size_t>(pairs_[p].first);
-    const auto b = static_cast<std::size_t>(pairs_[p].second);
-    const Vec3 diff = centers[a] - centers[b];
-    const double distance2 = diff.squaredNorm();
-    if (distance2 >= reach_[p] * reach_[p]) continue;
-    const double distance = std::sqrt(distance2);
-    const double v = reach_[p] - distance;
-    total += barrier_.value(v);
-    if (!gradient) continue;
-    // dv/ds_a = −u with u the unit vector from b to a (any direction if the centres coincide).
-    const Vec3 u = distance > 1e-12 ? Vec3(diff / distance) : Vec3::UnitX();
-    const Vec3 force = -barrier_.derivative(v) * u;
-    forces[a] += force;
-    forces[b] -= force;
+  for (const Block& block : blocks_) {
+    const auto a = static_cast<std::size_t>(block.sphere);
+    const double reach_a = radius[a] + margin_;
+    // Most blocks are clear: a branch-free pass finds out (and vectorises).
+    int overlapping = 0;
+    for (int b = block.begin; b < block.end; ++b) {
+      const double dx = x[a] - x[b], dy = y[a] - y[b], dz = z[a] - z[b];
+      const double reach = reach_a + radius[b];
+      overlapping += dx * dx + dy * dy + dz * dz < reach * reach;
+    }
+    if (overlapping == 0) continue;
+    for (int b = block.begin; b < block.end; ++b) {
+      const Vec3 diff(x[a] - x[b], y[a] - y[b], z[a] - z[b]);
+      const double distance = diff.norm();
+      const double v = reach_a + radius[b] - distance;
+      if (v <= 0) continue;
+      total += barrier_.value(v);
+      if (!gradient) continue;
+      // dv/ds_a = −u with u the unit vector from b to a (any direction if the centres coincide).
+      const Vec3 u = distance > 1e-12 ? Vec3(diff / distance) : Vec3::UnitX();
+      const Vec3 force = -barrier_.derivative(v) * u;
+      forces[a] += force;
+      forces[static_cast<std::size_t>(b)] -= force;
+    }
   }
   if (gradient) {
     gradient->setZero(robot.active_count());
-    for (std::size_t s = 0; s < spheres_.size(); ++s)
+    for (std::size_t s = 0; s < n; ++s)
       if (!forces[s].isZero(0))
-        add_point_jacobian_transpose(robot, state, spheres_[s].link, centers[s], forces[s], *gradient);
+        add_point_jacobian_transpose(robot, state, spheres_[s].link, Vec3(x[s], y[s], z[s]),
+                                     forces[s], *gradient);
   }
   return total;
 }

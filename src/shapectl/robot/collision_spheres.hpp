@@ -47,6 +47,7 @@ class CollisionModel {
   CollisionModel(const RobotModel& robot, std::vector<CollisionSphere> spheres, double margin,
                  double stiffness, const std::vector<std::pair<int, int>>& ignore_pairs = {});
 
+  // Grouped by link, in link order (a stable sort of the input).
   const std::vector<CollisionSphere>& spheres() const { return spheres_; }
   // Checked pairs, as sphere indices (first < second).
   const std::vector<std::pair<int, int>>& pairs() const { return pairs_; }
@@ -71,8 +72,17 @@ class CollisionModel {
                  Eigen::MatrixXd* jacobian = nullptr) const;
 
  private:
+  // One sphere against the contiguous spheres [begin, end) of another link: the hot loop runs
+  // over such blocks with the centres stored coordinate by coordinate.
+  struct Block {
+    int sphere;
+    int begin;
+    int end;
+  };
   std::vector<CollisionSphere> spheres_;
-  std::vector<std::pair<int, int>> pairs_;
+  std::vector<std::pair<int, int>> pairs_;  // the blocks' pairs, in block order
+  std::vector<Block> blocks_;
+  std::vector<double> radii_;
   std::vector<double> reach_;  // per pair: r_i + r_j + margin
   double margin_;
   CubicBarrier barrier_;

@@ -1,0 +1,303 @@
+#include <shapectl/control/controller.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include <shapectl/control/centerline.hpp>
+#include <shapectl/io/input_error.hpp>
+
+namespace shapectl {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+
+// Requests from other threads, applied by the worker before its next iteration.
+struct Inbox {
+  std::optional<ShapeTargets> targets;
+  std::optional<std::vector<Vec3>> centerline;
+  bool clear = false;
+  std::optional<bool> paused;
+  std::optional<Eigen::VectorXd> jog;
+  bool reset = false;
+  bool empty() const {
+    return !targets && !centerline && !clear && !paused && !jog && !reset;
+  }
+};
+}  // namespace
+
+struct Controller::State {
+  Scene scene;
+  ControllerOptions options;
+  std::unique_ptr<GrippedObject> object;
+  std::unique_ptr<ReducedObjective> objective;
+  std::unique_ptr<Optimizer> optimizer;
+  std::optional<BarAxis> bar_axis;
+  Clock::time_point started = Clock::now();
+
+  // Owned by whoever runs iterations (the worker thread, or the step_once caller).
+  Evaluation current;
+  std::vector<Vec3> centerline;
+  bool paused = false;
+  bool idle = true;  // nothing to do until a request arrives
+  StepOutcome last_outcome = StepOutcome::Improved;
+  std::uint64_t iterations = 0;
+  double rate = 0;
+  Clock::time_point last_iteration = Clock::now();
+  std::string last_error;
+
+  mutable std::mutex inbox_mutex;
+  std::condition_variable inbox_changed;
+  Inbox inbox;
+
+  mutable std::mutex snapshot_mutex;
+  mutable std::condition_variable snapshot_changed;
+  std::shared_ptr<const ControllerSnapshot> snapshot;
+  std::uint64_t sequence = 0;
+
+  std::mutex step_mutex;  // one runner at a time
+  std::thread worker;
+  std::atomic<bool> running{false};
+
+  void apply(Inbox in);
+  void iterate();
+  void publish();
+  void run();
+  void validate(const ShapeTargets& t) const;
+};
+
+void Controller::State::validate(const ShapeTargets& t) const {
+  const int n = object->node_count();
+  if (t.nodes.size() != t.positions.size())
+    throw InputError("targets", "", "as many positions as nodes");
+  for (std::size_t k = 0; k < t.nodes.size(); ++k) {
+    if (t.nodes[k] < 0 || t.nodes[k] >= n)
+      throw InputError("targets", "node " + std::to_string(t.nodes[k]),
+                       "out of range (mesh has " + std::to_string(n) + " nodes)");
+    if (!t.positions[k].allFinite())
+      throw InputError("targets", "node " + std::to_string(t.nodes[k]), "position is not finite");
+  }
+}
+
+void Controller::State::apply(Inbox in) {
+  if (in.reset) {
+    current = objective->evaluate(object->reference_joints(), object->reference_positions());
+    objective->set_targets({});
+    centerline.clear();
+    objective->rescore(current);
+    optimizer->reset();
+    last_error.clear();
+  }
+  if (in.clear) {
+    objective->set_targets({});
+    centerline.clear();
+  }
+  if (in.targets) {
+    objective->set_targets(*in.targets);
+    centerline.clear();
+  }
+  if (in.centerline) {
+    centerline = *in.centerline;
+    objective->set_targets(centerline_targets(object->mesh(), *bar_axis, centerline, current.positions));
+  }
+  if (in.paused) paused = *in.paused;
+  if (in.jog && paused) {
+    const Eigen::VectorXd theta = in.jog->cwiseMax(object->robot().lower_limits())
+                                      .cwiseMin(object->robot().upper_limits());
+    Evaluation e = objective->evaluate(theta, current.positions);
+    if (e.statics.converged()) {
+      current = std::move(e);
+      last_error.clear();
+    } else {
+      last_error = "jog refused: statics " + e.statics.reason;
+    }
+  }
+  if (in.clear || in.targets || in.centerline || in.reset) {
+    objective->rescore(current);
+    optimizer->reset();
+  }
+  idle = false;
+}
+
+void Controller::State::iterate() {
+  Inbox in;
+  {
+    std::lock_guard lock(inbox_mutex);
+    std::swap(in, inbox);
+  }
+  const bool had_requests = !in.empty();
+  if (had_requests) apply(std::move(in));
+  const bool work = !paused && !objective->targets().empty() && !idle;
+  if (work) {
+    last_outcome = optimizer->step(*objective, current);
+    ++iterations;
+    const auto now = Clock::now();
+    const double dt = std::chrono::duration<double>(now - last_iteration).count();
+    last_iteration = now;
+    if (dt > 0) rate = rate == 0 ? 1 / dt : 0.8 * rate + 0.2 / dt;
+    if (last_outcome != StepOutcome::Improved) idle = true;  // wait for the next request
+  } else if (objective->targets().empty() || paused) {
+    idle = true;
+  }
+  if (work || had_requests) publish();
+}
+
+void Controller::State::publish() {
+  auto s = std::make_shared<ControllerSnapshot>();
+  const RobotModel& robot = object->robot();
+  s->time = std::chrono::duration<double>(Clock::now() - started).count();
+  s->joint_names = robot.active_joint_names();
+  s->joints = current.joints;
+  s->lower_limits = robot.lower_limits();
+  s->upper_limits = robot.upper_limits();
+  s->T_world_link = forward_kinematics(robot, current.joints).T_world_link;
+  s->positions = current.positions;
+  s->targets = objective->targets();
+  s->centerline = centerline;
+  s->error = current.error;
+  s->objective = current.objective;
+  s->min_clearance = current.min_clearance;
+  s->within_limits = current.within_limits;
+  s->safe = current.safe();
+  s->iterations = iterations;
+  s->iterations_per_second = rate;
+  s->paused = paused;
+  s->last_error = last_error;
+  if (paused) s->status = "paused";
+  else if (objective->targets().empty()) s->status = "idle";
+  else if (!idle) s->status = "optimizing";
+  else s->status = to_string(last_outcome);
+  {
+    std::lock_guard lock(snapshot_mutex);
+    s->sequence = ++sequence;
+    snapshot = std::move(s);
+  }
+  snapshot_changed.notify_all();
+}
+
+void Controller::State::run() {
+  while (running) {
+    {
+      std::lock_guard step(step_mutex);
+      iterate();
+    }
+    if (idle) {
+      std::unique_lock lock(inbox_mutex);
+      inbox_changed.wait_for(lock, std::chrono::milliseconds(50),
+                             [&] { return !inbox.empty() || !running; });
+    }
+  }
+}
+
+Controller::Controller(const Scene& scene, ControllerOptions options) : state_(std::make_unique<State>()) {
+  State& s = *state_;
+  s.scene = scene;
+  s.options = options;
+  s.object = std::make_unique<GrippedObject>(s.scene);
+  s.objective = std::make_unique<ReducedObjective>(*s.object);
+  s.optimizer = make_optimizer(options.optimizer, options.gradient);
+  s.bar_axis = find_bar_axis(s.object->mesh());
+  s.current = s.objective->evaluate(s.object->reference_joints(), s.object->reference_positions());
+  s.publish();
+}
+
+Controller::~Controller() { stop(); }
+
+const Scene& Controller::scene() const { return state_->scene; }
+const TetMesh& Controller::mesh() const { return state_->object->mesh(); }
+const RobotModel& Controller::robot() const { return state_->object->robot(); }
+
+void Controller::start() {
+  if (state_->running.exchange(true)) return;
+  state_->worker = std::thread([this] { state_->run(); });
+}
+
+void Controller::stop() {
+  if (!state_->running.exchange(false)) return;
+  state_->inbox_changed.notify_all();
+  if (state_->worker.joinable()) state_->worker.join();
+}
+
+void Controller::step_once() {
+  std::lock_guard step(state_->step_mutex);
+  state_->iterate();
+}
+
+namespace {
+template <class Change>
+void post(Controller::State& s, Change change) {
+  {
+    std::lock_guard lock(s.inbox_mutex);
+    change(s.inbox);
+  }
+  s.inbox_changed.notify_all();
+}
+}  // namespace
+
+void Controller::set_targets(ShapeTargets targets) {
+  state_->validate(targets);
+  post(*state_, [&](Inbox& in) {
+    in.targets = std::move(targets);
+    in.centerline.reset();
+    in.clear = false;
+  });
+}
+
+void Controller::set_centerline(std::vector<Vec3> polyline) {
+  if (!state_->bar_axis)
+    throw InputError("centerline", "", "the object is not bar-like (length < 3 × thickness)");
+  double length = 0;
+  for (std::size_t k = 0; k < polyline.size(); ++k) {
+    if (!polyline[k].allFinite()) throw InputError("centerline", "point " + std::to_string(k), "not finite");
+    if (k) length += (polyline[k] - polyline[k - 1]).norm();
+  }
+  if (polyline.size() < 2 || !(length > 0))
+    throw InputError("centerline", "", "a polyline of at least 2 distinct points");
+  post(*state_, [&](Inbox& in) {
+    in.centerline = std::move(polyline);
+    in.targets.reset();
+    in.clear = false;
+  });
+}
+
+void Controller::clear_targets() {
+  post(*state_, [](Inbox& in) {
+    in.clear = true;
+    in.targets.reset();
+    in.centerline.reset();
+  });
+}
+
+void Controller::set_paused(bool paused) {
+  post(*state_, [&](Inbox& in) { in.paused = paused; });
+}
+
+void Controller::set_joints(const Eigen::VectorXd& joints) {
+  if (joints.size() != state_->object->joint_count())
+    throw InputError("joints", "", "one value per active joint (" +
+                                       std::to_string(state_->object->joint_count()) + ")");
+  if (!joints.allFinite()) throw InputError("joints", "", "finite values");
+  post(*state_, [&](Inbox& in) { in.jog = joints; });
+}
+
+void Controller::reset() {
+  post(*state_, [](Inbox& in) {
+    in = Inbox{};
+    in.reset = true;
+  });
+}
+
+std::shared_ptr<const ControllerSnapshot> Controller::snapshot() const {
+  std::lock_guard lock(state_->snapshot_mutex);
+  return state_->snapshot;
+}
+
+std::shared_ptr<const ControllerSnapshot> Controller::wait_for_snapshot(std::uint64_t after,
+                                                                        double timeout_seconds) const {
+  std::unique_lock lock(state_->snapshot_mutex);
+  state_->snapshot_changed.wait_for(lock, std::chrono::duration<double>(timeout_seconds),
+                                    [&] { return state_->snapshot->sequence > after; });
+  return state_->snapshot;
+}
+
+}  // namespace shapectl

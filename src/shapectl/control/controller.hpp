@@ -1,0 +1,89 @@
+#pragma once
+// The continuous controller (paper Section IV–V): owns the scene's simulation and optimizer
+// state, takes requests (targets, centre-lines, pause, jog, reset) from any thread, runs
+// optimizer iterations in its own thread, and publishes immutable snapshots that the GUI, the
+// robot link and the logger read without ever touching the state.
+#include <condition_variable>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include <shapectl/control/optimize.hpp>
+#include <shapectl/control/shape_targets.hpp>
+
+namespace shapectl {
+
+struct ControllerOptions {
+  OptimizerKind optimizer = OptimizerKind::GaussNewton;
+  GradientMethod gradient = GradientMethod::Sensitivity;
+};
+
+// One published state. Everything in the world frame, metres and radians.
+struct ControllerSnapshot {
+  std::uint64_t sequence = 0;     // increases with every publication
+  double time = 0;                // seconds since the controller started
+  std::vector<std::string> joint_names;  // active joints, θ order
+  Eigen::VectorXd joints;         // θ: the current best, always safe once a safe state exists
+  Eigen::VectorXd lower_limits, upper_limits;
+  std::vector<Eigen::Isometry3d> T_world_link;  // every link of the robot model
+  Positions positions;            // x̂(θ), 3n
+  ShapeTargets targets;           // what is asked for now
+  std::vector<Vec3> centerline;   // the sketched centre-line, if the targets came from one
+  ShapeError error;               // of positions against targets
+  double objective = 0;
+  double min_clearance = 0;       // m; +inf without a collision model
+  bool within_limits = true;
+  bool safe = true;
+  std::uint64_t iterations = 0;   // optimizer iterations so far
+  double iterations_per_second = 0;
+  bool paused = false;
+  std::string status;  // "idle" (no targets), "optimizing", "converged", "stuck", "paused"
+  std::string last_error;  // e.g. statics failure while jogging; empty when fine
+};
+
+class Controller {
+ public:
+  Controller(const Scene& scene, ControllerOptions options = {});
+  ~Controller();  // stops the thread
+  Controller(const Controller&) = delete;
+  Controller& operator=(const Controller&) = delete;
+
+  const Scene& scene() const;
+  const TetMesh& mesh() const;       // placed rest mesh (node order = file order)
+  const RobotModel& robot() const;
+
+  // Runs iterations in a background thread until stop() or destruction.
+  void start();
+  void stop();
+  // Without the thread: apply pending requests, then one optimizer iteration (if any is due).
+  void step_once();
+
+  // Requests; safe from any thread, applied before the next iteration. Invalid input (node out
+  // of range, non-finite numbers, centre-line on an object that is not bar-like) throws
+  // InputError and changes nothing.
+  void set_targets(ShapeTargets targets);
+  void set_centerline(std::vector<Vec3> polyline);
+  void clear_targets();
+  void set_paused(bool paused);
+  // Jog: only while paused; θ is clamped to the hard limits, statics follows.
+  void set_joints(const Eigen::VectorXd& joints);
+  void reset();  // reference joints and shape, targets cleared
+
+  std::shared_ptr<const ControllerSnapshot> snapshot() const;
+  // Blocks until a snapshot with sequence > `after` exists, or the timeout passes.
+  std::shared_ptr<const ControllerSnapshot> wait_for_snapshot(std::uint64_t after,
+                                                              double timeout_seconds) const;
+
+ struct State;  // the worker's state (controller.cpp)
+
+ private:
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace shapectl

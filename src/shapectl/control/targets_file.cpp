@@ -1,0 +1,39 @@
+#include <shapectl/control/targets_file.hpp>
+
+#include <set>
+
+namespace shapectl {
+
+TargetsInput read_targets(const JsonInput& json, int node_count) {
+  json.expect_only({"targets", "centerline"});
+  TargetsInput in;
+  if (json.has("targets") == json.has("centerline"))
+    json.fail("an object with either \"targets\" or \"centerline\"");
+  if (json.has("targets")) {
+    const JsonInput list = json.at("targets");
+    if (list.size() == 0) list.fail("a non-empty list of targets");
+    std::set<int> seen;
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      const JsonInput t = list.at(k);
+      t.expect_only({"node", "position"});
+      const int node = static_cast<int>(t.at("node").integer_in(0, node_count - 1));
+      if (!seen.insert(node).second) t.at("node").fail("a node without another target");
+      in.targets.nodes.push_back(node);
+      in.targets.positions.push_back(t.at("position").vec3());
+    }
+  } else {
+    const JsonInput list = json.at("centerline");
+    for (std::size_t k = 0; k < list.size(); ++k) in.centerline.push_back(list.at(k).vec3());
+    double length = 0;
+    for (std::size_t k = 1; k < in.centerline.size(); ++k)
+      length += (in.centerline[k] - in.centerline[k - 1]).norm();
+    if (in.centerline.size() < 2 || !(length > 0)) list.fail("a polyline of at least 2 distinct points");
+  }
+  return in;
+}
+
+TargetsInput load_targets(const std::filesystem::path& file, int node_count) {
+  return read_targets(JsonInput::load(file), node_count);
+}
+
+}  // namespace shapectl

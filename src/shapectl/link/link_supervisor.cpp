@@ -1,0 +1,202 @@
+#include <shapectl/link/link_supervisor.hpp>
+
+#include <cassert>
+#include <cmath>
+#include <sstream>
+
+#include <shapectl/io/session_log.hpp>
+
+namespace shapectl {
+
+namespace {
+
+std::vector<double> to_list(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
+
+std::string format(double value, int precision = 3) {
+  std::ostringstream s;
+  s.precision(precision);
+  s << value;
+  return s.str();
+}
+
+}  // namespace
+
+LinkSupervisor::LinkSupervisor(std::string kind, std::vector<std::string> joint_names,
+                               std::vector<LinkChannel> channels, Eigen::VectorXd hard_lower,
+                               Eigen::VectorXd hard_upper, GovernorLimits limits,
+                               SupervisorSettings settings, PoseCheck check, SessionLog* log)
+    : kind_(std::move(kind)),
+      joint_names_(std::move(joint_names)),
+      channels_(std::move(channels)),
+      hard_lower_(std::move(hard_lower)),
+      hard_upper_(std::move(hard_upper)),
+      limits_(std::move(limits)),
+      settings_(settings),
+      check_(std::move(check)),
+      log_(log) {
+  assert(static_cast<int>(joint_names_.size()) == limits_.size());
+  for (const auto& spec : channels_) {
+    Channel c{spec, MotionGovernor(limits_.subset(spec.joints)), {}, {}, false, {}};
+    c.measured = c.governor.position();
+    state_.push_back(std::move(c));
+  }
+  target_ = Eigen::VectorXd::Zero(limits_.size());
+}
+
+void LinkSupervisor::log(std::string_view event, const nlohmann::json& fields) const {
+  if (log_) log_->write(event, fields);
+}
+
+Eigen::VectorXd LinkSupervisor::channel_part(const Eigen::VectorXd& full, const Channel& c) const {
+  Eigen::VectorXd part(static_cast<Eigen::Index>(c.spec.joints.size()));
+  for (std::size_t i = 0; i < c.spec.joints.size(); ++i)
+    part[static_cast<Eigen::Index>(i)] = full[c.spec.joints[i]];
+  return part;
+}
+
+Eigen::VectorXd LinkSupervisor::full_commanded() const {
+  Eigen::VectorXd full = target_;  // joints on no channel (none in practice) show the target
+  for (const auto& c : state_)
+    for (std::size_t i = 0; i < c.spec.joints.size(); ++i)
+      full[c.spec.joints[i]] = c.governor.position()[static_cast<Eigen::Index>(i)];
+  return full;
+}
+
+std::string LinkSupervisor::unsafe_reason(const Eigen::VectorXd& joints, bool safe) const {
+  for (Eigen::Index i = 0; i < joints.size(); ++i)
+    if (!std::isfinite(joints[i]))
+      return "target for " + joint_names_[static_cast<std::size_t>(i)] + " is not finite";
+  if (!safe) return "optimizer marked the target unsafe (collision or limits)";
+  for (Eigen::Index i = 0; i < joints.size(); ++i)
+    if (joints[i] < hard_lower_[i] || joints[i] > hard_upper_[i])
+      return "target for " + joint_names_[static_cast<std::size_t>(i)] + " (" +
+             format(joints[i]) + " rad) is outside its limits [" + format(hard_lower_[i]) +
+             ", " + format(hard_upper_[i]) + "]";
+  std::string why;
+  if (check_ && !check_(joints, &why)) return "target pose: " + why;
+  return {};
+}
+
+bool LinkSupervisor::set_target(const Eigen::VectorXd& joints, bool safe) {
+  assert(joints.size() == limits_.size());
+  const std::string why = unsafe_reason(joints, safe);
+  if (!why.empty()) {
+    if (target_problem_.empty() || armed_) log("target_rejected", {{"reason", why}});
+    target_problem_ = why;
+    if (armed_) disarm(why);
+    else reason_ = why;
+    return false;
+  }
+  if (!target_problem_.empty() && !armed_) reason_ = "not armed";
+  target_problem_.clear();
+  has_target_ = true;
+  target_ = joints.cwiseMax(limits_.lower).cwiseMin(limits_.upper);
+  return true;
+}
+
+bool LinkSupervisor::arm(double now, std::string* why_not) {
+  check_watchdog(now);
+  std::string why;
+  for (const auto& c : state_) {
+    if (!c.connected) why = c.spec.name + ": no feedback";
+    else if (!c.fault.empty()) why = c.spec.name + ": " + c.fault;
+    if (!why.empty()) break;
+  }
+  if (why.empty() && !target_problem_.empty()) why = target_problem_;
+  if (!why.empty()) {
+    if (why_not) *why_not = why;
+    log("arm_refused", {{"reason", why}});
+    return false;
+  }
+  if (armed_) return true;
+  // Start from where the robot is, unless still braking (then stay continuous).
+  for (auto& c : state_)
+    if (c.governor.at_rest()) c.governor.reset(c.measured);
+  armed_ = true;
+  reason_.clear();
+  log("arm", {{"commanded", to_list(full_commanded())}});
+  return true;
+}
+
+void LinkSupervisor::disarm(const std::string& reason) {
+  reason_ = reason.empty() ? "disarmed" : reason;
+  if (!armed_) return;
+  armed_ = false;
+  log("disarm", {{"reason", reason_}});
+}
+
+void LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& measured,
+                                 std::string_view fault, double now, double dt) {
+  Channel& c = state_[static_cast<std::size_t>(channel)];
+  assert(measured.size() == c.governor.limits().size() && measured.allFinite());
+  const bool resumed = !c.connected;
+  c.connected = true;
+  c.last_feedback = now;
+  c.measured = measured;
+  c.fault = fault;
+  if (resumed) {
+    // No jump on (re)connect: command the robot where it is.
+    c.governor.reset(measured);
+    log("connect", {{"channel", c.spec.name}, {"measured", to_list(measured)}});
+  }
+  if (armed_ && !c.fault.empty()) disarm(c.spec.name + ": " + c.fault);
+  if (armed_) {
+    const double error = (measured - c.governor.position()).cwiseAbs().maxCoeff();
+    if (error > settings_.max_tracking_error)
+      disarm(c.spec.name + ": tracking error " + format(error) + " rad above " +
+             format(settings_.max_tracking_error) + " rad");
+  }
+  const Eigen::VectorXd before = c.governor.position();
+  if (armed_ && has_target_) c.governor.step_towards(channel_part(target_, c), dt);
+  else c.governor.step_stop(dt);
+  std::string why;
+  if (check_ && c.governor.position() != before && !check_(full_commanded(), &why)) {
+    c.governor.reset(before);  // stop at the last good pose at once
+    disarm(c.spec.name + ": commanded pose: " + why);
+  }
+}
+
+const Eigen::VectorXd& LinkSupervisor::command(int channel) const {
+  return state_[static_cast<std::size_t>(channel)].governor.position();
+}
+
+const Eigen::VectorXd& LinkSupervisor::command_velocity(int channel) const {
+  return state_[static_cast<std::size_t>(channel)].governor.velocity();
+}
+
+void LinkSupervisor::check_watchdog(double now) {
+  for (auto& c : state_) {
+    if (!c.connected || now - c.last_feedback <= settings_.watchdog_timeout) continue;
+    c.connected = false;
+    const std::string why = c.spec.name + ": no feedback for " + format(now - c.last_feedback) +
+                            " s (watchdog " + format(settings_.watchdog_timeout) + " s)";
+    log("feedback_lost", {{"channel", c.spec.name}, {"reason", why}});
+    if (armed_) disarm(why);
+  }
+}
+
+LinkStatus LinkSupervisor::status(double now) const {
+  LinkStatus s;
+  s.kind = kind_;
+  s.armed = armed_;
+  s.reason = reason_;
+  s.connected = !state_.empty();
+  s.measured = Eigen::VectorXd::Zero(limits_.size());
+  double oldest = 0;
+  bool arrived = armed_ && has_target_;
+  for (const auto& c : state_) {
+    s.connected = s.connected && c.connected;
+    oldest = std::max(oldest, now - c.last_feedback);
+    for (std::size_t i = 0; i < c.spec.joints.size(); ++i)
+      s.measured[c.spec.joints[i]] = c.measured[static_cast<Eigen::Index>(i)];
+    arrived = arrived && c.governor.arrived_at(channel_part(target_, c)) &&
+              (c.measured - c.governor.position()).cwiseAbs().maxCoeff() <=
+                  settings_.arrive_tolerance;
+  }
+  s.feedback_age = oldest;
+  s.commanded = full_commanded();
+  s.arrived = arrived;
+  return s;
+}
+
+}  // namespace shapectl

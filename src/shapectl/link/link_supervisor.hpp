@@ -1,0 +1,108 @@
+#pragma once
+// The safety logic shared by every robot link, free of threads and sockets so it can be tested
+// step by step: it validates targets, owns the armed state, runs one MotionGovernor per
+// channel (an EGM arm, or the whole robot) and the feedback watchdog.
+//
+// Rules:
+// - Commands start from the measured position: a channel's governor is reset to the measured
+//   joints when its feedback (re)appears, and at arming if it stands still.
+// - Motion towards the target only while armed; otherwise the governor brakes to a standstill
+//   at the acceleration limit and holds.
+// - Disarm (with a reason) on: an unsafe target (flagged, non-finite, outside the joint limits,
+//   failing the pose check), feedback missing longer than the watchdog time, a robot fault,
+//   a tracking error above the limit, a commanded pose failing the pose check (then it stops
+//   at the last good pose at once).
+// Not thread-safe: the links call it under their own mutex. Times are seconds on one clock.
+#include <functional>
+#include <limits>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include <shapectl/link/motion_governor.hpp>
+#include <shapectl/link/robot_link.hpp>
+
+namespace shapectl {
+
+class SessionLog;
+
+struct LinkChannel {
+  std::string name;         // "robot", "left", "right"
+  std::vector<int> joints;  // indices into θ, in the order the channel carries them
+};
+
+struct SupervisorSettings {
+  double watchdog_timeout = 0.1;    // s without feedback on a channel: hold and disarm
+  double max_tracking_error = 0.2;  // rad between commanded and measured while armed
+  double arrive_tolerance = 1e-3;   // rad: measured this close to the commanded target
+};
+
+// Full-θ check of a pose (e.g. self-collision): true when fine, else false and `why` set.
+using PoseCheck = std::function<bool(const Eigen::VectorXd& joints, std::string* why)>;
+
+class LinkSupervisor {
+ public:
+  // `hard_lower`/`hard_upper`: the robot's joint limits (targets outside are unsafe);
+  // `limits`: the governor's band and rates, full θ. `check` may be empty; `log` may be null.
+  LinkSupervisor(std::string kind, std::vector<std::string> joint_names,
+                 std::vector<LinkChannel> channels, Eigen::VectorXd hard_lower,
+                 Eigen::VectorXd hard_upper, GovernorLimits limits, SupervisorSettings settings,
+                 PoseCheck check = {}, SessionLog* log = nullptr);
+
+  const std::vector<LinkChannel>& channels() const { return channels_; }
+  const GovernorLimits& limits() const { return limits_; }
+
+  // The optimizer's θ (full, active-joint order). Returns false (and disarms) when unsafe.
+  bool set_target(const Eigen::VectorXd& joints, bool safe);
+  bool arm(double now, std::string* why_not);
+  void disarm(const std::string& reason);
+
+  // One feedback sample of `channel` (its joints, rad, channel order) arrived at `now`;
+  // `fault` is non-empty when the robot says it cannot follow. Advances that channel's
+  // governor by `dt` and returns the command to send (channel order): positions, velocities.
+  void on_feedback(int channel, const Eigen::VectorXd& measured, std::string_view fault,
+                   double now, double dt);
+  const Eigen::VectorXd& command(int channel) const;
+  const Eigen::VectorXd& command_velocity(int channel) const;
+
+  // Marks channels whose feedback is older than the watchdog time as disconnected and
+  // disarms if armed. Call regularly (every sample period or so), also without feedback.
+  void check_watchdog(double now);
+
+  LinkStatus status(double now) const;
+
+ private:
+  struct Channel {
+    LinkChannel spec;
+    MotionGovernor governor;
+    Eigen::VectorXd measured;
+    double last_feedback = -std::numeric_limits<double>::infinity();
+    bool connected = false;
+    std::string fault;
+  };
+  void log(std::string_view event, const nlohmann::json& fields) const;
+  std::string unsafe_reason(const Eigen::VectorXd& joints, bool safe) const;
+  Eigen::VectorXd channel_part(const Eigen::VectorXd& full, const Channel& c) const;
+  Eigen::VectorXd full_commanded() const;
+
+  std::string kind_;
+  std::vector<std::string> joint_names_;
+  std::vector<LinkChannel> channels_;
+  std::vector<Channel> state_;
+  Eigen::VectorXd hard_lower_, hard_upper_;
+  GovernorLimits limits_;
+  SupervisorSettings settings_;
+  PoseCheck check_;
+  SessionLog* log_;
+
+  bool armed_ = false;
+  std::string reason_ = "not armed";
+  bool has_target_ = false;
+  std::string target_problem_;  // why the last target was refused; empty when it was fine
+  Eigen::VectorXd target_;  // band-clamped
+};
+
+}  // namespace shapectl

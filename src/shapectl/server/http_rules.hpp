@@ -1,0 +1,29 @@
+#pragma once
+// The server's decisions about HTTP requests, kept free of networking so they are easy to test:
+// which file a URL names, its content type, and which Host/Origin headers are accepted.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+
+namespace shapectl::server {
+
+// The file under `web_root` that `target` ("/js/app.js?x=1") names; "/" is "/index.html".
+// nullopt for anything that could escape the root or reach hidden files: "..", "\", "%",
+// control characters, segments starting with '.', or a path that is not a regular file
+// inside the root once symlinks are resolved.
+std::optional<std::filesystem::path> resolve_static_file(const std::filesystem::path& web_root,
+                                                         std::string_view target);
+
+// "text/javascript; charset=utf-8" for .js, and so on; application/octet-stream when unknown.
+std::string content_type(const std::filesystem::path& file);
+
+// DNS rebinding guard: the Host header must name a loopback or literal IP address, or the
+// host the server was told to bind to (`bind_host`). Port is ignored.
+bool host_allowed(std::string_view host_header, std::string_view bind_host);
+
+// Cross-site guard for the WebSocket: a browser's Origin must be the page's own
+// ("http://" + Host). Programs that send no Origin are allowed.
+bool origin_allowed(std::string_view origin_header, std::string_view host_header);
+
+}  // namespace shapectl::server

@@ -1,0 +1,244 @@
+#include <shapectl/server/protocol.hpp>
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <set>
+
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_input.hpp>
+
+namespace shapectl::server {
+
+namespace {
+
+const char* const source = "message";
+
+// Deep nesting is refused before parsing: no valid command nests deeper than 4.
+bool nesting_within(std::string_view text, int max_depth) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) return false;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return true;
+}
+
+nlohmann::json parse_json(std::string_view text) {
+  if (text.size() > max_message_bytes)
+    throw InputError(source, "", "at most " + std::to_string(max_message_bytes) + " bytes");
+  if (!nesting_within(text, max_json_depth))
+    throw InputError(source, "", "JSON nested at most " + std::to_string(max_json_depth) + " deep");
+  nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+  if (j.is_discarded()) throw InputError(source, "", "valid JSON");
+  return j;
+}
+
+bool valid_id(const nlohmann::json& id) {
+  if (id.is_number_integer()) return true;
+  return id.is_string() && id.get_ref<const std::string&>().size() <= 64;
+}
+
+Vec3 read_point(const JsonInput& j) {
+  const Vec3 p = j.vec3();
+  if (p.norm() > max_coordinate)
+    j.fail("a point within " + std::to_string(static_cast<int>(max_coordinate)) +
+           " m of the origin");
+  return p;
+}
+
+int read_node(const JsonInput& j, const ProtocolContext& context) {
+  if (context.node_count <= 0) j.fail_problem("the scene has no nodes");
+  return static_cast<int>(j.integer_in(0, context.node_count - 1));
+}
+
+double read_joint_value(const JsonInput& j, const ProtocolContext& context, int joint) {
+  const double v = j.number();
+  const double lo = context.lower_limits[joint], hi = context.upper_limits[joint];
+  if (v < lo - 1e-9 || v > hi + 1e-9)
+    j.fail("a value within the limits of joint '" + context.joint_names[joint] + "' [" +
+           std::to_string(lo) + ", " + std::to_string(hi) + "]");
+  return v;
+}
+
+int read_joint(const JsonInput& j, const ProtocolContext& context) {
+  const int count = static_cast<int>(context.joint_names.size());
+  if (count == 0) j.fail_problem("the scene has no robot joints");
+  if (j.is_string()) {
+    const std::string name = j.string();
+    for (int k = 0; k < count; ++k)
+      if (context.joint_names[k] == name) return k;
+    j.fail("the name of an active joint");
+  }
+  return static_cast<int>(j.integer_in(0, count - 1));
+}
+
+const std::vector<std::pair<std::string, Command::Type>>& type_names() {
+  static const std::vector<std::pair<std::string, Command::Type>> names = {
+      {"ping", Command::Type::Ping},
+      {"set_target", Command::Type::SetTarget},
+      {"remove_target", Command::Type::RemoveTarget},
+      {"set_targets", Command::Type::SetTargets},
+      {"clear_targets", Command::Type::ClearTargets},
+      {"set_centerline", Command::Type::SetCenterline},
+      {"set_paused", Command::Type::SetPaused},
+      {"set_joint", Command::Type::SetJoint},
+      {"set_joints", Command::Type::SetJoints},
+      {"reset", Command::Type::Reset},
+      {"load_scene", Command::Type::LoadScene},
+      {"arm", Command::Type::Arm},
+      {"disarm", Command::Type::Disarm},
+  };
+  return names;
+}
+
+}  // namespace
+
+nlohmann::json message_id(std::string_view text) {
+  if (text.size() > max_message_bytes || !nesting_within(text, max_json_depth)) return nullptr;
+  const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+  if (!j.is_object()) return nullptr;
+  const auto it = j.find("id");
+  if (it == j.end() || !valid_id(*it)) return nullptr;
+  return *it;
+}
+
+Command parse_command(std::string_view text, const ProtocolContext& context) {
+  const JsonInput message(parse_json(text), source);
+  if (!message.is_object()) message.fail("a JSON object");
+  Command c;
+  if (message.has("id")) {
+    c.id = message.at("id").raw();
+    if (!valid_id(c.id)) message.at("id").fail("an integer or a string of at most 64 characters");
+  }
+  const JsonInput type = message.at("type");
+  const std::string name = type.string();
+  const auto& names = type_names();
+  const auto found = std::find_if(names.begin(), names.end(),
+                                  [&](const auto& entry) { return entry.first == name; });
+  if (found == names.end()) {
+    std::string known;
+    for (const auto& entry : names) known += (known.empty() ? "" : ", ") + entry.first;
+    type.fail("one of " + known);
+  }
+  c.type = found->second;
+
+  using T = Command::Type;
+  switch (c.type) {
+    case T::Ping: case T::ClearTargets: case T::Reset: case T::Arm: case T::Disarm:
+      message.expect_only({"type", "id"});
+      break;
+    case T::SetTarget:
+      message.expect_only({"type", "id", "node", "position"});
+      c.node = read_node(message.at("node"), context);
+      c.position = read_point(message.at("position"));
+      break;
+    case T::RemoveTarget:
+      message.expect_only({"type", "id", "node"});
+      c.node = read_node(message.at("node"), context);
+      break;
+    case T::SetTargets: {
+      message.expect_only({"type", "id", "targets"});
+      const JsonInput list = message.at("targets");
+      if (list.size() > static_cast<std::size_t>(context.node_count))
+        list.fail("at most one target per node (" + std::to_string(context.node_count) + ")");
+      std::set<int> seen;
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        const JsonInput t = list.at(k);
+        t.expect_only({"node", "position"});
+        const int node = read_node(t.at("node"), context);
+        if (!seen.insert(node).second) t.at("node").fail("a node not targeted twice");
+        c.targets.nodes.push_back(node);
+        c.targets.positions.push_back(read_point(t.at("position")));
+      }
+      break;
+    }
+    case T::SetCenterline: {
+      message.expect_only({"type", "id", "points"});
+      const JsonInput list = message.at("points");
+      if (list.size() < 2 || list.size() > max_centerline_points)
+        list.fail("from 2 to " + std::to_string(max_centerline_points) + " points");
+      for (std::size_t k = 0; k < list.size(); ++k) c.points.push_back(read_point(list.at(k)));
+      break;
+    }
+    case T::SetPaused:
+      message.expect_only({"type", "id", "paused"});
+      c.paused = message.at("paused").boolean();
+      break;
+    case T::SetJoint:
+      message.expect_only({"type", "id", "joint", "value"});
+      c.joint = read_joint(message.at("joint"), context);
+      c.value = read_joint_value(message.at("value"), context, c.joint);
+      break;
+    case T::SetJoints: {
+      message.expect_only({"type", "id", "joints"});
+      const JsonInput list = message.at("joints");
+      const std::size_t count = context.joint_names.size();
+      if (count == 0) list.fail_problem("the scene has no robot joints");
+      if (list.size() != count) list.fail("an array of " + std::to_string(count) + " joint values");
+      c.joints.resize(static_cast<Eigen::Index>(count));
+      for (std::size_t k = 0; k < count; ++k)
+        c.joints[static_cast<Eigen::Index>(k)] = read_joint_value(list.at(k), context, static_cast<int>(k));
+      break;
+    }
+    case T::LoadScene: {
+      message.expect_only({"type", "id", "scene"});
+      const JsonInput scene = message.at("scene");
+      c.scene = scene.string();
+      const auto& known = context.scene_names;
+      if (std::find(known.begin(), known.end(), c.scene) == known.end()) {
+        std::string list;
+        for (const auto& s : known) list += (list.empty() ? "" : ", ") + s;
+        scene.fail("one of the bundled scenes: " + list);
+      }
+      break;
+    }
+  }
+  return c;
+}
+
+std::string ok_reply(const nlohmann::json& id) {
+  return nlohmann::json{{"type", "ok"}, {"id", id}}.dump();
+}
+
+std::string error_reply(const nlohmann::json& id, const std::string& message) {
+  // Replace invalid UTF-8 (echoed client bytes) instead of throwing.
+  return nlohmann::json{{"type", "error"}, {"id", id}, {"message", message}}
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+std::string positions_frame(const ControllerSnapshot& snapshot) {
+  static_assert(std::endian::native == std::endian::little, "frames are little-endian");
+  const auto n = static_cast<std::uint32_t>(snapshot.positions.size() / 3);
+  const double sequence = static_cast<double>(snapshot.sequence);
+  std::string frame(16 + 12 * static_cast<std::size_t>(n), '\0');
+  std::memcpy(frame.data(), "POS1", 4);
+  std::memcpy(frame.data() + 4, &n, 4);
+  std::memcpy(frame.data() + 8, &sequence, 8);
+  for (std::size_t i = 0; i < 3 * static_cast<std::size_t>(n); ++i) {
+    const float v = static_cast<float>(snapshot.positions[static_cast<Eigen::Index>(i)]);
+    std::memcpy(frame.data() + 16 + 4 * i, &v, 4);
+  }
+  return frame;
+}
+
+nlohmann::json pose_json(const Eigen::Isometry3d& T) {
+  nlohmann::json a = nlohmann::json::array();
+  const Eigen::Matrix4d& m = T.matrix();
+  for (int col = 0; col < 4; ++col)
+    for (int row = 0; row < 4; ++row) a.push_back(m(row, col));
+  return a;
+}
+
+}  // namespace shapectl::server

@@ -1,0 +1,331 @@
+#include <shapectl/server/session.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include <shapectl/control/centerline.hpp>
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/link/robot_link.hpp>
+#include <shapectl/sim/scene.hpp>
+
+namespace shapectl::server {
+
+namespace {
+
+// JSON has no infinity: unbounded limits and clearances go out as null.
+nlohmann::json finite_or_null(double v) {
+  if (std::isfinite(v)) return v;
+  return nullptr;
+}
+
+nlohmann::json vector_json(const Eigen::VectorXd& v) {
+  nlohmann::json a = nlohmann::json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(finite_or_null(v[i]));
+  return a;
+}
+
+nlohmann::json point_json(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
+
+const char* kind_name(Shape::Kind kind) {
+  switch (kind) {
+    case Shape::Kind::Sphere: return "sphere";
+    case Shape::Kind::Box: return "box";
+    case Shape::Kind::Cylinder: return "cylinder";
+  }
+  return "sphere";
+}
+
+nlohmann::json shape_json(const Shape& s) {
+  return {{"kind", kind_name(s.kind)},
+          {"pose", pose_json(s.T_link_shape)},
+          {"size", point_json(s.box_size)},
+          {"radius", s.radius},
+          {"length", s.length}};
+}
+
+nlohmann::json robot_json(const RobotSetup& setup) {
+  const RobotModel& model = *setup.model;
+  nlohmann::json links = nlohmann::json::array();
+  for (const Link& link : model.links()) {
+    nlohmann::json visuals = nlohmann::json::array();
+    for (const Shape& s : link.visual_shapes) visuals.push_back(shape_json(s));
+    links.push_back({{"name", link.name}, {"visuals", visuals}});
+  }
+  nlohmann::json spheres = nlohmann::json::array();
+  if (setup.collisions)
+    for (const CollisionSphere& s : setup.collisions->spheres())
+      spheres.push_back({{"link", s.link}, {"center", point_json(s.center_link)}, {"radius", s.radius}});
+  nlohmann::json end_effectors = nlohmann::json::array();
+  for (const EndEffector& e : setup.end_effectors)
+    end_effectors.push_back({{"name", e.name}, {"link", e.link}, {"tcp", point_json(e.tcp_link)}});
+  return {{"name", model.name()},
+          {"links", links},
+          {"joint_names", model.active_joint_names()},
+          {"lower_limits", vector_json(model.lower_limits())},
+          {"upper_limits", vector_json(model.upper_limits())},
+          {"reference_joints", vector_json(setup.reference_joints)},
+          {"end_effectors", end_effectors},
+          {"collision_spheres", spheres}};
+}
+
+nlohmann::json link_status_json(const LinkStatus& s) {
+  return {{"kind", s.kind},
+          {"connected", s.connected},
+          {"armed", s.armed},
+          {"feedback_age", finite_or_null(s.feedback_age)},
+          {"reason", s.reason},
+          {"measured", vector_json(s.measured)},
+          {"commanded", vector_json(s.commanded)}};
+}
+
+}  // namespace
+
+std::vector<SceneEntry> find_bundled_scenes(const std::filesystem::path& directory) {
+  std::vector<SceneEntry> scenes;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
+    if (entry.path().extension() != ".json" || !entry.is_regular_file(ec)) continue;
+    std::ifstream in(entry.path());
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_object() && j.contains("robot"))
+      scenes.push_back({entry.path().filename().string(), entry.path()});
+  }
+  std::sort(scenes.begin(), scenes.end(),
+            [](const SceneEntry& a, const SceneEntry& b) { return a.name < b.name; });
+  return scenes;
+}
+
+Session::Session(const std::filesystem::path& scene, std::vector<SceneEntry> scenes,
+                 RobotLink* link, ControllerOptions options)
+    : scenes_(std::move(scenes)), link_(link), options_(options) {
+  const std::string name = scene.filename().string();
+  auto same = [&](const SceneEntry& e) { return e.name == name; };
+  auto it = std::find_if(scenes_.begin(), scenes_.end(), same);
+  if (it == scenes_.end()) {
+    scenes_.push_back({name, scene});
+    it = scenes_.end() - 1;
+  } else {
+    it->path = scene;  // the file asked for wins over a bundled one of the same name
+  }
+  load(*it);
+}
+
+Session::~Session() = default;
+
+void Session::load(const SceneEntry& entry) {
+  // Load first: a bad scene leaves the current one running.
+  const Scene scene = load_scene(entry.path);
+  auto controller = std::make_unique<Controller>(scene, options_);
+  if (controller_) controller_->stop();
+  controller_ = std::move(controller);
+  controller_->start();
+  scene_name_ = entry.name;
+  targets_ = {};
+  history_.clear();
+  started_ = std::chrono::steady_clock::now();
+  last_edit_time_ = -1e9;
+  snapshot_ = controller_->snapshot();
+  if (link_) link_->disarm("scene changed to " + entry.name);
+  scene_description_ = describe_scene();
+}
+
+double Session::now() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - started_).count();
+}
+
+ProtocolContext Session::context() const {
+  ProtocolContext c;
+  c.node_count = controller_->mesh().node_count();
+  c.joint_names = snapshot_->joint_names;
+  c.lower_limits = snapshot_->lower_limits;
+  c.upper_limits = snapshot_->upper_limits;
+  for (const auto& s : scenes_) c.scene_names.push_back(s.name);
+  return c;
+}
+
+Session::Reply Session::handle(std::string_view text) {
+  Reply reply;
+  nlohmann::json id;
+  try {
+    const Command command = parse_command(text, context());
+    id = command.id;
+    apply(command);
+    reply.ok = true;
+    reply.scene_changed = command.type == Command::Type::LoadScene;
+    reply.text = ok_reply(id);
+  } catch (const InputError& e) {
+    if (id.is_null()) id = message_id(text);
+    reply.text = error_reply(id, e.what());
+    reply.log = e.what();
+  } catch (const std::exception& e) {
+    if (id.is_null()) id = message_id(text);
+    reply.text = error_reply(id, std::string("failed: ") + e.what());
+    reply.log = std::string("failed: ") + e.what();
+  }
+  return reply;
+}
+
+void Session::apply(const Command& c) {
+  using T = Command::Type;
+  auto edited = [&] { last_edit_time_ = now(); };
+  switch (c.type) {
+    case T::Ping:
+      break;
+    case T::SetTarget: case T::RemoveTarget: case T::SetTargets: {
+      ShapeTargets next = targets_;
+      if (c.type == T::SetTargets) next = c.targets;
+      const auto it = std::find(next.nodes.begin(), next.nodes.end(), c.node);
+      const auto k = it - next.nodes.begin();
+      if (c.type == T::SetTarget && it != next.nodes.end()) {
+        next.positions[static_cast<std::size_t>(k)] = c.position;
+      } else if (c.type == T::SetTarget) {
+        next.nodes.push_back(c.node);
+        next.positions.push_back(c.position);
+      } else if (c.type == T::RemoveTarget) {
+        if (it == next.nodes.end())
+          throw InputError("message", "node", "a node that has a target", c.node);
+        next.nodes.erase(it);
+        next.positions.erase(next.positions.begin() + k);
+      }
+      if (next.empty()) controller_->clear_targets();
+      else controller_->set_targets(next);
+      targets_ = std::move(next);
+      edited();
+      break;
+    }
+    case T::ClearTargets:
+      controller_->clear_targets();
+      targets_ = {};
+      edited();
+      break;
+    case T::SetCenterline:
+      controller_->set_centerline(c.points);
+      targets_ = {};
+      edited();
+      break;
+    case T::SetPaused:
+      controller_->set_paused(c.paused);
+      break;
+    case T::SetJoint: case T::SetJoints: {
+      // Jog from the newest state; the controller refuses it unless paused.
+      Eigen::VectorXd joints = c.joints;
+      if (c.type == T::SetJoint) {
+        joints = controller_->snapshot()->joints;
+        joints[c.joint] = c.value;
+      }
+      controller_->set_joints(joints);
+      break;
+    }
+    case T::Reset:
+      controller_->reset();
+      targets_ = {};
+      edited();
+      break;
+    case T::LoadScene: {
+      const auto it = std::find_if(scenes_.begin(), scenes_.end(),
+                                   [&](const SceneEntry& e) { return e.name == c.scene; });
+      load(*it);  // parse_command admitted only known names
+      break;
+    }
+    case T::Arm: {
+      if (!link_) throw InputError("message", "type", "no robot link in this session");
+      std::string why_not;
+      if (!link_->arm(&why_not)) throw InputError("message", "arm", "refused: " + why_not);
+      break;
+    }
+    case T::Disarm:
+      if (!link_) throw InputError("message", "type", "no robot link in this session");
+      link_->disarm("disarmed from the GUI");
+      break;
+  }
+}
+
+void Session::tick() {
+  snapshot_ = controller_->snapshot();
+  const double t = now();
+  history_.push_back({t, snapshot_->error.mean, t - last_edit_time_ < editing_window});
+  while (history_.size() > history_capacity) history_.pop_front();
+  if (link_) link_->set_target(snapshot_->joints, snapshot_->safe);
+}
+
+bool Session::busy() const { return snapshot_->status == "optimizing"; }
+
+nlohmann::json Session::describe_scene() const {
+  const Scene& scene = controller_->scene();
+  const TetMesh& mesh = controller_->mesh();
+  nlohmann::json triangles = nlohmann::json::array();
+  for (const auto& t : mesh.surface_triangles())
+    for (int v : t) triangles.push_back(v);
+  nlohmann::json grips = nlohmann::json::array();
+  for (const Grip& g : scene.grips) {
+    const std::string name = scene.robot ? scene.robot->end_effectors[g.end_effector].name : "";
+    grips.push_back({{"end_effector", name}, {"nodes", g.nodes}});
+  }
+  nlohmann::json bar = nullptr;
+  if (const auto axis = find_bar_axis(mesh))
+    bar = {{"center", point_json(axis->center)}, {"direction", point_json(axis->direction)},
+           {"length", axis->length}, {"thickness", axis->thickness}};
+  nlohmann::json scenes = nlohmann::json::array();
+  for (const auto& s : scenes_) scenes.push_back(s.name);
+  return {{"type", "scene"},
+          {"protocol", protocol_version},
+          {"scene", scene_name_},
+          {"scenes", scenes},
+          {"node_count", mesh.node_count()},
+          {"triangles", triangles},
+          {"grips", grips},
+          {"bar", bar},
+          {"robot", scene.robot ? robot_json(*scene.robot) : nlohmann::json(nullptr)},
+          {"link", link_ != nullptr},
+          {"limits", {{"max_message_bytes", max_message_bytes},
+                      {"max_coordinate", max_coordinate},
+                      {"max_centerline_points", max_centerline_points}}}};
+}
+
+std::string Session::scene_message() const {
+  nlohmann::json m = scene_description_;
+  nlohmann::json history = nlohmann::json::array();
+  for (const auto& h : history_) history.push_back({h.time, h.error_mean, h.editing ? 1 : 0});
+  m["history"] = std::move(history);
+  return m.dump();
+}
+
+std::string Session::state_message(int clients) const {
+  const ControllerSnapshot& s = *snapshot_;
+  nlohmann::json links = nlohmann::json::array();
+  for (const auto& T : s.T_world_link) links.push_back(pose_json(T));
+  nlohmann::json targets = nlohmann::json::array();
+  for (int k = 0; k < s.targets.size(); ++k)
+    targets.push_back({{"node", s.targets.nodes[static_cast<std::size_t>(k)]},
+                       {"position", point_json(s.targets.positions[static_cast<std::size_t>(k)])}});
+  nlohmann::json centerline = nlohmann::json::array();
+  for (const Vec3& p : s.centerline) centerline.push_back(point_json(p));
+  const double t = now();
+  const nlohmann::json m = {
+      {"type", "state"},
+      {"scene", scene_name_},
+      {"seq", s.sequence},
+      {"time", t},
+      {"controller_time", s.time},
+      {"status", s.status},
+      {"paused", s.paused},
+      {"safe", s.safe},
+      {"within_limits", s.within_limits},
+      {"min_clearance", finite_or_null(s.min_clearance)},
+      {"iterations", s.iterations},
+      {"iterations_per_second", finite_or_null(s.iterations_per_second)},
+      {"objective", finite_or_null(s.objective)},
+      {"error", {{"mean", finite_or_null(s.error.mean)}, {"max", finite_or_null(s.error.max)}}},
+      {"editing", t - last_edit_time_ < editing_window},
+      {"joints", vector_json(s.joints)},
+      {"links", links},
+      {"targets", targets},
+      {"centerline", centerline},
+      {"last_error", s.last_error},
+      {"clients", clients},
+      {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)}};
+  return m.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+}  // namespace shapectl::server

@@ -1,0 +1,93 @@
+#pragma once
+// One interactive session shared by every connected page: the controller of the current scene,
+// the bundled scenes to switch between, the error history for the convergence plot and,
+// optionally, a robot link. Commands come in as protocol text; what goes out (scene
+// descriptions, states, position frames) is encoded here once and broadcast by the server.
+//
+// Not thread-safe: the server calls it from its one network thread. The controller it owns
+// runs its optimizer in a thread of its own.
+#include <chrono>
+#include <deque>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <shapectl/control/controller.hpp>
+#include <shapectl/server/protocol.hpp>
+
+namespace shapectl {
+class RobotLink;
+}
+
+namespace shapectl::server {
+
+struct SceneEntry {
+  std::string name;  // what clients ask for, e.g. "yumi_bar.json"
+  std::filesystem::path path;
+};
+
+// The scenes (*.json with a "robot") in `directory`, sorted by name; unreadable files skipped.
+std::vector<SceneEntry> find_bundled_scenes(const std::filesystem::path& directory);
+
+struct HistorySample {
+  double time = 0;        // s since the scene was loaded
+  double error_mean = 0;  // m
+  bool editing = false;   // a target edit arrived within the last `editing_window` s
+};
+
+class Session {
+ public:
+  // Loads `scene` (an InputError if it is bad) and starts its controller. `scenes` are what
+  // load_scene may switch to; `scene` is added to them if absent. `link` may be null.
+  Session(const std::filesystem::path& scene, std::vector<SceneEntry> scenes,
+          RobotLink* link = nullptr, ControllerOptions options = {});
+  ~Session();
+
+  struct Reply {
+    std::string text;            // "ok" or "error" message for the sender
+    bool ok = false;
+    std::string log;             // a line for the server log when the message was bad
+    bool scene_changed = false;  // broadcast scene_message() to everyone
+  };
+  // Validates and applies one client message; never throws for bad input.
+  Reply handle(std::string_view text);
+
+  // Called at the streaming rate: samples the history, forwards θ to the link.
+  void tick();
+  // JSON "scene" message: static description (robot geometry, mesh triangles, grips, scene
+  // list, limits, history). Sent on connect and after a scene switch.
+  std::string scene_message() const;
+  // JSON "state" message for the latest snapshot (at most as old as the last tick()).
+  std::string state_message(int clients) const;
+  std::shared_ptr<const ControllerSnapshot> snapshot() const { return snapshot_; }
+  // True while the optimizer works (streaming at full rate matters then).
+  bool busy() const;
+
+  Controller& controller() { return *controller_; }
+  const std::string& scene_name() const { return scene_name_; }
+
+  static constexpr double editing_window = 0.3;   // s
+  static constexpr std::size_t history_capacity = 6000;
+
+ private:
+  void load(const SceneEntry& entry);
+  void apply(const Command& command);
+  ProtocolContext context() const;
+  nlohmann::json describe_scene() const;
+  double now() const;
+
+  std::vector<SceneEntry> scenes_;
+  std::string scene_name_;
+  RobotLink* link_;
+  ControllerOptions options_;
+  std::unique_ptr<Controller> controller_;
+  std::shared_ptr<const ControllerSnapshot> snapshot_;
+  nlohmann::json scene_description_;  // the static part of scene_message()
+  ShapeTargets targets_;  // node targets as the clients set them (a centre-line clears them)
+  std::chrono::steady_clock::time_point started_;
+  double last_edit_time_ = -1e9;
+  std::deque<HistorySample> history_;
+};
+
+}  // namespace shapectl::server

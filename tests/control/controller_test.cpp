@@ -1,0 +1,107 @@
+#include <shapectl/control/controller.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <thread>
+
+#include <shapectl/control/centerline.hpp>
+#include <shapectl/io/input_error.hpp>
+
+#include "support/two_arm_scene.hpp"
+
+namespace shapectl {
+namespace {
+
+// Waits (bounded) until `done` holds for a snapshot.
+template <class Done>
+std::shared_ptr<const ControllerSnapshot> wait_until(const Controller& c, Done done, double seconds) {
+  auto s = c.snapshot();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!done(*s) && std::chrono::steady_clock::now() < deadline) s = c.wait_for_snapshot(s->sequence, 0.1);
+  return s;
+}
+
+TEST(Controller, FollowsTargetsSetFromAnotherThread) {
+  const Scene scene = test::two_arm_scene({24, 2, 2});
+  // Reachable targets: the shape at other joint angles.
+  GrippedObject probe(scene);
+  ReducedObjective probe_objective(probe);
+  Eigen::VectorXd goal = probe.reference_joints();
+  goal << 0.1, -0.4, 1.0, -0.1, -0.2, 0.8;
+  const Evaluation e = probe_objective.evaluate(goal, probe.reference_positions());
+  ShapeTargets targets;
+  for (int i = 0; i < probe.node_count(); i += 7) {
+    targets.nodes.push_back(i);
+    targets.positions.push_back(e.positions.segment<3>(3 * i));
+  }
+
+  Controller controller(scene);
+  controller.start();
+  std::thread editor([&] { controller.set_targets(targets); });
+  editor.join();
+  const auto s = wait_until(controller, [](const ControllerSnapshot& s) { return s.error.mean < 1e-3 && !s.targets.empty(); }, 30);
+  EXPECT_LT(s->error.mean, 1e-3);
+  EXPECT_TRUE(s->safe);
+  EXPECT_GT(s->iterations, 0u);
+  EXPECT_GT((s->joints - scene.robot->reference_joints).norm(), 0.05);
+  EXPECT_EQ(s->joint_names.size(), 6u);
+  EXPECT_EQ(s->T_world_link.size(), static_cast<std::size_t>(controller.robot().link_count()));
+  controller.stop();
+}
+
+TEST(Controller, BadRequestsThrowAndChangeNothing) {
+  Controller controller(test::two_arm_scene());
+  const auto before = controller.snapshot();
+  EXPECT_THROW(controller.set_targets({{100000}, {Vec3(0, 0, 0)}}), InputError);
+  EXPECT_THROW(controller.set_targets({{0}, {Vec3(0, NAN, 0)}}), InputError);
+  EXPECT_THROW(controller.set_centerline({Vec3(0, 0, 0)}), InputError);
+  EXPECT_THROW(controller.set_joints(Eigen::VectorXd::Zero(2)), InputError);
+  controller.step_once();
+  EXPECT_EQ(controller.snapshot()->sequence, before->sequence);  // nothing was applied
+}
+
+TEST(Controller, PauseAndJogMoveTheRobotWithoutTheOptimizer) {
+  Controller controller(test::two_arm_scene());
+  controller.set_paused(true);
+  Eigen::VectorXd jog = controller.snapshot()->joints;
+  jog[0] += 0.2;
+  controller.set_joints(jog);
+  controller.step_once();
+  const auto s = controller.snapshot();
+  EXPECT_TRUE(s->paused);
+  EXPECT_EQ(s->status, "paused");
+  EXPECT_NEAR(s->joints[0], jog[0], 1e-12);
+  EXPECT_EQ(s->iterations, 0u);
+  // The object followed: its gripped left end moved.
+  const int node = controller.scene().grips[0].nodes[0];
+  EXPECT_GT((s->positions - controller.scene().world_rest_positions()).segment<3>(3 * node).norm(), 0.01);
+  controller.reset();
+  controller.step_once();
+  EXPECT_NEAR((controller.snapshot()->joints - controller.scene().robot->reference_joints).norm(), 0, 1e-12);
+}
+
+TEST(Centerline, StraightSketchAlongTheBarTargetsItsCentreNodes) {
+  const Scene scene = test::two_arm_scene({24, 2, 2});
+  GrippedObject object(scene);
+  const auto axis = find_bar_axis(object.mesh());
+  ASSERT_TRUE(axis.has_value());
+  EXPECT_EQ(axis->centerline_nodes.size(), 25u);  // one per station of the 24-cell bar
+  const Positions x = object.reference_positions();
+  const Vec3 a = axis->center + axis->s_min * axis->direction;
+  const Vec3 b = a + axis->length * axis->direction;
+  for (const auto& sketch : {std::vector<Vec3>{a, 0.5 * (a + b), b}, std::vector<Vec3>{b, a}}) {
+    const ShapeTargets t = centerline_targets(object.mesh(), *axis, sketch, x);
+    EXPECT_LT(shape_error(t, x).max, 1e-9);
+  }
+  // A sketch twice as long stretches the targets over it.
+  const ShapeTargets longer = centerline_targets(object.mesh(), *axis, {a, a + 2 * (b - a)}, x);
+  EXPECT_NEAR((longer.positions.back() - longer.positions.front()).norm(), 2 * axis->length, 1e-9);
+}
+
+TEST(Centerline, CubeIsNotBarLike) {
+  EXPECT_FALSE(find_bar_axis(make_box_mesh({0.1, 0.1, 0.1}, {2, 2, 2})).has_value());
+}
+
+}  // namespace
+}  // namespace shapectl
