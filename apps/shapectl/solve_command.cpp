@@ -1,5 +1,105 @@
-// placeholder: being written
+// shapectl solve SCENE.json --targets TARGETS.json --out RESULT.json
+//   [--optimizer lbfgs|gauss-newton] [--gradient sensitivity|adjoint|finite-difference]
+//   [--max-iterations N] [--max-seconds S]
+// Finds joint angles whose equilibrium shape best matches the targets.
+#include <iostream>
+
+#include <shapectl/control/centerline.hpp>
+#include <shapectl/control/optimize.hpp>
+#include <shapectl/control/targets_file.hpp>
+#include <shapectl/io/json_output.hpp>
+
 #include "commands.hpp"
+#include "result_json.hpp"
+
 namespace shapectl::cli {
-void add_solve_command(CLI::App&) {}
+
+namespace {
+
+struct SolveArgs {
+  std::string scene, targets, out;
+  std::string optimizer = "gauss-newton";
+  std::string gradient = "sensitivity";
+  int max_iterations = 100;
+  double max_seconds = 60;
+};
+
+ShapeTargets resolve_targets(const TargetsInput& in, const std::string& file, GrippedObject& object) {
+  if (in.centerline.empty()) return in.targets;
+  const auto axis = find_bar_axis(object.mesh());
+  if (!axis)
+    throw InputError(file, "centerline", "an object that is bar-like (length ≥ 3 × thickness)",
+                     "a " + std::to_string(object.mesh().node_count()) + "-node object that is not");
+  return centerline_targets(object.mesh(), *axis, in.centerline, object.reference_positions());
+}
+
+void run_solve(const SolveArgs& args) {
+  const Scene scene = load_scene(args.scene);
+  if (!scene.robot) throw InputError(args.scene, "robot", "a robot to optimize (missing key)");
+  GrippedObject object(scene);
+  const TargetsInput input = load_targets(args.targets, object.node_count());
+  ReducedObjective objective(object);
+  objective.set_targets(resolve_targets(input, args.targets, object));
+
+  const OptimizerKind kind = args.optimizer == "lbfgs" ? OptimizerKind::Lbfgs : OptimizerKind::GaussNewton;
+  const GradientMethod gradient = args.gradient == "adjoint"             ? GradientMethod::Adjoint
+                                  : args.gradient == "finite-difference" ? GradientMethod::FiniteDifference
+                                                                         : GradientMethod::Sensitivity;
+  auto optimizer = make_optimizer(kind, gradient);
+  const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
+  if (!start.statics.converged())
+    throw SolverFailure("statics at the reference joints: " + start.statics.reason);
+  const OptimizeResult result =
+      optimize(objective, *optimizer, start,
+               {.max_iterations = args.max_iterations, .max_seconds = args.max_seconds});
+
+  const Evaluation& best = result.best;
+  nlohmann::json out = robot_json(scene, best.joints);
+  out["converged"] = result.converged;
+  out["reason"] = result.reason;
+  out["iterations"] = result.iterations;
+  out["error_mean"] = best.error.mean;
+  out["error_max"] = best.error.max;
+  out["objective"] = best.objective;
+  out["min_clearance"] = best.min_clearance;
+  nlohmann::json violations = nlohmann::json::array();
+  const KinematicsState state = forward_kinematics(object.robot(), best.joints);
+  for (const auto& v : limit_violations(object.robot(), state.joints))
+    violations.push_back({{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
+  out["limit_violations"] = violations;
+  out["positions"] = positions_to_json(best.positions);
+  nlohmann::json targets = nlohmann::json::array();
+  for (int k = 0; k < objective.targets().size(); ++k) {
+    const Vec3& p = objective.targets().positions[k];
+    targets.push_back({{"node", objective.targets().nodes[k]}, {"position", {p.x(), p.y(), p.z()}}});
+  }
+  out["targets"] = targets;
+  for (const auto& h : result.history)
+    out["history"].push_back({{"iteration", h.iteration}, {"time", h.time}, {"error_mean", h.error_mean},
+                              {"objective", h.objective}});
+  const ObjectiveTiming& t = objective.timing();
+  out["timing"] = {{"statics_solves", t.statics_solves}, {"statics_seconds", t.statics_seconds},
+                   {"gradient_evaluations", t.gradient_evaluations}, {"gradient_seconds", t.gradient_seconds}};
+  write_json_file(args.out, out);
+  std::cerr << "solve: " << result.reason << "; mean error " << best.error.mean * 1e3 << " mm, max "
+            << best.error.max * 1e3 << " mm, min clearance " << best.min_clearance * 1e3 << " mm\n";
+}
+
+}  // namespace
+
+void add_solve_command(CLI::App& app) {
+  auto args = std::make_shared<SolveArgs>();
+  auto* cmd = app.add_subcommand("solve", "Find joint angles that give the object the target shape");
+  cmd->add_option("scene", args->scene, "SCENE.json")->required();
+  cmd->add_option("--targets", args->targets, "TARGETS.json")->required();
+  cmd->add_option("--out", args->out, "RESULT.json to write")->required();
+  cmd->add_option("--optimizer", args->optimizer, "gauss-newton (default) or lbfgs")
+      ->check(CLI::IsMember({"gauss-newton", "lbfgs"}));
+  cmd->add_option("--gradient", args->gradient, "sensitivity (default), adjoint or finite-difference")
+      ->check(CLI::IsMember({"sensitivity", "adjoint", "finite-difference"}));
+  cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")->check(CLI::Range(1, 100000));
+  cmd->add_option("--max-seconds", args->max_seconds, "time limit")->check(CLI::PositiveNumber);
+  cmd->callback([args] { run_solve(*args); });
+}
+
 }  // namespace shapectl::cli

@@ -1,12 +1,14 @@
-// shapectl statics SCENE.json --out RESULT.json [--vtu DEFORMED.vtu]
-// Solves the object's static equilibrium and writes the deformed positions.
+// shapectl statics SCENE.json [--joints JOINTS.json] --out RESULT.json [--vtu DEFORMED.vtu]
+// Solves the object's static equilibrium (held by fixed nodes, or by the robot at the given
+// joints) and writes the deformed positions.
 #include <iostream>
 
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/io/vtu_writer.hpp>
-#include <shapectl/sim/object_statics.hpp>
+#include <shapectl/sim/gripped_object.hpp>
 
 #include "commands.hpp"
+#include "result_json.hpp"
 
 namespace shapectl::cli {
 
@@ -14,29 +16,48 @@ namespace {
 
 struct StaticsArgs {
   std::string scene;
+  std::string joints;
   std::string out;
   std::string vtu;
 };
 
-void run_statics(const StaticsArgs& args) {
-  const Scene scene = load_scene(args.scene);
-  ObjectStatics statics(scene);
-  Positions x = scene.world_rest_positions();
-  const StaticsResult r = statics.solve(x);
-  const nlohmann::json result = {
-      {"converged", r.converged()}, {"status", to_string(r.status)}, {"reason", r.reason},
-      {"iterations", r.iterations}, {"residual", r.residual},        {"energy", r.energy},
-      {"positions", positions_to_json(x)}};
+void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMesh& mesh,
+                   const Positions& rest, const Positions& x, nlohmann::json result) {
+  result["converged"] = r.converged();
+  result["status"] = to_string(r.status);
+  result["reason"] = r.reason;
+  result["iterations"] = r.iterations;
+  result["residual"] = r.residual;
+  result["energy"] = r.energy;
+  result["positions"] = positions_to_json(x);
   write_json_file(args.out, result);
   if (!args.vtu.empty()) {
     std::vector<std::array<int, 4>> tets;
-    for (const auto& t : statics.mesh().tets()) tets.push_back(t.nodes);
-    const Positions rest = scene.world_rest_positions();
+    for (const auto& t : mesh.tets()) tets.push_back(t.nodes);
     write_vtu(args.vtu, x, tets, {{"displacement", x - rest}});
   }
-  std::cerr << "statics: " << r.reason << " (" << statics.mesh().tet_count() << " tets, "
-            << statics.mesh().node_count() << " nodes)\n";
+  std::cerr << "statics: " << r.reason << " (" << mesh.tet_count() << " tets, " << mesh.node_count()
+            << " nodes)\n";
   if (!r.converged()) throw SolverFailure(r.reason);
+}
+
+void run_statics(const StaticsArgs& args) {
+  const Scene scene = load_scene(args.scene);
+  const Positions rest = scene.world_rest_positions();
+  Positions x = rest;
+  if (!scene.robot) {
+    if (!args.joints.empty())
+      throw InputError(args.joints, "", "joints given, but the scene has no robot");
+    ObjectStatics statics(scene);
+    const StaticsResult r = statics.solve(x);
+    write_outputs(args, r, statics.mesh(), rest, x, nlohmann::json::object());
+    return;
+  }
+  GrippedObject object(scene);
+  Eigen::VectorXd joints = object.reference_joints();
+  if (!args.joints.empty()) joints = read_joints_file(args.joints, object.robot(), joints);
+  const StaticsResult r = object.solve(joints, x);
+  write_outputs(args, r, object.mesh(), rest, x, robot_json(scene, joints));
 }
 
 }  // namespace
@@ -45,6 +66,7 @@ void add_statics_command(CLI::App& app) {
   auto args = std::make_shared<StaticsArgs>();
   auto* cmd = app.add_subcommand("statics", "Solve the object's static equilibrium");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
+  cmd->add_option("--joints", args->joints, "JOINTS.json {\"joints\": {name: rad}} (default: the reference joints)");
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
   cmd->add_option("--vtu", args->vtu, "also write the deformed mesh as VTU (ParaView)");
   cmd->callback([args] { run_statics(*args); });

@@ -6,6 +6,7 @@
 #include <numeric>
 #include <random>
 
+#include "support/test_support.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
@@ -95,6 +96,63 @@ INSTANTIATE_TEST_SUITE_P(BothOptimizers, OptimizeTest,
                          [](const auto& info) {
                            return info.param == OptimizerKind::GaussNewton ? "GaussNewton" : "Lbfgs";
                          });
+
+}  // namespace
+}  // namespace shapectl
+
+namespace shapectl {
+namespace {
+
+// The same two properties on the bundled YuMi + foam bar scene.
+class YumiBar : public ::testing::Test {
+ protected:
+  Scene scene = load_scene(test::source_path("scenes/yumi_bar.json"));
+};
+
+TEST_F(YumiBar, ReachableTargetsAreReachedOverSeveralSeeds) {
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  const Evaluation reference = objective.evaluate(object.reference_joints(), object.reference_positions());
+  ASSERT_TRUE(reference.safe());
+  int tried = 0;
+  for (unsigned seed = 1; tried < 3; ++seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(-0.15, 0.15);
+    Eigen::VectorXd goal = reference.joints;
+    for (int j = 0; j < goal.size(); ++j) goal[j] += u(rng);
+    const Evaluation at_goal = objective.evaluate(goal, reference.positions);
+    if (!at_goal.safe()) continue;  // only collision-free, in-limit goals are reachable
+    ++tried;
+    objective.set_targets(targets_from_shape(at_goal.positions, 10 + 7 * tried, rng));
+    Evaluation start = reference;
+    objective.rescore(start);
+    GaussNewton optimizer;
+    const OptimizeResult result = optimize(objective, optimizer, start, {.max_iterations = 50});
+    EXPECT_LT(result.best.error.mean, 1e-3) << "seed " << seed << ": " << result.reason;
+    EXPECT_TRUE(result.best.safe());
+  }
+}
+
+TEST_F(YumiBar, TargetsPullingTheGrippersThroughEachOtherEndCollisionFree) {
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  const Positions x0 = object.reference_positions();
+  ShapeTargets t;
+  for (int e = 0; e < 2; ++e)
+    for (int i : scene.grips[e].nodes) {
+      t.nodes.push_back(i);
+      t.positions.push_back(x0.segment<3>(3 * i) + Vec3(0, e == 0 ? -0.45 : 0.45, 0));
+    }
+  objective.set_targets(t);
+  const Evaluation start = objective.evaluate(object.reference_joints(), x0);
+  ASSERT_TRUE(start.safe());
+  GaussNewton optimizer;
+  const OptimizeResult result = optimize(objective, optimizer, start, {.max_iterations = 25});
+  EXPECT_GE(result.best.min_clearance, 0.0);
+  EXPECT_TRUE(result.best.within_limits);
+  EXPECT_LT(result.best.error.mean, start.error.mean);
+  EXPECT_GT(result.best.error.mean, 0.1);  // the ends cannot pass each other
+}
 
 }  // namespace
 }  // namespace shapectl

@@ -22,9 +22,10 @@ bool acceptable(const Evaluation& trial, const Evaluation& current, double requi
   return trial.objective < required_objective;
 }
 
-// Relative decrease too small to matter: stop instead of polishing round-off.
+// A decrease too small to matter (relative 1e-6, or an objective below 1e-16 m², i.e. errors
+// of nanometres): stop instead of polishing round-off.
 bool negligible(double before, double after) {
-  return before - after <= 1e-12 * std::abs(before) + 1e-18;
+  return before - after <= 1e-6 * std::abs(before) || after <= 1e-16;
 }
 }  // namespace
 
@@ -42,24 +43,30 @@ StepOutcome GaussNewton::step(ReducedObjective& objective, Evaluation& current) 
   const Eigen::VectorXd g = J.transpose() * r;
   if (g.cwiseAbs().maxCoeff() <= 1e-14 + 1e-10 * r.squaredNorm()) return StepOutcome::Converged;
   const Eigen::MatrixXd A = J.transpose() * J;
-  const Eigen::VectorXd scaling = A.diagonal().cwiseMax(1e-12 * A.diagonal().maxCoeff() + 1e-18);
-  for (int attempt = 0; attempt < 10; ++attempt) {
+  // Damping λ·max(diag JᵀJ)·I, not Marquardt's diag(JᵀJ): a 7-joint arm has self-motions
+  // that barely move the object, and scaling by their tiny diagonal would let them run away.
+  const double scale = std::max(A.diagonal().maxCoeff(), 1e-18);
+  for (int attempt = 0; attempt < 12; ++attempt) {
     Eigen::MatrixXd damped = A;
-    damped.diagonal() += damping_ * scaling;
+    damped.diagonal().array() += damping_ * scale;
     Eigen::VectorXd delta = damped.ldlt().solve(-g);
     const double largest = delta.cwiseAbs().maxCoeff();
-    if (largest > max_step) delta *= max_step / largest;
     if (largest < 1e-12) return StepOutcome::Converged;
+    if (largest > max_step) delta *= max_step / largest;
     const Eigen::VectorXd theta = current.joints + delta;
     const Evaluation trial =
         evaluate_predicted(objective, theta, current.positions, current.positions + dx * delta);
+    const double predicted = current.objective - 0.5 * (r + J * delta).squaredNorm();
     if (acceptable(trial, current, current.objective)) {
+      // Gain ratio: how well the linear model predicted the decrease.
+      const double gain = (current.objective - trial.objective) / std::max(predicted, 1e-300);
       const bool tiny = negligible(current.objective, trial.objective);
       current = trial;
-      damping_ = std::max(damping_ / 4, 1e-9);
+      if (gain > 0.75) damping_ = std::max(damping_ / 3, 1e-9);
+      else if (gain < 0.25) damping_ *= 2;
       return tiny ? StepOutcome::Converged : StepOutcome::Improved;
     }
-    damping_ = std::max(damping_ * 8, 1e-6);
+    damping_ = std::min(damping_ * 4, 1e6);
   }
   return StepOutcome::Stuck;
 }

@@ -35,11 +35,11 @@ class GaussNewton : public Optimizer {
  public:
   std::string name() const override { return "gauss-newton"; }
   StepOutcome step(ReducedObjective& objective, Evaluation& current) override;
-  void reset() override { damping_ = 1e-6; }
+  void reset() override { damping_ = 1e-4; }
   double max_step = 0.5;  // rad, largest joint change per trial
 
  private:
-  double damping_ = 1e-6;
+  double damping_ = 1e-4;  // λ, relative to the largest diagonal entry of JᵀJ
 };
 
 // L-BFGS with a backtracking (Armijo) line search, as in the paper.

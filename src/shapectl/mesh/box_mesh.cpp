@@ -7,7 +7,8 @@
 
 namespace shapectl {
 
-TetMesh make_box_mesh(const Vec3& size, const std::array<int, 3>& cells) {
+TetMesh make_box_mesh(const Vec3& size, const std::array<int, 3>& cells,
+                      const std::optional<BoxHole>& hole) {
   static const char* axis_names[3] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {
     if (!(std::isfinite(size[a]) && size[a] > 0))
@@ -40,13 +41,30 @@ TetMesh make_box_mesh(const Vec3& size, const std::array<int, 3>& cells) {
   tets.reserve(6 * static_cast<std::size_t>(nx) * ny * nz);
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
+      for (int i = 0; i < nx; ++i) {
+        const Vec3 centre = 0.5 * (rest_positions[index(i, j, k)] + rest_positions[index(i + 1, j + 1, k + 1)]);
+        if (hole && (centre - hole->min).minCoeff() > 0 && (hole->max - centre).minCoeff() > 0) continue;
         for (const auto& tet : kuhn) {
           std::array<int, 4> t;
           for (int a = 0; a < 4; ++a)
             t[a] = index(i + (tet[a] & 1), j + ((tet[a] >> 1) & 1), k + ((tet[a] >> 2) & 1));
           tets.push_back(t);
         }
+      }
+  if (hole) {  // drop the nodes only the removed cells used, keeping the others' order
+    std::vector<int> renumber(rest_positions.size(), -1);
+    for (const auto& t : tets)
+      for (int a : t) renumber[a] = 0;
+    std::vector<Vec3> kept;
+    for (std::size_t i = 0; i < rest_positions.size(); ++i)
+      if (renumber[i] == 0) {
+        renumber[i] = static_cast<int>(kept.size());
+        kept.push_back(rest_positions[i]);
+      }
+    for (auto& t : tets)
+      for (int& a : t) a = renumber[a];
+    rest_positions = std::move(kept);
+  }
   return TetMesh(std::move(rest_positions), std::move(tets), "box mesh");
 }
 

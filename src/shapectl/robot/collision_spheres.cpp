@@ -4,8 +4,6 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
-#include <numeric>
-#include <set>
 
 namespace shapectl {
 
@@ -68,15 +66,19 @@ CollisionModel::CollisionModel(const RobotModel& robot, std::vector<CollisionSph
     r.first = s;
   }
   const auto checked = checked_link_pairs(robot, ignore_pairs);
-  for (int a = 0; a < static_cast<int>(spheres_.size()); ++a) {
-    const auto link_a = static_cast<std::size_t>(spheres_[static_cast<std::size_t>(a)].link);
+  for (std::size_t link_a = 0; link_a < range.size(); ++link_a) {
     for (std::size_t link_b = link_a + 1; link_b < range.size(); ++link_b) {
-      const auto [begin, end] = range[link_b];
-      if (begin == end || !checked[link_a][link_b]) continue;
-      blocks_.push_back({a, begin, end});
-      for (int b = begin; b < end; ++b) {
-        pairs_.emplace_back(a, b);
-        reach_.push_back(radii_[static_cast<std::size_t>(a)] + radii_[static_cast<std::size_t>(b)] + margin_);
+      auto outer = range[link_a];
+      auto inner = range[link_b];
+      if (outer.first == outer.second || inner.first == inner.second || !checked[link_a][link_b]) continue;
+      // The link with more spheres forms the inner loop, which is the one that vectorises.
+      if (outer.second - outer.first > inner.second - inner.first) std::swap(outer, inner);
+      for (int a = outer.first; a < outer.second; ++a) {
+        blocks_.push_back({a, inner.first, inner.second});
+        for (int b = inner.first; b < inner.second; ++b) {
+          pairs_.emplace_back(a, b);
+          reach_.push_back(radii_[static_cast<std::size_t>(a)] + radii_[static_cast<std::size_t>(b)] + margin_);
+        }
       }
     }
   }

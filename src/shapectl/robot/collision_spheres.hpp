@@ -49,7 +49,7 @@ class CollisionModel {
 
   // Grouped by link, in link order (a stable sort of the input).
   const std::vector<CollisionSphere>& spheres() const { return spheres_; }
-  // Checked pairs, as sphere indices (first < second).
+  // Checked pairs, as sphere indices.
   const std::vector<std::pair<int, int>>& pairs() const { return pairs_; }
   int pair_count() const { return static_cast<int>(pairs_.size()); }
   double margin() const { return margin_; }

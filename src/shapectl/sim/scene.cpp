@@ -69,7 +69,7 @@ std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j) {
   if (j.has("box")) {
     j.expect_only({"box"});
     const JsonInput box = j.at("box");
-    box.expect_only({"size", "cells"});
+    box.expect_only({"size", "cells", "hole"});
     const Vec3 size = box.at("size").vec3();
     for (int k = 0; k < 3; ++k)
       if (!(size[k] > 0)) box.at("size").at(k).fail("a positive number");
@@ -77,7 +77,12 @@ std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j) {
     if (cells.size() != 3) cells.fail("an array of 3 whole numbers");
     std::array<int, 3> n{};
     for (int k = 0; k < 3; ++k) n[k] = static_cast<int>(cells.at(k).integer_in(1, 1000));
-    return std::make_shared<const TetMesh>(make_box_mesh(size, n));
+    std::optional<BoxHole> hole;
+    if (box.has("hole")) {
+      const AlignedBox b = read_box(box.at("hole"));
+      hole = BoxHole{b.min, b.max};
+    }
+    return std::make_shared<const TetMesh>(make_box_mesh(size, n, hole));
   }
   j.expect_only({"file", "max_radius_edge_ratio", "max_tet_volume", "keep_surface"});
   SurfaceMeshOptions options;

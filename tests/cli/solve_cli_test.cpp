@@ -1,0 +1,103 @@
+// The `shapectl solve` and robot `statics` contracts on the bundled YuMi scenes.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "support/test_support.hpp"
+
+namespace shapectl {
+namespace {
+
+using test::run_cli;
+using test::TempDir;
+
+const std::string kBar = test::source_path("scenes/yumi_bar.json").string();
+const std::string kFrame = test::source_path("scenes/yumi_frame.json").string();
+
+nlohmann::json run_json(const std::vector<std::string>& args, const std::filesystem::path& out) {
+  const auto run = run_cli(args);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return nlohmann::json::parse(test::read_text(out));
+}
+
+TEST(SolveCli, ReachesTargetsTakenFromAnotherConfiguration) {
+  TempDir dir;
+  // The shape at other joint angles (read back from `statics --joints`)...
+  const auto reference = run_json({"statics", kBar, "--out", (dir.path() / "ref.json").string()}, dir.path() / "ref.json");
+  nlohmann::json joints = reference["joints"];
+  joints["yumi_joint_1_l"] = joints["yumi_joint_1_l"].get<double>() + 0.12;
+  joints["yumi_joint_2_r"] = joints["yumi_joint_2_r"].get<double>() - 0.1;
+  joints["yumi_joint_6_l"] = joints["yumi_joint_6_l"].get<double>() + 0.2;
+  const auto joints_file = dir.write("joints.json", nlohmann::json{{"joints", joints}}.dump());
+  const auto goal = run_json({"statics", kBar, "--joints", joints_file.string(), "--out",
+                              (dir.path() / "goal.json").string()}, dir.path() / "goal.json");
+  ASSERT_TRUE(goal["converged"].get<bool>());
+  EXPECT_EQ(goal["tools"].size(), 2u);
+  // ... gives targets for every 17th node.
+  nlohmann::json targets = nlohmann::json::array();
+  for (int i = 0; i < 425; i += 17) targets.push_back({{"node", i}, {"position", goal["positions"][i]}});
+  const auto targets_file = dir.write("targets.json", nlohmann::json{{"targets", targets}}.dump());
+  const auto out = dir.path() / "solve.json";
+  const auto result = run_json({"solve", kBar, "--targets", targets_file.string(), "--out", out.string()}, out);
+  EXPECT_LT(result["error_mean"].get<double>(), 1e-3);
+  EXPECT_GE(result["min_clearance"].get<double>(), 0.0);
+  EXPECT_TRUE(result["limit_violations"].empty());
+  EXPECT_EQ(result["joints"].size(), 14u);
+  EXPECT_EQ(result["positions"].size(), 425u);
+  EXPECT_GE(result["history"].size(), 2u);
+  EXPECT_GT(result["history"][0]["error_mean"].get<double>(), 3e-3);
+  EXPECT_GT(result["timing"]["statics_solves"].get<int>(), 0);
+  EXPECT_GT(result["timing"]["gradient_seconds"].get<double>(), 0);
+}
+
+TEST(SolveCli, CentreLineIsFollowedOnTheBar) {
+  TempDir dir;
+  // A gentle arc through the bar's current ends (y = ±0.16), bulging up by 3 cm.
+  nlohmann::json line = nlohmann::json::array();
+  for (int k = 0; k <= 10; ++k) {
+    const double t = k / 10.0, y = 0.16 - 0.32 * t;
+    line.push_back({0.3905, y, 0.2553 + 0.03 * std::sin(M_PI * t)});
+  }
+  const auto targets = dir.write("line.json", nlohmann::json{{"centerline", line}}.dump());
+  const auto out = dir.path() / "solve.json";
+  const auto result = run_json({"solve", kBar, "--targets", targets.string(), "--out", out.string(),
+                                "--max-iterations", "30"}, out);
+  EXPECT_LT(result["error_mean"].get<double>(), result["history"][0]["error_mean"].get<double>() / 3);
+  EXPECT_GE(result["targets"].size(), 10u);
+}
+
+TEST(SolveCli, BadTargetsAreBadInput) {
+  TempDir dir;
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {R"({"targets": [{"node": 425, "position": [0, 0, 0]}]})", "targets[0].node: expected a whole number from 0 to 424"},
+      {R"({"targets": []})", "targets: expected a non-empty list of targets"},
+      {R"({"targets": [{"node": 1, "position": [0, 0]}]})", "targets[0].position: expected an array of 3 numbers"},
+      {R"({"centerline": [[0, 0, 0]]})", "centerline: expected a polyline of at least 2 distinct points"},
+      {R"({"target": []})", "target: unknown key"},
+  };
+  for (const auto& [text, message] : cases) {
+    const auto file = dir.write("bad.json", text);
+    const auto run = run_cli({"solve", kBar, "--targets", file.string(), "--out", (dir.path() / "r.json").string()});
+    EXPECT_EQ(run.exit_code, 1) << text;
+    EXPECT_NE(run.err.find("bad.json: " + message), std::string::npos) << run.err;
+  }
+}
+
+TEST(SolveCli, CentreLineOnAnObjectThatIsNotBarLikeIsBadInput) {
+  TempDir dir;
+  const auto file = dir.write("line.json", R"({"centerline": [[0.3, 0, 0.3], [0.4, 0, 0.3]]})");
+  const auto run = run_cli({"solve", kFrame, "--targets", file.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("line.json: centerline: expected an object that is bar-like"), std::string::npos) << run.err;
+}
+
+TEST(StaticsCli, UnknownJointInJointsFileIsNamed) {
+  TempDir dir;
+  const auto file = dir.write("j.json", R"({"joints": {"yumi_joint_9_l": 0.1}})");
+  const auto run = run_cli({"statics", kBar, "--joints", file.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("j.json: joints.yumi_joint_9_l: not an active joint"), std::string::npos) << run.err;
+}
+
+}  // namespace
+}  // namespace shapectl
