@@ -20,6 +20,8 @@ const char* to_string(StaticsStatus status);
 struct StaticsOptions {
   double force_tolerance = 1e-6;  // N: converged when every free node's force is below this
   int max_iterations = 100;
+  // Try a step with the last true-Hessian factorization before factoring anew (see newton()).
+  bool chord_steps = true;
   // Which sparse Cholesky; by default chosen by system size (SparseCholesky::choose).
   std::optional<SparseCholesky::Backend> backend;
 };
@@ -31,6 +33,7 @@ struct NewtonIterate {
   double step = 0;           // largest nodal displacement of the accepted step, m
   double step_length = 0;    // line-search factor α
   bool projected = false;    // the PSD-projected Hessian was used
+  bool chord = false;        // an earlier factorization was reused (no new one)
 };
 
 struct StaticsResult {
@@ -57,9 +60,9 @@ class StaticsSolver {
   Eigen::VectorXd gradient(const Positions& x) const;
   // Solves H(x) Y = rhs with the true Hessian at x, rows of fixed dofs zero. Reuses the
   // factorization when it is of the true Hessian at exactly this x, or — when x is the result
-  // of the last solve and `stale_step` > 0 — at the start of that solve's last Newton step,
-  // provided that step moved no node more than `stale_step` metres (an error of that order
-  // in H; it saves a factorization per optimizer iteration).
+  // of the last solve and `stale_step` > 0 — at a state from which no node of x is more than
+  // `stale_step` metres away (an error of that order in H; it saves a factorization per
+  // optimizer iteration).
   Eigen::MatrixXd solve_hessian(const Positions& x, const Eigen::MatrixXd& rhs,
                                 double stale_step = 0);
   // The true Hessian at x, lower triangle, fixed dofs eliminated (for tests and tools).
