@@ -147,7 +147,7 @@ TEST_F(YumiBar, TargetsPullingTheGrippersThroughEachOtherEndCollisionFree) {
   const Evaluation start = objective.evaluate(object.reference_joints(), x0);
   ASSERT_TRUE(start.safe());
   GaussNewton optimizer;
-  const OptimizeResult result = optimize(objective, optimizer, start, {.max_iterations = 25});
+  const OptimizeResult result = optimize(objective, optimizer, start, {.max_iterations = 12});
   EXPECT_GE(result.best.min_clearance, 0.0);
   EXPECT_TRUE(result.best.within_limits);
   EXPECT_LT(result.best.error.mean, start.error.mean);

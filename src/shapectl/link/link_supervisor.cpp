@@ -62,7 +62,10 @@ Eigen::VectorXd LinkSupervisor::full_commanded() const {
   return full;
 }
 
-std::string LinkSupervisor::unsafe_reason(const Eigen::VectorXd& joints, bool safe) const {
+std::string LinkSupervisor::target_problem(const Eigen::VectorXd& joints, bool safe) const {
+  if (joints.size() != limits_.size())
+    return "target has " + std::to_string(joints.size()) + " joints, expected " +
+           std::to_string(limits_.size());
   for (Eigen::Index i = 0; i < joints.size(); ++i)
     if (!std::isfinite(joints[i]))
       return "target for " + joint_names_[static_cast<std::size_t>(i)] + " is not finite";
@@ -77,9 +80,7 @@ std::string LinkSupervisor::unsafe_reason(const Eigen::VectorXd& joints, bool sa
   return {};
 }
 
-bool LinkSupervisor::set_target(const Eigen::VectorXd& joints, bool safe) {
-  assert(joints.size() == limits_.size());
-  const std::string why = unsafe_reason(joints, safe);
+bool LinkSupervisor::set_target(const Eigen::VectorXd& joints, const std::string& why) {
   if (!why.empty()) {
     if (target_problem_.empty() || armed_) log("target_rejected", {{"reason", why}});
     target_problem_ = why;
@@ -88,6 +89,7 @@ bool LinkSupervisor::set_target(const Eigen::VectorXd& joints, bool safe) {
     return false;
   }
   if (!target_problem_.empty() && !armed_) reason_ = "not armed";
+  assert(joints.size() == limits_.size());
   target_problem_.clear();
   has_target_ = true;
   target_ = joints.cwiseMax(limits_.lower).cwiseMin(limits_.upper);

@@ -55,8 +55,12 @@ class LinkSupervisor {
   const std::vector<LinkChannel>& channels() const { return channels_; }
   const GovernorLimits& limits() const { return limits_; }
 
-  // The optimizer's θ (full, active-joint order). Returns false (and disarms) when unsafe.
-  bool set_target(const Eigen::VectorXd& joints, bool safe);
+  // Why the optimizer's θ (full, active-joint order) must not be commanded; empty when it may.
+  // Const and free of shared state (the pose check may be slow): call it outside any lock.
+  std::string target_problem(const Eigen::VectorXd& joints, bool safe) const;
+  // Takes θ as the target when `problem` (from target_problem) is empty, else refuses it and
+  // disarms. Returns whether it was taken.
+  bool set_target(const Eigen::VectorXd& joints, const std::string& problem);
   bool arm(double now, std::string* why_not);
   void disarm(const std::string& reason);
 
@@ -84,7 +88,6 @@ class LinkSupervisor {
     std::string fault;
   };
   void log(std::string_view event, const nlohmann::json& fields) const;
-  std::string unsafe_reason(const Eigen::VectorXd& joints, bool safe) const;
   Eigen::VectorXd channel_part(const Eigen::VectorXd& full, const Channel& c) const;
   Eigen::VectorXd full_commanded() const;
 

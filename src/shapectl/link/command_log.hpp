@@ -1,0 +1,42 @@
+#pragma once
+// What links write to a SessionLog, and the check of a whole log against the limits it states.
+//
+//   {"event":"link","kind":"egm","joint_names":[..],"channels":[{"name":"left","joints":[..]}],
+//    "period":0.004,"lower":[..],"upper":[..],"velocity":[..],"acceleration":[..]}
+//   {"event":"command","channel":"left","seq":17,"joints":[..],"measured":[..]}   (rad)
+//   {"event":"connect"|"feedback_lost"|"arm"|"disarm"|"arm_refused"|"target_rejected", ..}
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include <shapectl/io/session_log.hpp>
+#include <shapectl/link/link_supervisor.hpp>
+
+namespace shapectl {
+
+void log_link_started(SessionLog& log, const std::string& kind,
+                      const std::vector<std::string>& joint_names,
+                      const std::vector<LinkChannel>& channels, const GovernorLimits& limits,
+                      double period);
+void log_command(SessionLog& log, const std::string& channel, std::uint64_t seq,
+                 const Eigen::VectorXd& joints, const Eigen::VectorXd& measured);
+
+struct CommandLogCheck {
+  int links = 0;     // "link" events (a log may hold several sessions)
+  int commands = 0;  // "command" events checked
+  // Largest |Δq|/(v·dt) and |Δ²q|/(a·dt²) seen: ≤ 1 means within the limits.
+  double velocity_ratio = 0;
+  double acceleration_ratio = 0;
+  std::vector<std::string> violations;  // "log.jsonl:120: left joint 3: ..." (first 20)
+  bool ok() const { return violations.empty(); }
+};
+
+// Checks every command of every channel: velocity and acceleration within the limits of the
+// "link" event before it (consecutive commands are dt apart), and position inside the band
+// unless holding still. A "connect" event restarts that channel's sequence (the governor
+// is reset to the measured position then).
+CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
+                                  const std::string& source);
+
+}  // namespace shapectl

@@ -1,0 +1,218 @@
+#include <shapectl/link/egm_link.hpp>
+
+#include <poll.h>
+
+#include <algorithm>
+#include <array>
+#include <regex>
+
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/io/session_log.hpp>
+#include <shapectl/link/command_log.hpp>
+#include <shapectl/robot/robot_model.hpp>
+
+namespace shapectl {
+
+namespace {
+
+constexpr std::size_t latency_capacity = 65536;
+constexpr int max_logged_rejections = 20;
+// ABB axis numbers in chain order.
+constexpr std::array<int, 7> chain_axes = {1, 2, 7, 3, 4, 5, 6};
+
+Eigen::VectorXd to_vector(const ArmJoints& q) { return q; }
+
+}  // namespace
+
+std::vector<LinkChannel> egm_arm_channels(const RobotModel& robot) {
+  const std::string where = robot.source() + ": robot '" + robot.name() + "'";
+  const std::regex pattern("yumi_joint_([1-7])_([lr])");
+  std::array<std::array<int, 7>, 2> index;  // [arm][chain position] → θ index, -1 when absent
+  for (auto& arm : index) arm.fill(-1);
+  const auto names = robot.active_joint_names();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    std::smatch m;
+    if (!std::regex_match(names[i], m, pattern))
+      throw InputError(where, "active joint '" + names[i] + "'",
+                       "egm streams YuMi arms only: expected yumi_joint_<1..7>_<l|r>");
+    const int arm = m[2] == "l" ? 0 : 1;
+    const int axis = std::stoi(m[1]);
+    const auto pos = std::find(chain_axes.begin(), chain_axes.end(), axis) - chain_axes.begin();
+    index[arm][static_cast<std::size_t>(pos)] = static_cast<int>(i);
+  }
+  std::vector<LinkChannel> channels;
+  const char* arm_names[2] = {"left", "right"};
+  const char* suffix[2] = {"l", "r"};
+  for (int arm = 0; arm < 2; ++arm) {
+    const auto& ix = index[static_cast<std::size_t>(arm)];
+    const auto present = std::count_if(ix.begin(), ix.end(), [](int i) { return i >= 0; });
+    if (present == 0) continue;
+    if (present < 7) {
+      std::string missing;
+      for (std::size_t p = 0; p < 7; ++p)
+        if (ix[p] < 0)
+          missing += (missing.empty() ? "" : ", ") + std::string("yumi_joint_") +
+                     std::to_string(chain_axes[p]) + "_" + suffix[arm];
+      throw InputError(where, std::string(arm_names[arm]) + " arm",
+                       "egm commands whole arms: all 7 joints must be active; missing " + missing);
+    }
+    channels.push_back({arm_names[arm], std::vector<int>(ix.begin(), ix.end())});
+  }
+  if (channels.empty()) throw InputError(where, "", "egm needs active YuMi arm joints; none are");
+  return channels;
+}
+
+EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck check,
+                 std::shared_ptr<SessionLog> log)
+    : period_(config.egm_period),
+      log_(std::move(log)),
+      start_(std::chrono::steady_clock::now()),
+      buffer_(EgmCodec::max_datagram + 1),
+      supervisor_("egm", robot.active_joint_names(), egm_arm_channels(robot), robot.lower_limits(),
+                  robot.upper_limits(), governor_limits(config, robot),
+                  {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance},
+                  std::move(check), log_.get()) {
+  for (const auto& c : supervisor_.channels()) {
+    const int port = c.name == "left" ? config.egm_left_port : config.egm_right_port;
+    sockets_.emplace_back(config.egm_address, port, "egm " + c.name + " port");
+  }
+  next_seqno_.assign(sockets_.size(), 1);
+  last_robot_seqno_.assign(sockets_.size(), -1);
+  latency_us_.reserve(latency_capacity);
+  if (log_)
+    log_link_started(*log_, "egm", robot.active_joint_names(), supervisor_.channels(),
+                     supervisor_.limits(), period_);
+}
+
+EgmLink::~EgmLink() { stop(); }
+
+double EgmLink::now() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+}
+
+void EgmLink::start() {
+  if (!thread_.joinable()) thread_ = std::jthread([this](std::stop_token s) { run(s); });
+}
+
+void EgmLink::stop() {
+  if (!thread_.joinable()) return;
+  thread_.request_stop();
+  thread_.join();
+}
+
+void EgmLink::run(std::stop_token stop) {
+  std::vector<pollfd> fds;
+  for (const auto& s : sockets_) fds.push_back({s.fd(), POLLIN, 0});
+  // Wake at least every millisecond for the watchdog and for stop requests.
+  constexpr int poll_timeout_ms = 1;
+  while (!stop.stop_requested()) {
+    ::poll(fds.data(), fds.size(), poll_timeout_ms);
+    for (std::size_t c = 0; c < sockets_.size(); ++c) {
+      if (!(fds[c].revents & POLLIN)) continue;
+      sockaddr_in from{};
+      long n;
+      while ((n = sockets_[c].receive(buffer_, &from)) >= 0)
+        handle_datagram(static_cast<int>(c),
+                        std::string_view(buffer_.data(), static_cast<std::size_t>(
+                                                             std::min<long>(n, static_cast<long>(buffer_.size())))),
+                        from, std::chrono::steady_clock::now());
+    }
+    std::lock_guard lock(mutex_);
+    supervisor_.check_watchdog(now());
+  }
+}
+
+void EgmLink::handle_datagram(int channel, std::string_view datagram, const sockaddr_in& from,
+                              std::chrono::steady_clock::time_point arrived) {
+  const auto c = static_cast<std::size_t>(channel);
+  EgmFeedback feedback;
+  std::string_view why;
+  // A datagram that filled the whole buffer was at least one byte too long: the codec sees
+  // it as oversized.
+  if (!codec_.decode_robot(datagram, feedback, &why)) {
+    std::uint64_t count;
+    {
+      std::lock_guard lock(mutex_);
+      count = ++rejected_;
+    }
+    if (log_ && count <= max_logged_rejections)
+      log_->write("datagram_rejected", {{"channel", supervisor_.channels()[c].name},
+                                         {"bytes", datagram.size()},
+                                         {"reason", why}});
+    return;
+  }
+  EgmCommand command;
+  Eigen::VectorXd measured = to_vector(feedback.joints);
+  {
+    std::lock_guard lock(mutex_);
+    if (last_robot_seqno_[c] >= 0) {
+      const std::uint32_t gap = feedback.seqno - static_cast<std::uint32_t>(last_robot_seqno_[c]);
+      if (gap > 1 && gap < 1000) lost_ += gap - 1;
+    }
+    last_robot_seqno_[c] = feedback.seqno;
+    supervisor_.on_feedback(channel, measured, feedback.fault(), now(), period_);
+    command.joints = supervisor_.command(channel);
+    command.velocity = supervisor_.command_velocity(channel);
+    command.seqno = next_seqno_[c]++;
+    command.tm = static_cast<std::uint32_t>(now() * 1000);
+  }
+  const std::string_view bytes = codec_.encode_sensor(command);
+  const bool sent = !bytes.empty() && sockets_[c].send_to(bytes, from);
+  const auto done = std::chrono::steady_clock::now();
+  const float us = std::chrono::duration<float, std::micro>(done - arrived).count();
+  std::uint64_t seq;
+  {
+    std::lock_guard lock(mutex_);
+    if (latency_us_.size() < latency_capacity) latency_us_.push_back(us);
+    else latency_us_[latency_next_] = us;
+    latency_next_ = (latency_next_ + 1) % latency_capacity;
+    if (bytes.empty()) supervisor_.disarm("internal: non-finite command not sent");
+    if (sent) ++commands_sent_;
+    seq = command.seqno;
+  }
+  if (log_ && sent) log_command(*log_, supervisor_.channels()[c].name, seq, command.joints, measured);
+}
+
+void EgmLink::set_target(const Eigen::VectorXd& joints, bool safe) {
+  const std::string problem = supervisor_.target_problem(joints, safe);
+  std::lock_guard lock(mutex_);
+  supervisor_.set_target(joints, problem);
+}
+
+bool EgmLink::arm(std::string* why_not) {
+  std::lock_guard lock(mutex_);
+  return supervisor_.arm(now(), why_not);
+}
+
+void EgmLink::disarm(const std::string& reason) {
+  std::lock_guard lock(mutex_);
+  supervisor_.disarm(reason);
+}
+
+LinkStatus EgmLink::status() const {
+  std::lock_guard lock(mutex_);
+  LinkStatus s = supervisor_.status(now());
+  s.commands_sent = commands_sent_;
+  s.rejected_datagrams = rejected_;
+  s.lost_datagrams = lost_;
+  return s;
+}
+
+LatencyStats EgmLink::latency() const {
+  std::vector<float> samples;
+  {
+    std::lock_guard lock(mutex_);
+    samples = latency_us_;
+  }
+  LatencyStats s;
+  s.samples = samples.size();
+  if (samples.empty()) return s;
+  std::sort(samples.begin(), samples.end());
+  auto at = [&](double q) { return samples[static_cast<std::size_t>(q * (samples.size() - 1))]; };
+  s.median_us = at(0.5);
+  s.p99_us = at(0.99);
+  s.max_us = samples.back();
+  return s;
+}
+
+}  // namespace shapectl

@@ -1,0 +1,133 @@
+#include <shapectl/link/egm_simulator.hpp>
+
+#include <array>
+#include <chrono>
+
+namespace shapectl {
+
+struct EgmSimulator::Arm {
+  std::optional<UdpSocket> socket;
+  sockaddr_in sensor{};
+  SimRobot robot;
+  EgmSimArmStats stats;
+  std::uint32_t seqno = 0;
+  std::vector<ArmJoints> recent;  // up to two previous commands, for the checks
+  bool resumed = false;
+};
+
+GovernorLimits yumi_arm_limits(double acceleration) {
+  // Axes 1, 2, 7, 3: 180 deg/s; 4, 5, 6: 400 deg/s.
+  GovernorLimits g;
+  g.lower.resize(7), g.upper.resize(7), g.velocity.resize(7);
+  g.lower << -2.94087978961, -2.50454747661, -2.94087978961, -2.15548162621, -5.06145483078,
+      -1.53588974176, -3.99680398707;
+  g.upper << 2.94087978961, 0.759218224618, 2.94087978961, 1.3962634016, 5.06145483078,
+      2.40855436775, 3.99680398707;
+  g.velocity << 3.14159265359, 3.14159265359, 3.14159265359, 3.14159265359, 6.98131700798,
+      6.98131700798, 6.98131700798;
+  g.acceleration = Eigen::VectorXd::Constant(7, acceleration);
+  return g;
+}
+
+EgmSimulator::EgmSimulator(EgmSimulatorConfig config) : config_(std::move(config)) {
+  const std::array<int, 2> ports = {config_.left_port, config_.right_port};
+  const std::array<ArmJoints, 2> initial = {config_.left_initial, config_.right_initial};
+  for (int a = 0; a < 2; ++a) {
+    auto arm = std::make_unique<Arm>(Arm{std::nullopt, {},
+                                         SimRobot(yumi_arm_limits(config_.acceleration), initial[a]),
+                                         {}, 0, {}, false});
+    if (ports[a] > 0) {
+      arm->sensor = ipv4_address(config_.sensor_address, ports[a], "egm-sim sensor address");
+      arm->socket.emplace("0.0.0.0", 0, "egm-sim");
+      arm->stats.present = true;
+    }
+    arm->stats.position = initial[a];
+    arms_.push_back(std::move(arm));
+  }
+}
+
+EgmSimulator::~EgmSimulator() { stop(); }
+
+void EgmSimulator::start() {
+  if (!thread_.joinable()) thread_ = std::jthread([this](std::stop_token s) { run(s); });
+}
+
+void EgmSimulator::stop() {
+  if (!thread_.joinable()) return;
+  thread_.request_stop();
+  thread_.join();
+}
+
+void EgmSimulator::set_paused(bool paused) { paused_ = paused; }
+
+EgmSimArmStats EgmSimulator::stats(int arm) const {
+  std::lock_guard lock(mutex_);
+  return arms_[static_cast<std::size_t>(arm)]->stats;
+}
+
+void EgmSimulator::run(std::stop_token stop) {
+  const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(config_.period));
+  const auto start = std::chrono::steady_clock::now();
+  auto next = start;
+  bool was_paused = false;
+  while (!stop.stop_requested()) {
+    next += period;
+    std::this_thread::sleep_until(next);
+    const bool paused = paused_;
+    for (auto& arm : arms_) {
+      if (!arm->socket) continue;
+      if (was_paused && !paused) arm->resumed = true;
+      tick(*arm, paused);
+    }
+    was_paused = paused;
+  }
+}
+
+void EgmSimulator::tick(Arm& arm, bool paused) {
+  const GovernorLimits limits = yumi_arm_limits(config_.acceleration);
+  std::array<char, EgmCodec::max_datagram + 1> buffer;
+  // Replies to earlier feedback: the newest valid one is the arm's command.
+  long n;
+  while ((n = arm.socket->receive(buffer, nullptr)) >= 0) {
+    EgmCommand command;
+    const auto size = static_cast<std::size_t>(std::min<long>(n, static_cast<long>(buffer.size())));
+    std::lock_guard lock(mutex_);
+    if (!codec_.decode_sensor({buffer.data(), size}, command, nullptr)) {
+      ++arm.stats.rejected;
+      continue;
+    }
+    EgmSimArmStats& s = arm.stats;
+    ++s.commands;
+    s.last_command = command.joints;
+    const ArmJoints& q = command.joints;
+    if ((q.array() < limits.lower.array()).any() || (q.array() > limits.upper.array()).any())
+      ++s.outside_limits;
+    if (arm.resumed) arm.recent.clear(), arm.resumed = false;
+    const double dt = config_.period;
+    if (!arm.recent.empty())
+      s.max_speed = std::max(s.max_speed, (q - arm.recent.back()).cwiseAbs().maxCoeff() / dt);
+    if (arm.recent.size() == 2)
+      s.max_acceleration = std::max(
+          s.max_acceleration,
+          (q - 2 * arm.recent.back() + arm.recent.front()).cwiseAbs().maxCoeff() / (dt * dt));
+    if (arm.recent.size() == 2) arm.recent.erase(arm.recent.begin());
+    arm.recent.push_back(q);
+    arm.robot.command(q);
+  }
+  EgmFeedback feedback;
+  {
+    std::lock_guard lock(mutex_);
+    arm.robot.step(config_.period);
+    arm.stats.position = arm.robot.position();
+    feedback.joints = arm.stats.position;
+    if (paused) return;
+    feedback.seqno = ++arm.seqno;
+    feedback.tm = static_cast<std::uint32_t>(arm.seqno * config_.period * 1000);
+    feedback.motors_on = feedback.egm_running = feedback.rapid_running = true;
+    ++arm.stats.feedback_sent;
+  }
+  arm.socket->send_to(codec_.encode_robot(feedback), arm.sensor);
+}
+
+}  // namespace shapectl

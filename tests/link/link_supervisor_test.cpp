@@ -1,0 +1,176 @@
+// Arming, holding, watchdog and target checks, in simulated time.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <shapectl/link/link_supervisor.hpp>
+
+namespace shapectl {
+namespace {
+
+constexpr double dt = 0.004;
+
+GovernorLimits limits() {
+  return {Eigen::Vector2d(-1.9, -1.9), Eigen::Vector2d(1.9, 1.9), Eigen::Vector2d(0.5, 0.5),
+          Eigen::Vector2d(2.0, 2.0)};
+}
+
+// Two joints, two channels ("a" drives joint 0, "b" joint 1); joint limits ±2 rad.
+struct Fixture {
+  explicit Fixture(PoseCheck check = {})
+      : s("test", {"j0", "j1"}, {{"a", {0}}, {"b", {1}}}, Eigen::Vector2d(-2, -2),
+          Eigen::Vector2d(2, 2), limits(), {.watchdog_timeout = 0.1}, std::move(check)) {}
+  // One sample on both channels at time `t`, the robot exactly where commanded.
+  void tick(bool with_feedback = true) {
+    t += dt;
+    if (with_feedback)
+      for (int c = 0; c < 2; ++c) {
+        s.on_feedback(c, robot.segment(c, 1), "", t, dt);
+        robot[c] = s.command(c)[0];
+      }
+    s.check_watchdog(t);
+  }
+  bool target(const Eigen::VectorXd& q, bool safe = true) {
+    return s.set_target(q, s.target_problem(q, safe));
+  }
+  LinkSupervisor s;
+  Eigen::Vector2d robot{0.3, -0.2};
+  double t = 0;
+};
+
+TEST(LinkSupervisor, CommandsWhereTheRobotIsAndDoesNotMoveUntilArmed) {
+  Fixture f;
+  f.target(Eigen::Vector2d(1, 1));
+  for (int k = 0; k < 100; ++k) f.tick();
+  EXPECT_EQ(f.robot, Eigen::Vector2d(0.3, -0.2));
+  EXPECT_FALSE(f.s.status(f.t).armed);
+  EXPECT_EQ(f.s.status(f.t).reason, "not armed");
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  for (int k = 0; k < 2000; ++k) f.tick();
+  EXPECT_EQ(f.robot, Eigen::Vector2d(1, 1));
+  EXPECT_TRUE(f.s.status(f.t).arrived);
+}
+
+TEST(LinkSupervisor, ArmingNeedsFeedbackOnEveryChannel) {
+  Fixture f;
+  std::string why;
+  EXPECT_FALSE(f.s.arm(0, &why));
+  EXPECT_EQ(why, "a: no feedback");
+  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.0), "", 0.001, dt);
+  EXPECT_FALSE(f.s.arm(0.001, &why));
+  EXPECT_EQ(why, "b: no feedback");
+}
+
+TEST(LinkSupervisor, UnsafeTargetsDisarmWithTheirReason) {
+  struct Case {
+    Eigen::VectorXd target;
+    bool safe;
+    std::string reason;
+  };
+  const std::vector<Case> cases = {
+      {Eigen::Vector2d(NAN, 0), true, "target for j0 is not finite"},
+      {Eigen::Vector2d(INFINITY, 0), true, "target for j0 is not finite"},
+      {Eigen::Vector2d(0.5, 0.5), false, "optimizer marked the target unsafe (collision or limits)"},
+      {Eigen::Vector2d(0.5, 2.5), true, "target for j1 (2.5 rad) is outside its limits [-2, 2]"},
+      {Eigen::Vector3d(0, 0, 0), true, "target has 3 joints, expected 2"},
+  };
+  for (const auto& c : cases) {
+    Fixture f;
+    f.target(Eigen::Vector2d(1, 1));
+    f.tick();
+    ASSERT_TRUE(f.s.arm(f.t, nullptr));
+    for (int k = 0; k < 50; ++k) f.tick();
+    EXPECT_FALSE(f.target(c.target, c.safe));
+    const LinkStatus st = f.s.status(f.t);
+    EXPECT_FALSE(st.armed);
+    EXPECT_EQ(st.reason, c.reason);
+    // It brakes to a halt and holds; arming again is refused until a safe target comes.
+    for (int k = 0; k < 200; ++k) f.tick();
+    const Eigen::Vector2d held = f.robot;
+    for (int k = 0; k < 50; ++k) f.tick();
+    EXPECT_EQ(f.robot, held);
+    std::string why;
+    EXPECT_FALSE(f.s.arm(f.t, &why));
+    EXPECT_EQ(why, c.reason);
+    f.target(Eigen::Vector2d(1, 1));
+    EXPECT_TRUE(f.s.arm(f.t, &why)) << why;
+  }
+}
+
+TEST(LinkSupervisor, MissingFeedbackDisarmsWithinTheWatchdogTime) {
+  Fixture f;
+  f.target(Eigen::Vector2d(1, 1));
+  f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  for (int k = 0; k < 50; ++k) f.tick();
+  const double lost_at = f.t;
+  while (f.s.status(f.t).armed && f.t < lost_at + 1) f.tick(false);
+  EXPECT_LE(f.t - lost_at, 0.1 + dt + 1e-9);
+  const LinkStatus st = f.s.status(f.t);
+  EXPECT_FALSE(st.connected);
+  EXPECT_NE(st.reason.find("no feedback for"), std::string::npos) << st.reason;
+  EXPECT_NE(st.reason.find("watchdog 0.1 s"), std::string::npos) << st.reason;
+}
+
+TEST(LinkSupervisor, ReconnectingHoldsWhereTheRobotIsUntilRearmed) {
+  Fixture f;
+  f.target(Eigen::Vector2d(1, 1));
+  f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  for (int k = 0; k < 50; ++k) f.tick();
+  for (int k = 0; k < 40; ++k) f.tick(false);
+  f.robot = Eigen::Vector2d(0.4, 0.1);  // moved meanwhile (e.g. jogged by hand)
+  for (int k = 0; k < 100; ++k) f.tick();
+  EXPECT_EQ(f.robot, Eigen::Vector2d(0.4, 0.1));
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  for (int k = 0; k < 2000; ++k) f.tick();
+  EXPECT_EQ(f.robot, Eigen::Vector2d(1, 1));
+}
+
+TEST(LinkSupervisor, RobotFaultDisarmsAndBlocksArming) {
+  Fixture f;
+  f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  f.s.on_feedback(1, Eigen::VectorXd::Constant(1, -0.2), "motors off", f.t + dt, dt);
+  EXPECT_EQ(f.s.status(f.t).reason, "b: motors off");
+  std::string why;
+  EXPECT_FALSE(f.s.arm(f.t, &why));
+  EXPECT_EQ(why, "b: motors off");
+}
+
+TEST(LinkSupervisor, TrackingErrorDisarms) {
+  Fixture f;
+  f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.6), "", f.t + dt, dt);
+  EXPECT_FALSE(f.s.status(f.t).armed);
+  EXPECT_EQ(f.s.status(f.t).reason, "a: tracking error 0.3 rad above 0.2 rad");
+}
+
+TEST(LinkSupervisor, CollidingTargetIsRefusedAndCollidingCommandsAreNeverIssued) {
+  // "Collision" in the corner j0 > 0.5, j1 < 0.05.
+  auto collides = [](const Eigen::VectorXd& q) { return q[0] > 0.5 && q[1] < 0.05; };
+  auto check = [&](const Eigen::VectorXd& q, std::string* why) {
+    if (!collides(q)) return true;
+    *why = "collides";
+    return false;
+  };
+  Fixture f(check);
+  EXPECT_FALSE(f.target(Eigen::Vector2d(1, 0)));
+  EXPECT_EQ(f.s.status(f.t).reason, "target pose: collides");
+  // A safe target whose joint-space path crosses the corner: the link stops at the last
+  // good pose and disarms.
+  ASSERT_TRUE(f.target(Eigen::Vector2d(1.1, 0.1)));
+  f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  for (int k = 0; k < 3000; ++k) {
+    f.tick();
+    ASSERT_FALSE(collides(f.s.status(f.t).commanded)) << "step " << k;
+  }
+  const LinkStatus st = f.s.status(f.t);
+  EXPECT_FALSE(st.armed);
+  EXPECT_NE(st.reason.find("commanded pose: collides"), std::string::npos) << st.reason;
+}
+
+}  // namespace
+}  // namespace shapectl
