@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Sets up (idempotent), builds and runs the main job: the default foam bar's statics.
+# Sets up (idempotent), builds and runs the main job: the browser GUI with the default YuMi +
+# foam bar scene and a simulated robot. Open the printed address; Ctrl-C stops it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
-./build/shapectl statics scenes/foam_bar_clamped.json --out build/foam_bar_result.json --vtu build/foam_bar.vtu
-echo "wrote build/foam_bar_result.json and build/foam_bar.vtu"
+exec ./build/shapectl serve scenes/yumi_bar.json --robot sim --port "${SHAPECTL_PORT:-8080}"

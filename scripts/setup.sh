@@ -10,6 +10,8 @@ packages=(
   liburdfdom-dev liborocos-kdl-dev libtet1.5-dev
   nlohmann-json3-dev libcli11-dev liblbfgspp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  libboost-dev chromium
+  libprotobuf-dev protobuf-compiler
 )
 
 missing=()
@@ -26,3 +28,18 @@ fi
 
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build -j "$(nproc)"
+
+# ---- web: the browser GUI's packages (three.js, playwright-core) from web/package-lock.json ----
+if ! command -v npm >/dev/null; then
+  sudo_cmd=""
+  [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  $sudo_cmd apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends nodejs npm
+fi
+# npm ci only when the lock file changed since the last install (stamp inside node_modules).
+lock_sum="$(sha256sum web/package-lock.json | cut -d' ' -f1)"
+if [ "$(cat web/node_modules/.shapectl-lock-sha256 2>/dev/null)" != "$lock_sum" ]; then
+  echo "setup: npm ci in web/"
+  (cd web && npm ci --no-audit --no-fund)
+  echo "$lock_sum" > web/node_modules/.shapectl-lock-sha256
+fi

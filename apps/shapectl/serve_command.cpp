@@ -1,5 +1,82 @@
-// placeholder: being written
+// shapectl serve [SCENE.json] [--host 127.0.0.1] [--port 8080] [--robot none|sim|egm] [--web-root DIR]
+// The browser GUI: serves web/ over HTTP and the session over a WebSocket at /ws (docs/gui.md).
+#include <iostream>
+
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/link/make_robot_link.hpp>
+#include <shapectl/sim/scene.hpp>
+#include <shapectl/server/server.hpp>
+#include <shapectl/server/web_paths.hpp>
+
 #include "commands.hpp"
+
 namespace shapectl::cli {
-void add_serve_command(CLI::App&) {}
+
+namespace {
+
+struct ServeArgs {
+  std::string scene;
+  std::string host = "127.0.0.1";
+  int port = 8080;
+  std::string robot = "none";
+  std::string web_root;
+  std::string scenes_dir;
+  double rate = 30;
+};
+
+void run_serve(const ServeArgs& args) {
+  server::ServerOptions options;
+  options.host = args.host;
+  options.port = static_cast<unsigned short>(args.port);
+  options.state_rate = args.rate;
+  options.web_root = args.web_root.empty() ? server::default_web_root() : std::filesystem::path(args.web_root);
+  if (!std::filesystem::is_regular_file(options.web_root / "index.html"))
+    throw InputError("serve", "--web-root", "a directory with index.html", options.web_root.string());
+  const std::filesystem::path scenes_dir =
+      args.scenes_dir.empty() ? server::default_scenes_dir() : std::filesystem::path(args.scenes_dir);
+  const std::filesystem::path scene =
+      args.scene.empty() ? scenes_dir / "yumi_bar.json" : std::filesystem::path(args.scene);
+
+  // The robot link follows the optimizer's θ; it starts disarmed (arm from the page).
+  std::unique_ptr<RobotLink> link;
+  if (args.robot != "none") {
+    const Scene description = load_scene(scene);
+    if (!description.robot) throw InputError(scene.string(), "robot", "a robot for --robot " + args.robot);
+    LinkConfig config;
+    config.kind = args.robot;
+    config.sim_initial_joints = description.robot->reference_joints;
+    link = make_robot_link(config, *description.robot->model, description.robot->collisions);
+    link->start();
+  }
+  server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get());
+  server::Server server(session, options);
+  std::cout << "shapectl serve: open " << server.url() << " (scene " << session.scene_name()
+            << "; Ctrl-C stops)" << std::endl;
+  if (args.host != "127.0.0.1" && args.host != "::1")
+    std::cerr << "serve: warning: listening on " << args.host
+              << ": anyone who can reach this port can move the robot (see docs/gui.md)\n";
+  server.run();
+  if (link) link->stop();
+  std::cout << "shapectl serve: stopped" << std::endl;
+}
+
+}  // namespace
+
+void add_serve_command(CLI::App& app) {
+  auto args = std::make_shared<ServeArgs>();
+  CLI::App* cmd = app.add_subcommand("serve", "Browser GUI: drag targets, sketch centre-lines, watch the robot follow");
+  cmd->add_option("scene", args->scene, "Scene JSON (default: scenes/yumi_bar.json)");
+  cmd->add_option("--host", args->host, "Address to listen on; anything but loopback exposes the robot")
+      ->capture_default_str();
+  cmd->add_option("--port", args->port, "TCP port; 0 picks a free one")
+      ->check(CLI::Range(0, 65535))->capture_default_str();
+  cmd->add_option("--robot", args->robot, "Robot link following the optimizer (starts disarmed)")
+      ->check(CLI::IsMember({"none", "sim", "egm"}))->capture_default_str();
+  cmd->add_option("--web-root", args->web_root, "Directory with index.html (default: the repository's web/)");
+  cmd->add_option("--scenes-dir", args->scenes_dir, "Scenes offered for switching (default: scenes/)");
+  cmd->add_option("--rate", args->rate, "State messages per second to each page")
+      ->check(CLI::Range(1.0, 120.0))->capture_default_str();
+  cmd->callback([args] { run_serve(*args); });
+}
+
 }  // namespace shapectl::cli

@@ -25,6 +25,18 @@ ShapeTargets targets_from_shape(const Positions& x, int count, std::mt19937& rng
   return t;
 }
 
+// Targets that move the first grip's nodes by −shift along y and the second's by +shift: with
+// shift larger than the grips' distance the arms would have to pass through each other.
+ShapeTargets grips_swapped(const Scene& scene, const Positions& x0, double shift) {
+  ShapeTargets t;
+  for (int e = 0; e < 2; ++e)
+    for (int i : scene.grips[e].nodes) {
+      t.nodes.push_back(i);
+      t.positions.push_back(x0.segment<3>(3 * i) + Vec3(0, e == 0 ? -shift : shift, 0));
+    }
+  return t;
+}
+
 class OptimizeTest : public ::testing::TestWithParam<OptimizerKind> {};
 
 TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
@@ -55,13 +67,7 @@ TEST_P(OptimizeTest, TargetsThroughEachOtherEndSafe) {
   GrippedObject object(scene);
   ReducedObjective objective(object);
   const Positions x0 = object.reference_positions();
-  ShapeTargets t;
-  for (int e = 0; e < 2; ++e)
-    for (int i : scene.grips[e].nodes) {
-      t.nodes.push_back(i);
-      t.positions.push_back(x0.segment<3>(3 * i) + Vec3(0, e == 0 ? -0.4 : 0.4, 0));
-    }
-  objective.set_targets(t);
+  objective.set_targets(grips_swapped(scene, x0, 0.4));
   const Evaluation start = objective.evaluate(object.reference_joints(), x0);
   ASSERT_TRUE(start.safe());
   auto optimizer = make_optimizer(GetParam(), GradientMethod::Adjoint);
@@ -137,13 +143,7 @@ TEST_F(YumiBar, TargetsPullingTheGrippersThroughEachOtherEndCollisionFree) {
   GrippedObject object(scene);
   ReducedObjective objective(object);
   const Positions x0 = object.reference_positions();
-  ShapeTargets t;
-  for (int e = 0; e < 2; ++e)
-    for (int i : scene.grips[e].nodes) {
-      t.nodes.push_back(i);
-      t.positions.push_back(x0.segment<3>(3 * i) + Vec3(0, e == 0 ? -0.45 : 0.45, 0));
-    }
-  objective.set_targets(t);
+  objective.set_targets(grips_swapped(scene, x0, 0.45));
   const Evaluation start = objective.evaluate(object.reference_joints(), x0);
   ASSERT_TRUE(start.safe());
   GaussNewton optimizer;

@@ -277,6 +277,11 @@ void Controller::set_joints(const Eigen::VectorXd& joints) {
     throw InputError("joints", "", "one value per active joint (" +
                                        std::to_string(state_->object->joint_count()) + ")");
   if (!joints.allFinite()) throw InputError("joints", "", "finite values");
+  {
+    std::lock_guard lock(state_->inbox_mutex);
+    const bool pausing = state_->inbox.paused.value_or(snapshot()->paused);
+    if (!pausing) throw InputError("joints", "", "the optimizer to be paused before jogging");
+  }
   post(*state_, [&](Inbox& in) { in.jog = joints; });
 }
 

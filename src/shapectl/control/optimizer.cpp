@@ -22,17 +22,21 @@ bool acceptable(const Evaluation& trial, const Evaluation& current, double requi
   return trial.objective < required_objective;
 }
 
-// A decrease too small to matter (relative 1e-6, or an objective below 1e-16 m², i.e. errors
-// of nanometres): stop instead of polishing round-off.
+// A decrease too small to matter (relative 1e-4, or an objective below 1e-16 m², i.e. errors
+// of nanometres): stop instead of creeping.
 bool negligible(double before, double after) {
-  return before - after <= 1e-6 * std::abs(before) || after <= 1e-16;
+  return before - after <= 1e-4 * std::abs(before) || after <= 1e-16;
 }
 }  // namespace
 
 Evaluation evaluate_predicted(ReducedObjective& objective, const Eigen::VectorXd& joints,
                               const Positions& warm, const Positions& predicted) {
-  Evaluation e = objective.evaluate(joints, predicted);
-  if (!e.statics.converged()) e = objective.evaluate(joints, warm);
+  // A trial whose statics need many Newton steps is far outside the linear model: better
+  // rejected (and the step shortened) than solved at length.
+  constexpr int kTrialNewtonLimit = 25;
+  Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit);
+  if (e.statics.status == StaticsStatus::Inverted && e.statics.iterations == 0)
+    e = objective.evaluate(joints, warm, kTrialNewtonLimit);  // the prediction itself inverted
   return e;
 }
 
@@ -108,7 +112,7 @@ StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
   double t = 1.0;
   for (int k = 0; k < 16; ++k, t *= 0.5) {
     const Eigen::VectorXd theta = current.joints + t * d;
-    const Evaluation trial = objective.evaluate(theta, current.positions);
+    const Evaluation trial = objective.evaluate(theta, current.positions, 25);
     if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
     const bool tiny = negligible(current.objective, trial.objective);
     const Eigen::VectorXd g_new = objective.gradient(trial, method_);

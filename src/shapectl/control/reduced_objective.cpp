@@ -31,12 +31,12 @@ void ReducedObjective::score(Evaluation& e) const {
 
 void ReducedObjective::rescore(Evaluation& e) const { score(e); }
 
-Evaluation ReducedObjective::evaluate(const Eigen::VectorXd& joints, const Positions& x) {
+Evaluation ReducedObjective::evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton) {
   Evaluation e;
   e.joints = joints;
   e.positions = x;
   const auto t0 = Clock::now();
-  e.statics = object_.solve(joints, e.positions);
+  e.statics = object_.solve(joints, e.positions, max_newton);
   timing_.statics_seconds += seconds_since(t0);
   ++timing_.statics_solves;
   current_joints_ = joints;

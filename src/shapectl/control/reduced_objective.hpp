@@ -49,7 +49,8 @@ class ReducedObjective {
 
   // Solves statics at θ from the warm start `x` and scores it. The object's state is then
   // this θ's (what gradient() and least_squares() need).
-  Evaluation evaluate(const Eigen::VectorXd& joints, const Positions& x);
+  // max_newton > 0 caps the Newton iterations (a trial that needs more is not worth it).
+  Evaluation evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton = 0);
   // Re-scores an evaluation after a target change, without re-solving.
   void rescore(Evaluation& e) const;
   // dÔ/dθ at `at` (re-solved first if the object has since moved elsewhere).

@@ -37,11 +37,11 @@ bool nesting_within(std::string_view text, int max_depth) {
 
 nlohmann::json parse_json(std::string_view text) {
   if (text.size() > max_message_bytes)
-    throw InputError(source, "", "at most " + std::to_string(max_message_bytes) + " bytes");
+    throw InputError(source, "", "longer than " + std::to_string(max_message_bytes) + " bytes");
   if (!nesting_within(text, max_json_depth))
-    throw InputError(source, "", "JSON nested at most " + std::to_string(max_json_depth) + " deep");
+    throw InputError(source, "", "JSON nested deeper than " + std::to_string(max_json_depth));
   nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
-  if (j.is_discarded()) throw InputError(source, "", "valid JSON");
+  if (j.is_discarded()) throw InputError(source, "", "not valid JSON");
   return j;
 }
 

@@ -27,18 +27,23 @@ constexpr std::size_t max_queued_stream = 4;     // state/position frames droppe
 constexpr int max_log_lines_per_second = 10;     // per client
 
 class Client;
+
+std::string_view view(beast::string_view s) { return {s.data(), s.size()}; }
 }  // namespace
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   Impl(Session& s, ServerOptions o) : session(s), options(std::move(o)) {}
   Session& session;
   ServerOptions options;
+  // Client objects alive, handshakes under way included; declared before ioc so it outlives the
+  // handlers that ioc destroys.
+  int websockets = 0;
   net::io_context ioc{1};
   tcp::acceptor acceptor{ioc};
   net::steady_timer ticker{ioc};
   net::signal_set signals{ioc, SIGINT, SIGTERM};
   Clock::time_point next_tick;
-  std::set<std::shared_ptr<Client>> clients;
+  std::set<std::shared_ptr<Client>> clients;  // after the handshake
   int next_client_id = 1;
 
   void accept();
@@ -55,7 +60,12 @@ void log_line(const std::string& line) { std::cerr << "serve: " << line << std::
 class Client : public std::enable_shared_from_this<Client> {
  public:
   Client(tcp::socket socket, Server::Impl& server, int id)
-      : ws_(std::move(socket)), server_(server), id_(id) {}
+      : ws_(std::move(socket)), server_(server), id_(id) {
+    ++server_.websockets;
+  }
+  ~Client() { --server_.websockets; }
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
 
   int id() const { return id_; }
   std::shared_ptr<const ControllerSnapshot> positions_sent;
@@ -185,7 +195,7 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     if (websocket::is_upgrade(request)) return upgrade(std::move(request), host);
     if (request.method() != http::verb::get && request.method() != http::verb::head)
       return reply_text(request, http::status::method_not_allowed, "GET or HEAD only\n");
-    const auto file = resolve_static_file(server_.options.web_root, request.target());
+    const auto file = resolve_static_file(server_.options.web_root, view(request.target()));
     if (!file) return reply_text(request, http::status::not_found, "not found\n");
     http::file_body::value_type body;
     body.open(file->c_str(), beast::file_mode::scan, ec);
@@ -206,9 +216,9 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
 
   void upgrade(http::request<http::string_body> request, const std::string& host) {
     if (request.target() != "/ws") return reply_text(request, http::status::not_found, "not found\n");
-    if (!origin_allowed(request[http::field::origin], host))
+    if (!origin_allowed(view(request[http::field::origin]), host))
       return reply_text(request, http::status::forbidden, "origin not allowed\n");
-    if (static_cast<int>(server_.clients.size()) >= server_.options.max_clients)
+    if (server_.websockets >= server_.options.max_clients)
       return reply_text(request, http::status::service_unavailable, "too many clients\n");
     stream_.expires_never();
     auto client = std::make_shared<Client>(stream_.release_socket(), server_, server_.next_client_id++);

@@ -32,8 +32,9 @@ class Server {
   void run();
   void stop();  // safe from any thread
 
+  struct Impl;  // defined in server.cpp (public only so its helper classes can name it)
+
  private:
-  struct Impl;
   std::shared_ptr<Impl> impl_;
 };
 

@@ -116,12 +116,22 @@ Session::~Session() = default;
 void Session::load(const SceneEntry& entry) {
   // Load first: a bad scene leaves the current one running.
   const Scene scene = load_scene(entry.path);
+  if (!scene.robot) throw InputError(entry.path.string(), "robot", "missing: the GUI needs a scene with a robot");
+  // A robot link drives one robot: every scene must have the same joints as the first.
+  if (link_ && controller_) {
+    const auto joints = scene.robot ? scene.robot->model->active_joint_names() : std::vector<std::string>{};
+    if (joints != controller_->robot().active_joint_names())
+      throw InputError("message", "scene", "a scene with the robot link's robot; " + entry.name +
+                                               " has other joints");
+  }
   auto controller = std::make_unique<Controller>(scene, options_);
   if (controller_) controller_->stop();
   controller_ = std::move(controller);
   controller_->start();
   scene_name_ = entry.name;
   targets_ = {};
+  paused_ = false;
+  jog_.reset();
   history_.clear();
   started_ = std::chrono::steady_clock::now();
   last_edit_time_ = -1e9;
@@ -206,20 +216,24 @@ void Session::apply(const Command& c) {
       break;
     case T::SetPaused:
       controller_->set_paused(c.paused);
+      paused_ = c.paused;
+      jog_.reset();
       break;
     case T::SetJoint: case T::SetJoints: {
-      // Jog from the newest state; the controller refuses it unless paused.
+      if (!paused_) throw InputError("message", "type", "jogging needs the optimizer paused first");
       Eigen::VectorXd joints = c.joints;
       if (c.type == T::SetJoint) {
-        joints = controller_->snapshot()->joints;
+        joints = jog_ ? *jog_ : controller_->snapshot()->joints;
         joints[c.joint] = c.value;
       }
       controller_->set_joints(joints);
+      jog_ = joints;
       break;
     }
     case T::Reset:
       controller_->reset();
       targets_ = {};
+      jog_.reset();
       edited();
       break;
     case T::LoadScene: {

@@ -25,9 +25,9 @@ GrippedObject::GrippedObject(const Scene& scene) : scene_(scene) {
   statics_ = std::make_unique<ObjectStatics>(scene_, std::vector<const EnergyTerm*>{grips_.get()}, held);
 }
 
-StaticsResult GrippedObject::solve(const Eigen::VectorXd& joints, Positions& x) {
+StaticsResult GrippedObject::solve(const Eigen::VectorXd& joints, Positions& x, int max_iterations) {
   grips_->set_robot_state(forward_kinematics(robot(), joints));
-  return statics_->solve(x);
+  return statics_->solve(x, max_iterations);
 }
 
 Eigen::MatrixXd GrippedObject::sensitivity(const Positions& x) {

@@ -25,7 +25,8 @@ class GrippedObject {
   Positions reference_positions() const { return scene_.world_rest_positions(); }
 
   // Equilibrium at θ = joints, warm-started from x (overwritten with the result).
-  StaticsResult solve(const Eigen::VectorXd& joints, Positions& x);
+  // max_iterations > 0 caps Newton for this call.
+  StaticsResult solve(const Eigen::VectorXd& joints, Positions& x, int max_iterations = 0);
   // Robot state of the last solve.
   const KinematicsState& kinematics() const { return grips_->robot_state(); }
   const GripSprings& grips() const { return *grips_; }

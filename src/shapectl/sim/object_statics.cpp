@@ -65,14 +65,14 @@ ObjectStatics::ObjectStatics(const Scene& scene, std::vector<const EnergyTerm*> 
   solver_ = std::make_unique<StaticsSolver>(mesh_->node_count(), terms, fixed_node_, options);
 }
 
-StaticsResult ObjectStatics::solve(Positions& x) {
+StaticsResult ObjectStatics::solve(Positions& x, int max_iterations) {
   if (!unheld_reason_.empty()) {
     StaticsResult r;
     r.status = StaticsStatus::Singular;
     r.reason = unheld_reason_;
     return r;
   }
-  return solver_->solve(x);
+  return solver_->solve(x, max_iterations);
 }
 
 }  // namespace shapectl

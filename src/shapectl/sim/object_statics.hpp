@@ -20,7 +20,7 @@ class ObjectStatics {
 
   // Equilibrium from the warm start x (fixed nodes must be at their prescribed positions).
   // An object that nothing holds is reported as Singular without iterating.
-  StaticsResult solve(Positions& x);
+  StaticsResult solve(Positions& x, int max_iterations = 0);
   StaticsSolver& solver() { return *solver_; }
   const TetMesh& mesh() const { return *mesh_; }
   const std::vector<char>& fixed_node() const { return fixed_node_; }

@@ -96,8 +96,8 @@ Eigen::MatrixXd StaticsSolver::solve_hessian(const Positions& x, const Eigen::Ma
   return cholesky_.solve(masked);
 }
 
-StaticsResult StaticsSolver::solve(Positions& x) {
-  StaticsResult result = newton(x);
+StaticsResult StaticsSolver::solve(Positions& x, int max_iterations) {
+  StaticsResult result = newton(x, max_iterations > 0 ? max_iterations : options_.max_iterations);
   solved_x_ = x;
   last_step_from_factor_ = std::numeric_limits<double>::infinity();
   if (factor_is_true_ && factor_x_.size() == x.size()) {
@@ -108,7 +108,7 @@ StaticsResult StaticsSolver::solve(Positions& x) {
   return result;
 }
 
-StaticsResult StaticsSolver::newton(Positions& x) {
+StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
   StaticsResult result;
   double e = energy(x);
   if (!std::isfinite(e)) {
@@ -128,7 +128,7 @@ StaticsResult StaticsSolver::newton(Positions& x) {
       result.reason = "residual " + sci(residual) + " N after " + std::to_string(it) + " iterations";
       return result;
     }
-    if (it == options_.max_iterations) {
+    if (it == max_iterations) {
       result.status = StaticsStatus::NotConverged;
       result.reason = "not converged: residual " + sci(residual) + " N after " +
                       std::to_string(it) + " iterations";

@@ -53,7 +53,8 @@ class StaticsSolver {
   StaticsSolver(int node_count, std::vector<const EnergyTerm*> terms, std::vector<char> fixed_node,
                 StaticsOptions options = {});
   // Starts from x (warm start) and overwrites it with the equilibrium or the last iterate.
-  StaticsResult solve(Positions& x);
+  // max_iterations > 0 overrides the options' limit for this call (optimizer trials).
+  StaticsResult solve(Positions& x, int max_iterations = 0);
 
   // Total energy and its gradient (fixed dofs zeroed) at x.
   double energy(const Positions& x) const;
@@ -71,10 +72,11 @@ class StaticsSolver {
   const std::vector<char>& fixed_dof() const { return assembler_.fixed_dof(); }
   const StaticsOptions& options() const { return options_; }
   void set_force_tolerance(double tolerance) { options_.force_tolerance = tolerance; }
+  void set_chord_steps(bool on) { options_.chord_steps = on; }
   int factorizations() const { return factorizations_; }
 
  private:
-  StaticsResult newton(Positions& x);
+  StaticsResult newton(Positions& x, int max_iterations);
   double max_force(const Eigen::VectorXd& gradient) const;
   // Assembles and factors at x; projected = use PSD-projected element Hessians.
   bool factor_at(const Positions& x, bool projected);

@@ -1,0 +1,120 @@
+#include <shapectl/server/session.hpp>
+
+#include <gtest/gtest.h>
+
+#include "support/test_support.hpp"
+
+namespace shapectl::server {
+namespace {
+
+nlohmann::json reply_json(const Session::Reply& r) { return nlohmann::json::parse(r.text); }
+
+// Waits (generously) until the controller has published a snapshot that satisfies `done`.
+template <class Done>
+std::shared_ptr<const ControllerSnapshot> wait_until(Session& session, Done done) {
+  auto s = session.controller().snapshot();
+  for (int k = 0; k < 600 && !done(*s); ++k) s = session.controller().wait_for_snapshot(s->sequence, 0.1);
+  return s;
+}
+
+class SessionTest : public ::testing::Test {
+ protected:
+  Session session{test::source_path("scenes/yumi_bar.json"),
+                  find_bundled_scenes(test::source_path("scenes"))};
+};
+
+TEST_F(SessionTest, SceneMessageDescribesRobotObjectAndScenes) {
+  const auto m = nlohmann::json::parse(session.scene_message());
+  EXPECT_EQ(m["type"], "scene");
+  EXPECT_EQ(m["scene"], "yumi_bar.json");
+  EXPECT_GT(m["node_count"].get<int>(), 0);
+  EXPECT_EQ(m["triangles"].size() % 3, 0u);
+  EXPECT_GT(m["triangles"].size(), 0u);
+  EXPECT_EQ(m["robot"]["joint_names"].size(), 14u);
+  EXPECT_GT(m["robot"]["links"].size(), 14u);
+  EXPECT_EQ(m["grips"].size(), 2u);
+  EXPECT_FALSE(m["bar"].is_null());
+  const auto& scenes = m["scenes"];
+  EXPECT_NE(std::find(scenes.begin(), scenes.end(), "yumi_bar.json"), scenes.end());
+  EXPECT_EQ(std::find(scenes.begin(), scenes.end(), "foam_bar_clamped.json"), scenes.end())
+      << "scenes without a robot are not offered";
+}
+
+TEST_F(SessionTest, SetTargetReachesTheControllerAndTheStateMessage) {
+  const auto r = session.handle(R"({"type":"set_target","id":1,"node":5,"position":[0.4,0.0,0.3]})");
+  EXPECT_TRUE(r.ok) << r.text;
+  EXPECT_EQ(reply_json(r)["type"], "ok");
+  EXPECT_EQ(reply_json(r)["id"], 1);
+  // Marked as editing right after the edit (the window is 0.3 s; this takes microseconds).
+  EXPECT_TRUE(nlohmann::json::parse(session.state_message(1))["editing"].get<bool>());
+  const auto s = wait_until(session, [](const ControllerSnapshot& s) { return s.targets.size() == 1; });
+  ASSERT_EQ(s->targets.size(), 1);
+  EXPECT_EQ(s->targets.nodes[0], 5);
+  session.tick();
+  const auto state = nlohmann::json::parse(session.state_message(1));
+  EXPECT_EQ(state["targets"].size(), 1u);
+  EXPECT_EQ(state["links"].size(), session.controller().robot().links().size());
+  EXPECT_EQ(state["links"][0].size(), 16u);
+}
+
+TEST_F(SessionTest, SecondSetTargetMovesTheFirstAndRemoveTargetDeletesIt) {
+  // Paused, requests apply without waiting for optimizer iterations.
+  EXPECT_TRUE(session.handle(R"({"type":"set_paused","paused":true})").ok);
+  EXPECT_TRUE(session.handle(R"({"type":"set_target","node":5,"position":[0.4,0.0,0.3]})").ok);
+  EXPECT_TRUE(session.handle(R"({"type":"set_target","node":6,"position":[0.4,0.0,0.3]})").ok);
+  EXPECT_TRUE(session.handle(R"({"type":"set_target","node":5,"position":[0.41,0.0,0.3]})").ok);
+  auto s = wait_until(session, [](const ControllerSnapshot& s) {
+    return s.targets.size() == 2 && s.targets.positions[0].x() > 0.405;
+  });
+  ASSERT_EQ(s->targets.size(), 2);
+  EXPECT_DOUBLE_EQ(s->targets.positions[0].x(), 0.41);
+  EXPECT_TRUE(session.handle(R"({"type":"remove_target","node":5})").ok);
+  s = wait_until(session, [](const ControllerSnapshot& s) { return s.targets.size() == 1; });
+  ASSERT_EQ(s->targets.size(), 1);
+  EXPECT_EQ(s->targets.nodes[0], 6);
+  EXPECT_FALSE(session.handle(R"({"type":"remove_target","node":5})").ok);
+}
+
+TEST_F(SessionTest, BadMessagesGetAnErrorReplyAndChangeNothing) {
+  EXPECT_TRUE(session.handle(R"({"type":"set_paused","paused":true})").ok);
+  EXPECT_TRUE(session.handle(R"({"type":"set_target","node":5,"position":[0.4,0.0,0.3]})").ok);
+  for (const char* bad : {"", "nonsense", R"({"type":"set_target","id":3,"node":100000,"position":[0,0,0]})",
+                          R"({"type":"set_targets","targets":[]}x)", R"({"type":"load_scene","scene":"/etc/passwd"})"}) {
+    const auto r = session.handle(bad);
+    EXPECT_FALSE(r.ok) << bad;
+    EXPECT_EQ(reply_json(r)["type"], "error");
+    EXPECT_FALSE(r.log.empty());
+  }
+  EXPECT_EQ(reply_json(session.handle(R"({"type":"nope","id":3})"))["id"], 3);
+  const auto s = wait_until(session, [](const ControllerSnapshot& s) { return s.targets.size() == 1; });
+  EXPECT_EQ(s->targets.size(), 1);
+  EXPECT_EQ(s->targets.nodes[0], 5);
+}
+
+TEST_F(SessionTest, JoggingNeedsPauseAndArmingNeedsALink) {
+  const auto jog = R"({"type":"set_joint","joint":0,"value":0.0})";
+  EXPECT_FALSE(session.handle(jog).ok);
+  EXPECT_TRUE(session.handle(R"({"type":"set_paused","paused":true})").ok);
+  EXPECT_TRUE(wait_until(session, [](const ControllerSnapshot& s) { return s.paused; })->paused);
+  EXPECT_TRUE(session.handle(jog).ok);
+  const auto s = wait_until(session, [](const ControllerSnapshot& s) { return std::abs(s.joints[0]) < 1e-9; });
+  EXPECT_NEAR(s->joints[0], 0.0, 1e-9);
+  EXPECT_NE(reply_json(session.handle(R"({"type":"arm"})"))["message"].get<std::string>().find("no robot link"),
+            std::string::npos);
+}
+
+TEST(SessionScenes, BundledScenesAreTheOnesWithARobot) {
+  test::TempDir dir;
+  dir.write("b.json", R"({"robot": {}})");
+  dir.write("a.json", R"({"robot": {}, "object": {}})");
+  dir.write("plain.json", R"({"object": {}})");
+  dir.write("broken.json", "{");
+  dir.write("notes.txt", R"({"robot": {}})");
+  const auto scenes = find_bundled_scenes(dir.path());
+  ASSERT_EQ(scenes.size(), 2u);
+  EXPECT_EQ(scenes[0].name, "a.json");
+  EXPECT_EQ(scenes[1].name, "b.json");
+}
+
+}  // namespace
+}  // namespace shapectl::server

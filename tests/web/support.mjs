@@ -1,0 +1,171 @@
+// Shared by the browser and fuzz tests: start `shapectl serve` on a free port, launch Debian's
+// Chromium headless through playwright-core, and a minimal raw WebSocket client.
+import { spawn } from 'node:child_process';
+import { mkdtempSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import path from 'node:path';
+import net from 'node:net';
+import crypto from 'node:crypto';
+import { fileURLToPath } from 'node:url';
+
+export const sourceDir = process.env.SHAPECTL_SOURCE_DIR ?? path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+const cli = process.env.SHAPECTL_CLI ?? path.join(sourceDir, 'build/shapectl');
+
+export async function loadPlaywright() {
+  return import(path.join(sourceDir, 'web/node_modules/playwright-core/index.mjs'));
+}
+
+// Starts the server on port 0 and resolves once it printed its URL.
+export function startServer(args = []) {
+  const proc = spawn(cli, ['serve', ...args, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+  let log = '';
+  proc.stderr.on('data', (d) => { log += d; });
+  return new Promise((resolve, reject) => {
+    let out = '';
+    const timer = setTimeout(() => reject(new Error(`server did not start:\n${out}\n${log}`)), 60000);
+    proc.on('exit', (code) => reject(new Error(`server exited with ${code}:\n${out}\n${log}`)));
+    proc.stdout.on('data', (d) => {
+      out += d;
+      const m = out.match(/open (http:\/\/127\.0\.0\.1:(\d+)\/)/);
+      if (!m) return;
+      clearTimeout(timer);
+      resolve({
+        url: m[1], port: Number(m[2]), proc,
+        get log() { return log; },
+        alive: () => proc.exitCode === null && proc.signalCode === null,
+        stop: () => new Promise((done) => { if (proc.exitCode !== null) return done(); proc.on('exit', done); proc.kill('SIGTERM'); }),
+      });
+    });
+  });
+}
+
+export const chromiumFlags = ['--headless', '--no-sandbox', '--disable-gpu', '--no-first-run',
+  '--disable-background-networking', '--disable-component-update', '--disable-sync'];
+
+export async function launchChromium() {
+  const { chromium } = await loadPlaywright();
+  const userDataDir = mkdtempSync(path.join(tmpdir(), 'shapectl-chromium-'));
+  const context = await chromium.launchPersistentContext(userDataDir, {
+    executablePath: '/usr/bin/chromium', headless: true, args: chromiumFlags,
+    viewport: { width: 1280, height: 800 },
+  });
+  return { context, close: async () => { await context.close(); rmSync(userDataDir, { recursive: true, force: true }); } };
+}
+
+// Polls `probe` (sync or async) until it returns a truthy value; fails after `timeoutMs`.
+export async function waitFor(probe, what, timeoutMs = 30000) {
+  const end = Date.now() + timeoutMs;
+  let last;
+  while (Date.now() < end) {
+    last = await probe();
+    if (last) return last;
+    await new Promise((r) => setTimeout(r, 50));
+  }
+  throw new Error(`timed out waiting for ${what} (last: ${JSON.stringify(last)})`);
+}
+
+// A WebSocket client on a raw TCP socket, so tests can also send what no browser would:
+// binary frames, bad opcodes, unmasked or oversized frames.
+export class RawWebSocket {
+  static connect(port, { origin } = {}) {
+    return new Promise((resolve, reject) => {
+      const socket = net.connect(port, '127.0.0.1');
+      const key = crypto.randomBytes(16).toString('base64');
+      let buffer = Buffer.alloc(0);
+      socket.once('error', reject);
+      socket.on('connect', () => socket.write(
+        `GET /ws HTTP/1.1\r\nHost: 127.0.0.1:${port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n` +
+        `Sec-WebSocket-Key: ${key}\r\nSec-WebSocket-Version: 13\r\n${origin ? `Origin: ${origin}\r\n` : ''}\r\n`));
+      const onHandshake = (d) => {
+        buffer = Buffer.concat([buffer, d]);
+        const end = buffer.indexOf('\r\n\r\n');
+        if (end < 0) return;
+        socket.off('data', onHandshake);
+        const head = buffer.subarray(0, end).toString();
+        if (!head.startsWith('HTTP/1.1 101')) { socket.destroy(); reject(new Error(head.split('\r\n')[0])); return; }
+        resolve(new RawWebSocket(socket, buffer.subarray(end + 4)));
+      };
+      socket.on('data', onHandshake);
+    });
+  }
+
+  constructor(socket, rest) {
+    this.socket = socket;
+    this.buffer = Buffer.alloc(0);
+    this.messages = [];  // {text} or {binary}
+    this.waiters = [];
+    this.closed = false;
+    socket.on('data', (d) => this.receive(d));
+    socket.on('close', () => { this.closed = true; this.wake(); });
+    socket.on('error', () => {});
+    if (rest.length) this.receive(rest);
+  }
+
+  receive(d) {
+    this.buffer = Buffer.concat([this.buffer, d]);
+    for (;;) {
+      const b = this.buffer;
+      if (b.length < 2) break;
+      let len = b[1] & 0x7f, offset = 2;
+      if (len === 126) { if (b.length < 4) break; len = b.readUInt16BE(2); offset = 4; }
+      else if (len === 127) { if (b.length < 10) break; len = Number(b.readBigUInt64BE(2)); offset = 10; }
+      if (b.length < offset + len) break;
+      const fin = (b[0] & 0x80) !== 0, payload = Buffer.from(b.subarray(offset, offset + len));
+      let opcode = b[0] & 0x0f;
+      this.buffer = b.subarray(offset + len);
+      if (opcode === 0 || ((opcode === 1 || opcode === 2) && !fin)) {
+        // Fragmented message: collect until the final frame.
+        if (opcode !== 0) this.fragments = { opcode, parts: [] };
+        this.fragments.parts.push(payload);
+        if (!fin) continue;
+        opcode = this.fragments.opcode;
+        const whole = Buffer.concat(this.fragments.parts);
+        this.fragments = null;
+        if (opcode === 1) this.messages.push({ text: whole.toString() });
+        else this.messages.push({ binary: whole });
+      } else if (opcode === 1) this.messages.push({ text: payload.toString() });
+      else if (opcode === 2) this.messages.push({ binary: payload });
+      else if (opcode === 9) this.sendFrame(10, payload);  // pong
+      else if (opcode === 8) this.messages.push({ close: payload.length >= 2 ? payload.readUInt16BE(0) : 0 });
+    }
+    this.wake();
+  }
+
+  wake() { for (const w of this.waiters.splice(0)) w(); }
+
+  // One frame; `mask` false breaks the protocol on purpose (clients must mask).
+  sendFrame(opcode, payload, { fin = true, mask = true, rsv = 0 } = {}) {
+    const data = Buffer.isBuffer(payload) ? payload : Buffer.from(payload);
+    const head = [((fin ? 0x80 : 0) | (rsv << 4) | opcode)];
+    const m = mask ? 0x80 : 0;
+    if (data.length < 126) head.push(m | data.length);
+    else if (data.length < 65536) head.push(m | 126, data.length >> 8, data.length & 0xff);
+    else { head.push(m | 127); const l = Buffer.alloc(8); l.writeBigUInt64BE(BigInt(data.length)); head.push(...l); }
+    let body = data;
+    if (mask) {
+      const key = crypto.randomBytes(4);
+      body = Buffer.from(data.map((byte, i) => byte ^ key[i % 4]));
+      head.push(...key);
+    }
+    if (!this.socket.destroyed) this.socket.write(Buffer.concat([Buffer.from(head), body]));
+  }
+
+  sendText(text) { this.sendFrame(1, text); }
+  sendJson(object) { this.sendText(JSON.stringify(object)); }
+
+  // The next message matching `match`, from those received since `from` (index).
+  async next(match, timeoutMs = 15000, from = 0) {
+    const end = Date.now() + timeoutMs;
+    for (;;) {
+      const found = this.messages.slice(from).find(match);
+      if (found) return found;
+      if (this.closed) throw new Error('connection closed');
+      const left = end - Date.now();
+      if (left <= 0) throw new Error('timed out waiting for a message');
+      await new Promise((r) => { const timer = setTimeout(r, left); this.waiters.push(() => { clearTimeout(timer); r(); }); });
+    }
+  }
+
+  json(match) { return this.messages.filter((m) => m.text).map((m) => JSON.parse(m.text)).filter(match); }
+  close() { this.socket.destroy(); }
+}

@@ -1,0 +1,194 @@
+// The shapectl page: connects to /ws, shows the session in 3D and in the side panel, and turns
+// clicks, drags, sketches, buttons and sliders into protocol commands (docs/gui.md).
+import { Connection } from './connection.js';
+import { View3D } from './view3d.js';
+import { ConvergencePlot } from './plot.js';
+
+const $ = (id) => document.getElementById(id);
+const DEG = 180 / Math.PI;
+
+const page = {
+  scene: null,       // the last "scene" message
+  state: null,       // the last "state" message
+  positionsSeq: -1,  // sequence of the last positions frame
+  stats: { states: 0, positions: 0, errors: [], editingStates: 0, stateTimes: [] },
+};
+
+const view = new View3D($('view'), {
+  addTarget: (node, position) => command('set_target', { node, position }),
+  moveTarget: (node, position) => command('set_target', { node, position }),
+  sketch: (points) => command('set_centerline', { points }).then(() => setSketchMode(false)),
+  select: (node) => { $('delete').disabled = node === null; },
+});
+const plot = new ConvergencePlot($('plot'));
+
+const connection = new Connection(`ws://${location.host}/ws`, {
+  open: () => setBadge('connection', 'connected', 'ok'),
+  close: () => setBadge('connection', 'disconnected — retrying', 'bad'),
+  scene: onScene,
+  state: onState,
+  positions: (frame) => {
+    page.positionsSeq = frame.sequence;
+    page.stats.positions++;
+    if (page.scene && frame.positions.length === 3 * page.scene.node_count) view.setPositions(frame.positions);
+  },
+  error: (message) => { page.stats.errors.push(message.message); toast(message.message); },
+});
+
+// Fire and forget: errors already show as a toast.
+function command(type, fields) {
+  return connection.send(type, fields).catch(() => {});
+}
+
+function toast(text) {
+  const t = $('toast');
+  t.textContent = text;
+  t.classList.add('shown');
+  clearTimeout(toast.timer);
+  toast.timer = setTimeout(() => t.classList.remove('shown'), 4000);
+}
+
+function setBadge(id, text, kind) {
+  const b = $(id);
+  b.textContent = text;
+  b.className = `badge ${kind ?? ''}`;
+}
+
+// ---- scene ----
+function onScene(scene) {
+  page.scene = scene;
+  page.state = null;
+  view.setScene(scene);
+  plot.reset(scene.history);
+  const select = $('scene-select');
+  select.replaceChildren(...scene.scenes.map((name) => new Option(name, name, false, name === scene.scene)));
+  $('sketch').disabled = !scene.bar;
+  $('face-bar').disabled = !scene.bar;
+  $('sketch').title = scene.bar ? 'Sketch a centre-line with the mouse (C)' : 'Only for bar-like objects';
+  $('link-section').hidden = !scene.link;
+  buildJointSliders(scene.robot);
+}
+
+function buildJointSliders(robot) {
+  const box = $('joints');
+  box.replaceChildren();
+  page.sliders = [];
+  if (!robot) return;
+  robot.joint_names.forEach((name, k) => {
+    const lo = robot.lower_limits[k] ?? -Math.PI, hi = robot.upper_limits[k] ?? Math.PI;
+    const row = document.createElement('div');
+    row.className = 'joint';
+    row.innerHTML = `<span class="name" title="${name}">${name}</span>
+      <input type="range" min="${lo}" max="${hi}" step="0.001" aria-label="${name}" data-joint="${k}">
+      <span class="value"></span><div class="limit"><i></i></div>`;
+    const slider = row.querySelector('input');
+    slider.addEventListener('pointerdown', () => { slider.dragging = true; });
+    slider.addEventListener('pointerup', () => { slider.dragging = false; });
+    slider.addEventListener('blur', () => { slider.dragging = false; });
+    slider.addEventListener('input', () => {
+      slider.editedAt = performance.now();
+      command('set_joint', { joint: k, value: Number(slider.value) });
+    });
+    box.appendChild(row);
+    page.sliders.push({ slider, row, value: row.querySelector('.value'), mark: row.querySelector('.limit i'), lo, hi });
+  });
+}
+
+// ---- state ----
+function onState(state) {
+  page.state = state;
+  page.stats.states++;
+  if (state.editing) page.stats.editingStates++;
+  page.stats.stateTimes.push(performance.now());
+  if (page.stats.stateTimes.length > 200) page.stats.stateTimes.shift();
+  view.setState(state);
+  plot.add(state.time, state.error.mean, state.editing);
+  drawPlot();
+
+  const kind = { converged: 'ok', optimizing: 'busy', stuck: 'bad', paused: '', idle: '' }[state.status];
+  setBadge('status', state.status, kind);
+  const mm = (v) => (v === null ? '–' : (1000 * v).toFixed(2));
+  $('error-mean').textContent = state.targets.length ? mm(state.error.mean) : '–';
+  $('error-max').textContent = state.targets.length ? mm(state.error.max) : '–';
+  $('rate').textContent = (state.iterations_per_second ?? 0).toFixed(0);
+  const clearance = state.min_clearance === null ? '' : ` · clearance ${(1000 * state.min_clearance).toFixed(0)} mm`;
+  $('status-detail').textContent = `${state.targets.length} targets · ${state.iterations} iterations · ${state.clients} page(s)` +
+    `${clearance}${state.safe ? '' : ' · UNSAFE'}${state.last_error ? ' · ' + state.last_error : ''}`;
+  $('pause').textContent = state.paused ? 'Resume' : 'Pause';
+  $('pause').classList.toggle('active', state.paused);
+  $('jog-hint').textContent = state.paused ? '(drag to jog)' : '(pause to jog)';
+
+  (page.sliders ?? []).forEach((s, k) => {
+    const v = state.joints[k];
+    s.slider.disabled = !state.paused;
+    // Don't fight the user's hand: a slider being moved keeps its own value.
+    const recentlyEdited = performance.now() - (s.slider.editedAt ?? -1e9) < 500;
+    if (!s.slider.dragging && !recentlyEdited) s.slider.value = v;
+    s.value.textContent = `${(v * DEG).toFixed(1)}°`;
+    s.mark.style.left = `calc(${(100 * (v - s.lo) / (s.hi - s.lo)).toFixed(2)}% - 1px)`;
+    const margin = 0.05 * (s.hi - s.lo);
+    s.row.classList.toggle('near-limit', v < s.lo + margin || v > s.hi - margin);
+  });
+
+  if (state.link) {
+    const l = state.link;
+    $('link-status').textContent = `${l.kind}: ${l.connected ? 'connected' : 'no feedback'}, ${l.armed ? 'ARMED' : 'disarmed'}` +
+      (l.reason ? ` — ${l.reason}` : '');
+  }
+}
+
+let plotPending = false;
+function drawPlot() {
+  if (plotPending) return;
+  plotPending = true;
+  requestAnimationFrame(() => { plotPending = false; plot.draw(); });
+}
+
+// ---- controls ----
+function setSketchMode(on) {
+  view.setSketchMode(on);
+  $('sketch').classList.toggle('active', on);
+}
+
+function deleteSelected() {
+  if (view.selected === null) return;
+  command('remove_target', { node: view.selected });
+  view.select(null);
+}
+
+$('pause').onclick = () => command('set_paused', { paused: !page.state?.paused });
+$('reset').onclick = () => command('reset');
+$('clear').onclick = () => { command('clear_targets'); view.select(null); };
+$('delete').onclick = deleteSelected;
+$('sketch').onclick = () => setSketchMode(!view.sketchMode);
+$('face-bar').onclick = () => { if (page.scene?.bar) view.faceBar(page.scene.bar.direction); };
+$('show-wireframe').onchange = (e) => view.setWireframe(e.target.checked);
+$('show-spheres').onchange = (e) => view.setSpheresVisible(e.target.checked);
+$('show-robot').onchange = (e) => view.setRobotVisible(e.target.checked);
+$('scene-select').onchange = (e) => command('load_scene', { scene: e.target.value });
+$('arm').onclick = () => command('arm');
+$('disarm').onclick = () => command('disarm');
+window.addEventListener('keydown', (e) => {
+  if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
+  if (e.key === 'Delete' || e.key === 'Backspace') deleteSelected();
+  else if (e.key === 'c') setSketchMode(!view.sketchMode);
+  else if (e.key === 'Escape') setSketchMode(false);
+  else if (e.key === ' ') { e.preventDefault(); $('pause').click(); }
+});
+
+// ---- hooks for tests and scripts (read-only views plus screen projections) ----
+window.shapectl = {
+  get scene() { return page.scene; },
+  get state() { return page.state; },
+  get stats() { return page.stats; },
+  get ready() { return !!(page.scene && page.state && view.positions && view.frames > 2); },
+  get arrowCount() { return view.arrowCount ?? 0; },
+  get selected() { return view.selected; },
+  nodePosition: (node) => view.nodePosition(node).toArray(),
+  positions: () => Array.from(view.positions ?? []),
+  worldToPage: (point) => view.worldToPage(point),
+  nodeToPage: (node) => view.worldToPage(view.nodePosition(node).toArray()),
+  setLayers: ({ robot = true, object = true } = {}) => { view.setRobotVisible(robot); view.setObjectVisible(object); view.render(); },
+  objectCentroid: () => view.objectCentroid().toArray(),
+  cameraDirection: () => { const d = view.camera.getWorldDirection(new (view.camera.position.constructor)()); return d.toArray(); },
+};
