@@ -56,8 +56,8 @@ double neo_hookean_tet(const TetRest& rest, const Material& m, const Vec12& x, V
   if (!gradient && !hessian) return rest.volume * psi;
 
   const Mat3 F_inv_T = F.inverse().transpose();
-  const Mat9x12 B = dF_dx(rest.Dm_inverse);
   if (gradient) {
+    const Mat9x12 B = dF_dx(rest.Dm_inverse);
     // P = μ(F − F⁻ᵀ) + κ ln J F⁻ᵀ
     const Mat3 P = m.mu * (F - F_inv_T) + m.kappa * log_J * F_inv_T;
     *gradient = rest.volume * B.transpose() * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(P.data());
@@ -75,7 +75,21 @@ double neo_hookean_tet(const TetRest& rest, const Material& m, const Vec12& x, V
         for (int k = 0; k < 3; ++k)
           for (int l = 0; l < 3; ++l) C(3 * j + i, 3 * k + l) += c * G(i, k) * G(l, j);
     if (project_psd) clamp_negative_eigenvalues(C);
-    *hessian = rest.volume * B.transpose() * C * B;
+    // H = V Bᵀ C B with B's structure B(3j+i, 3a+i) = b(j, a) used directly: a third of the
+    // flops of the dense product.
+    Eigen::Matrix<double, 3, 4> b;
+    b.rightCols<3>() = rest.Dm_inverse.transpose();
+    b.col(0) = -b.rightCols<3>().rowwise().sum();
+    Eigen::Matrix<double, 9, 12> CB;  // C B
+    for (int n = 0; n < 4; ++n)
+      for (int k = 0; k < 3; ++k)
+        for (int r = 0; r < 9; ++r)
+          CB(r, 3 * n + k) = C(r, k) * b(0, n) + C(r, 3 + k) * b(1, n) + C(r, 6 + k) * b(2, n);
+    for (int a = 0; a < 4; ++a)
+      for (int i = 0; i < 3; ++i)
+        for (int col = 0; col < 12; ++col)
+          (*hessian)(3 * a + i, col) =
+              rest.volume * (b(0, a) * CB(i, col) + b(1, a) * CB(3 + i, col) + b(2, a) * CB(6 + i, col));
   }
   return rest.volume * psi;
 }
