@@ -52,7 +52,8 @@ inline Scene two_arm_scene(const std::array<int, 3>& cells = {12, 1, 1}) {
   s.robot = robot;
   const double end = length / 2 - 0.02 - 1e-9;
   for (int e = 0; e < 2; ++e) {
-    Grip g{.end_effector = e};
+    Grip g;
+    g.end_effector = e;
     for (int i = 0; i < s.object_mesh->node_count(); ++i) {
       const double x = s.object_mesh->rest_positions()[i].x();
       if (e == 0 ? x > end : x < -end) g.nodes.push_back(i);
