@@ -49,6 +49,23 @@ void full_solve(benchmark::State& state, std::array<int, 3> cells,
 void BM_StaticsFullSolve(benchmark::State& state) { full_solve(state, {16, 4, 4}, std::nullopt); }
 BENCHMARK(BM_StaticsFullSolve)->Unit(benchmark::kMillisecond);
 
+// From the rest shape with the per-mesh set-up (symbolic analysis) already done; Newton only
+// (no chord steps: no earlier factorization helps).
+void BM_StaticsSolveFromRest(benchmark::State& state) {
+  Scene scene = clamped_bar({16, 4, 4});
+  ObjectStatics statics(scene);
+  statics.solver().set_chord_steps(false);
+  int iterations = 0;
+  for (auto _ : state) {
+    Positions x = scene.world_rest_positions();
+    const StaticsResult r = statics.solve(x);
+    if (!r.converged()) state.SkipWithError(r.reason.c_str());
+    iterations = r.iterations;
+  }
+  state.counters["newton_iterations"] = iterations;
+}
+BENCHMARK(BM_StaticsSolveFromRest)->Unit(benchmark::kMillisecond);
+
 void BM_StaticsWarmResolve(benchmark::State& state) {
   const Scene scene = clamped_bar({16, 4, 4});
   ObjectStatics statics(scene);
