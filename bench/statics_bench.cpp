@@ -1,5 +1,5 @@
 // Statics benchmarks: the default foam bar (1,536 tets) clamped at both ends, solved from rest
-// and re-solved warm after one clamp moves by 1 mm; larger boxes for scaling; both Cholesky
+// and re-solved warm after one clamp moves by 1 mm; larger boxes for scaling; the Cholesky
 // backends side by side to pick the crossover.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -102,8 +102,37 @@ void BM_BackendCholmod(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   full_solve(state, {4 * n, n, n}, SparseCholesky::Backend::CholmodSupernodal);
 }
+void BM_BackendBand(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  full_solve(state, {4 * n, n, n}, SparseCholesky::Backend::Band);
+}
 BENCHMARK(BM_BackendLDLT)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_BackendBand)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK(BM_BackendCholmod)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(2);
+
+// One numeric factorization of the default bar's Hessian at its equilibrium, and one solve
+// with 14 right-hand sides (a sensitivity dx̂/dθ for a two-arm robot), each backend.
+void factorize(benchmark::State& state, SparseCholesky::Backend backend, int rhs_columns) {
+  const Scene scene = clamped_bar({16, 4, 4});
+  ObjectStatics statics(scene);
+  Positions x = scene.world_rest_positions();
+  if (!statics.solve(x).converged()) state.SkipWithError("statics failed");
+  const SparseMatrix H = statics.solver().hessian(x);
+  SparseCholesky cholesky(backend);
+  cholesky.analyze(H);
+  if (!cholesky.factorize(H)) state.SkipWithError("not positive definite");
+  const Eigen::MatrixXd rhs = Eigen::MatrixXd::Ones(H.rows(), rhs_columns);
+  for (auto _ : state) {
+    if (rhs_columns == 0) benchmark::DoNotOptimize(cholesky.factorize(H));
+    else benchmark::DoNotOptimize(cholesky.solve(rhs));
+  }
+}
+BENCHMARK_CAPTURE(factorize, ldlt, SparseCholesky::Backend::SimplicialLDLT, 0)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, band, SparseCholesky::Backend::Band, 0)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, cholmod, SparseCholesky::Backend::CholmodSupernodal, 0)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, solve14_ldlt, SparseCholesky::Backend::SimplicialLDLT, 14)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, solve14_band, SparseCholesky::Backend::Band, 14)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, solve14_cholmod, SparseCholesky::Backend::CholmodSupernodal, 14)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace shapectl

@@ -28,6 +28,7 @@ TEST(Statics, ClampedBarConvergesSuperlinearly) {
   // A soft foam bar clamped at both ends sags visibly under its own weight.
   const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
   ObjectStatics statics(scene);
+  statics.solver().set_chord_steps(false);  // Newton proper: a new factorization every step
   Positions x = scene.world_rest_positions();
   const StaticsResult r = statics.solve(x);
   ASSERT_TRUE(r.converged()) << r.reason;
@@ -49,6 +50,53 @@ TEST(Statics, ClampedBarConvergesSuperlinearly) {
   EXPECT_LT(ratio_last, 1e-2);
   // The final steps use the true Hessian.
   EXPECT_FALSE(r.log.back().projected);
+}
+
+TEST(Statics, ChordStepsSaveFactorizationsAndReachTheSameEquilibrium) {
+  const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
+  Positions newton_x = scene.world_rest_positions(), chord_x = newton_x;
+  ObjectStatics newton(scene), chord(scene);
+  newton.solver().set_chord_steps(false);
+  ASSERT_TRUE(newton.solve(newton_x).converged());
+  ASSERT_TRUE(chord.solve(chord_x).converged());
+  // Warm re-solves after the +x clamp moves 2 mm sideways: the case chord steps are for.
+  for (int i = 0; i < chord.mesh().node_count(); ++i)
+    if (chord.fixed_node()[i] && chord.mesh().rest_positions()[i].x() > 0) {
+      newton_x[3 * i + 1] += 2e-3;
+      chord_x[3 * i + 1] += 2e-3;
+    }
+  const int newton_before = newton.solver().factorizations(), chord_before = chord.solver().factorizations();
+  const StaticsResult rn = newton.solve(newton_x), rc = chord.solve(chord_x);
+  ASSERT_TRUE(rn.converged()) << rn.reason;
+  ASSERT_TRUE(rc.converged()) << rc.reason;
+  const int newton_factorizations = newton.solver().factorizations() - newton_before;
+  const int chord_factorizations = chord.solver().factorizations() - chord_before;
+  EXPECT_LT(chord_factorizations, newton_factorizations);
+  int chord_steps = 0;
+  for (const auto& it : rc.log) chord_steps += it.chord;
+  EXPECT_GT(chord_steps, 0);
+  // Same equilibrium: both stop at forces below 1e-6 N, a sub-micrometre difference.
+  double largest = 0;
+  for (int i = 0; i < chord.mesh().node_count(); ++i)
+    largest = std::max(largest, (chord_x - newton_x).segment<3>(3 * i).norm());
+  EXPECT_LT(largest, 1e-6);
+}
+
+TEST(Statics, CompressedSlenderBarIsNotPositiveDefinite) {
+  // Clamped at both ends and shortened 10 % while straight: three times the Euler buckling
+  // strain (4π² I / A L² ≈ 3 %), so bending modes have negative stiffness there.
+  Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e5, 0.3, 40), 0.001, true);
+  scene.gravity = Vec3::Zero();
+  ObjectStatics statics(scene);
+  Positions x = scene.world_rest_positions();
+  EXPECT_TRUE(statics.solver().hessian_positive_definite(x));
+  for (int i = 0; i < statics.mesh().node_count(); ++i) x[3 * i] *= 0.9;
+  EXPECT_FALSE(statics.solver().hessian_positive_definite(x));
+  EXPECT_THROW(statics.solver().solve_hessian(x, Eigen::MatrixXd::Ones(x.size(), 1)), std::runtime_error);
+  // Shortened 0.1 %: far from buckling, still positive definite.
+  x = scene.world_rest_positions();
+  for (int i = 0; i < statics.mesh().node_count(); ++i) x[3 * i] *= 0.999;
+  EXPECT_TRUE(statics.solver().hessian_positive_definite(x));
 }
 
 TEST(Statics, WarmStartAtEquilibriumNeedsNoIteration) {

@@ -105,7 +105,7 @@ void Controller::State::apply(Inbox in) {
     const Eigen::VectorXd theta = in.jog->cwiseMax(object->robot().lower_limits())
                                       .cwiseMin(object->robot().upper_limits());
     Evaluation e = objective->evaluate(theta, current.positions);
-    if (e.statics.converged()) {
+    if (objective->confirm_stable(e)) {
       current = std::move(e);
       last_error.clear();
     } else {
@@ -129,7 +129,12 @@ void Controller::State::iterate() {
   if (had_requests) apply(std::move(in));
   const bool work = !paused && !objective->targets().empty() && !idle;
   if (work) {
-    last_outcome = optimizer->step(*objective, current);
+    try {
+      last_outcome = optimizer->step(*objective, current);
+    } catch (const std::exception& e) {  // e.g. the start state is no stable equilibrium
+      last_outcome = StepOutcome::Stuck;
+      last_error = std::string("optimizer stopped: ") + e.what();
+    }
     ++iterations;
     const auto now = Clock::now();
     const double dt = std::chrono::duration<double>(now - last_iteration).count();

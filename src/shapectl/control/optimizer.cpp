@@ -58,10 +58,10 @@ StepOutcome GaussNewton::step(ReducedObjective& objective, Evaluation& current) 
     if (largest < 1e-12) return StepOutcome::Converged;
     if (largest > max_step) delta *= max_step / largest;
     const Eigen::VectorXd theta = current.joints + delta;
-    const Evaluation trial =
+    Evaluation trial =
         evaluate_predicted(objective, theta, current.positions, current.positions + dx * delta);
     const double predicted = current.objective - 0.5 * (r + J * delta).squaredNorm();
-    if (acceptable(trial, current, current.objective)) {
+    if (acceptable(trial, current, current.objective) && objective.confirm_stable(trial)) {
       // Gain ratio: how well the linear model predicted the decrease.
       const double gain = (current.objective - trial.objective) / std::max(predicted, 1e-300);
       const bool tiny = negligible(current.objective, trial.objective);
@@ -112,8 +112,9 @@ StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
   double t = 1.0;
   for (int k = 0; k < 16; ++k, t *= 0.5) {
     const Eigen::VectorXd theta = current.joints + t * d;
-    const Evaluation trial = objective.evaluate(theta, current.positions, 25);
+    Evaluation trial = objective.evaluate(theta, current.positions, 25);
     if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
+    if (!objective.confirm_stable(trial)) continue;
     const bool tiny = negligible(current.objective, trial.objective);
     const Eigen::VectorXd g_new = objective.gradient(trial, method_);
     const Eigen::VectorXd s = trial.joints - current.joints, y = g_new - g;

@@ -53,6 +53,16 @@ Evaluation ReducedObjective::evaluate(const Eigen::VectorXd& joints, const Posit
   return e;
 }
 
+bool ReducedObjective::confirm_stable(Evaluation& e) {
+  if (!e.statics.converged()) return false;
+  make_current(e);
+  if (object_.statics().solver().hessian_positive_definite(e.positions, stale_factor_step)) return true;
+  e.statics.status = StaticsStatus::Unstable;
+  e.statics.reason = "unstable equilibrium: the Hessian there is not positive definite";
+  score(e);
+  return false;
+}
+
 void ReducedObjective::make_current(const Evaluation& at) {
   if (current_joints_.size() == at.joints.size() && current_joints_ == at.joints &&
       current_positions_ == at.positions)

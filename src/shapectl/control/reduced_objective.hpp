@@ -51,6 +51,11 @@ class ReducedObjective {
   // this θ's (what gradient() and least_squares() need).
   // max_newton > 0 caps the Newton iterations (a trial that needs more is not worth it).
   Evaluation evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton = 0);
+  // True if `e` is a stable equilibrium (the Hessian there positive definite); otherwise
+  // marks it Unstable, objective +inf. Optimizers ask before accepting a state: an unstable
+  // equilibrium is no shape a robot can hold. The factorization it needs is the one the next
+  // gradient reuses, so accepted states cost nothing extra.
+  bool confirm_stable(Evaluation& e);
   // Re-scores an evaluation after a target change, without re-solving.
   void rescore(Evaluation& e) const;
   // dÔ/dθ at `at` (re-solved first if the object has since moved elsewhere).

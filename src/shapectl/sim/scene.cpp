@@ -201,8 +201,9 @@ Scene load_scene(const std::filesystem::path& file) {
     if (s.has("linear_solver")) {
       const std::string name = s.at("linear_solver").string();
       if (name == "ldlt") scene.statics.backend = SparseCholesky::Backend::SimplicialLDLT;
+      else if (name == "band") scene.statics.backend = SparseCholesky::Backend::Band;
       else if (name == "cholmod") scene.statics.backend = SparseCholesky::Backend::CholmodSupernodal;
-      else if (name != "auto") s.at("linear_solver").fail("\"auto\", \"ldlt\" or \"cholmod\"");
+      else if (name != "auto") s.at("linear_solver").fail("\"auto\", \"ldlt\", \"band\" or \"cholmod\"");
     }
     if (s.has("max_iterations")) scene.statics.max_iterations = static_cast<int>(s.at("max_iterations").integer_in(1, 100000));
     if (s.has("relative_tolerance")) scene.statics.relative_tolerance = s.at("relative_tolerance").positive();

@@ -36,7 +36,7 @@ struct NodeSelection {
 struct StaticsSettings {
   int max_iterations = 100;
   double relative_tolerance = 1e-6;  // force tolerance as a fraction of the object's weight
-  std::optional<SparseCholesky::Backend> backend;  // "ldlt" | "cholmod"; default by size
+  std::optional<SparseCholesky::Backend> backend;  // "ldlt" | "band" | "cholmod"; default: from the matrix
 };
 
 struct EndEffector {

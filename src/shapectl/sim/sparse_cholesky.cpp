@@ -3,20 +3,31 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
 
+#include <shapectl/sim/band_cholesky.hpp>
+
 namespace shapectl {
 
+namespace {
+// Eigen's LDLᵀ, plus the flop count of its factorization from the symbolic analysis.
+struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
+  double flops() const {
+    double f = 0;
+    for (int j = 0; j < m_nonZerosPerCol.size(); ++j) f += double(m_nonZerosPerCol[j] + 1) * (m_nonZerosPerCol[j] + 1);
+    return f;
+  }
+};
+}  // namespace
+
 struct SparseCholesky::Impl {
-  Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> ldlt;
+  CountingLdlt ldlt;
+  BandCholesky band;
   Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholmod;
 };
 
-SparseCholesky::Backend SparseCholesky::choose(int dof_count) {
-  // Measured crossover (bench/statics_bench.cpp BM_Backend*, README): LDLT is as fast or faster
-  // up to ~1.5k tets (1,275 unknowns); CHOLMOD is 2x faster at 5k tets and 6x at 24k.
-  return dof_count < 2500 ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
-}
-
-SparseCholesky::SparseCholesky(Backend backend) : backend_(backend), impl_(std::make_unique<Impl>()) {
+SparseCholesky::SparseCholesky(std::optional<Backend> backend)
+    : automatic_(!backend),
+      backend_(backend.value_or(Backend::SimplicialLDLT)),
+      impl_(std::make_unique<Impl>()) {
   // Not positive definite is an expected outcome (we fall back), not something to print.
   impl_->cholmod.cholmod().print = 0;
 }
@@ -24,16 +35,45 @@ SparseCholesky::SparseCholesky(Backend backend) : backend_(backend), impl_(std::
 SparseCholesky::~SparseCholesky() = default;
 
 void SparseCholesky::analyze(const SparseMatrix& lower) {
-  if (backend_ == Backend::SimplicialLDLT)
-    impl_->ldlt.analyzePattern(lower);
-  else
-    impl_->cholmod.analyzePattern(lower);
+  if (automatic_) {
+    // Measured (bench/statics_bench.cpp, README) on a 2-core Xeon with box meshes of 400 to
+    // 50k tets: LAPACK's band Cholesky after reverse Cuthill–McKee runs 3-10x the flop rate
+    // of Eigen's simplicial LDLᵀ and 2-3x CHOLMOD's supernodal one, so it is the faster while
+    // it does at most ~2.5x the flops of the sparse factorization: bars, frames, plates and
+    // blocks up to ~12 cells a side. Otherwise (or over 1 GiB of band) the sparse one: LDLᵀ
+    // for small systems, CHOLMOD for large ones.
+    constexpr double kBandFlopAllowance = 2.5;
+    constexpr double kBandBytesLimit = 1 << 30;
+    constexpr int kCholmodFrom = 2500;  // unknowns
+    const bool small = lower.rows() < kCholmodFrom;
+    impl_->band.analyze(lower);
+    double sparse_flops = 0;
+    if (small) {
+      impl_->ldlt.analyzePattern(lower);
+      sparse_flops = impl_->ldlt.flops();
+    } else {
+      impl_->cholmod.analyzePattern(lower);
+      sparse_flops = impl_->cholmod.cholmod().fl;
+    }
+    const bool band = impl_->band.flops() <= kBandFlopAllowance * sparse_flops &&
+                      impl_->band.storage_bytes() <= kBandBytesLimit;
+    backend_ = band ? Backend::Band : small ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
+    return;
+  }
+  switch (backend_) {
+    case Backend::SimplicialLDLT: impl_->ldlt.analyzePattern(lower); break;
+    case Backend::Band: impl_->band.analyze(lower); break;
+    case Backend::CholmodSupernodal: impl_->cholmod.analyzePattern(lower); break;
+  }
 }
 
 bool SparseCholesky::factorize(const SparseMatrix& lower) {
-  if (backend_ == Backend::CholmodSupernodal) {
-    impl_->cholmod.factorize(lower);
-    return impl_->cholmod.info() == Eigen::Success;
+  switch (backend_) {
+    case Backend::Band: return impl_->band.factorize(lower);
+    case Backend::CholmodSupernodal:
+      impl_->cholmod.factorize(lower);
+      return impl_->cholmod.info() == Eigen::Success;
+    case Backend::SimplicialLDLT: break;
   }
   impl_->ldlt.factorize(lower);
   if (impl_->ldlt.info() != Eigen::Success) return false;
@@ -43,14 +83,17 @@ bool SparseCholesky::factorize(const SparseMatrix& lower) {
   return D.minCoeff() > 1e-13 * D.cwiseAbs().maxCoeff();
 }
 
-Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& rhs) const {
-  if (backend_ == Backend::SimplicialLDLT) return impl_->ldlt.solve(rhs);
-  return impl_->cholmod.solve(rhs);
+Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
+  switch (backend_) {
+    case Backend::Band: return impl_->band.solve(rhs);
+    case Backend::CholmodSupernodal: return impl_->cholmod.solve(rhs);
+    case Backend::SimplicialLDLT: break;
+  }
+  return impl_->ldlt.solve(rhs);
 }
 
-Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
-  if (backend_ == Backend::SimplicialLDLT) return impl_->ldlt.solve(rhs);
-  return impl_->cholmod.solve(rhs);
+Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& rhs) const {
+  return solve(Eigen::MatrixXd(rhs)).col(0);
 }
 
 }  // namespace shapectl

@@ -1,8 +1,11 @@
 #pragma once
-// Sparse Cholesky with the symbolic analysis done once per pattern and reused.
-// Simplicial LDLᵀ (Eigen) for small systems, supernodal LLᵀ (CHOLMOD + OpenBLAS) for large
-// ones; the crossover comes from bench/statics_bench.cpp on a 2-core machine.
+// Sparse Cholesky with the symbolic analysis done once per pattern and reused. Three
+// backends: simplicial LDLᵀ (Eigen), a dense band after reverse Cuthill–McKee (LAPACK; the
+// fastest for bars, frames, plates and small blocks) and supernodal LLᵀ (CHOLMOD + OpenBLAS,
+// for large compact meshes). Chosen from the matrix unless fixed; the rule's numbers come from
+// bench/statics_bench.cpp.
 #include <memory>
+#include <optional>
 
 #include <shapectl/types.hpp>
 
@@ -10,12 +13,12 @@ namespace shapectl {
 
 class SparseCholesky {
  public:
-  enum class Backend { SimplicialLDLT, CholmodSupernodal };
-  // The faster backend for a system of this many unknowns.
-  static Backend choose(int dof_count);
+  enum class Backend { SimplicialLDLT, Band, CholmodSupernodal };
 
-  explicit SparseCholesky(Backend backend);
+  // A fixed backend, or none: then analyze() picks one for the matrix.
+  explicit SparseCholesky(std::optional<Backend> backend = std::nullopt);
   ~SparseCholesky();
+  // The backend in use (decided by the first analyze() when automatic).
   Backend backend() const { return backend_; }
   // Symbolic analysis; call again only when the pattern changes.
   void analyze(const SparseMatrix& lower);
@@ -23,11 +26,12 @@ class SparseCholesky {
   // positive definite; the factor is then unusable.
   bool factorize(const SparseMatrix& lower);
   // Solves with the last successful factorization.
-  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const;
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const;
 
  private:
   struct Impl;
+  bool automatic_;
   Backend backend_;
   std::unique_ptr<Impl> impl_;
 };

@@ -12,6 +12,7 @@ const char* to_string(StaticsStatus status) {
     case StaticsStatus::NotConverged: return "not converged";
     case StaticsStatus::Inverted: return "inverted";
     case StaticsStatus::Singular: return "singular";
+    case StaticsStatus::Unstable: return "unstable";
   }
   return "?";
 }
@@ -37,7 +38,7 @@ StaticsSolver::StaticsSolver(int node_count, std::vector<const EnergyTerm*> term
       terms_(std::move(terms)),
       options_(options),
       assembler_(3 * node_count, dof_mask(fixed_node)),
-      cholesky_(options.backend.value_or(SparseCholesky::choose(3 * node_count))) {}
+      cholesky_(options.backend) {}
 
 double StaticsSolver::energy(const Positions& x) const {
   double e = 0;
@@ -81,13 +82,16 @@ SparseMatrix StaticsSolver::hessian(const Positions& x) {
   return assembler_.assemble(triplets_);
 }
 
-Eigen::MatrixXd StaticsSolver::solve_hessian(const Positions& x, const Eigen::MatrixXd& rhs,
-                                             double stale_step) {
+bool StaticsSolver::hessian_positive_definite(const Positions& x, double stale_step) {
   const bool exact = factor_is_true_ && factor_x_.size() == x.size() && factor_x_ == x;
   const bool close = factor_is_true_ && stale_step > 0 && solved_x_.size() == x.size() &&
                      solved_x_ == x && last_step_from_factor_ <= stale_step;
-  const bool reusable = exact || close;
-  if (!reusable && !factor_at(x, false))
+  return exact || close || factor_at(x, false);
+}
+
+Eigen::MatrixXd StaticsSolver::solve_hessian(const Positions& x, const Eigen::MatrixXd& rhs,
+                                             double stale_step) {
+  if (!hessian_positive_definite(x, stale_step))
     throw std::runtime_error("the Hessian at the equilibrium is not positive definite");
   Eigen::MatrixXd masked = rhs;
   const auto& fixed = assembler_.fixed_dof();
@@ -135,10 +139,11 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
       return result;
     }
     NewtonIterate log{.iteration = it, .residual = residual, .energy = e};
-    // Chord steps first: the true Hessian's factor from before this solve (a nearby state) is
-    // kept while its full step lowers the energy and cuts the force 4-fold. This saves the
-    // factorization, the dominant cost, on warm re-solves. Once the solve factors anew it
-    // stays with Newton, so the last steps converge quadratically.
+    // Chord step first: the last factorization (from before this solve, or of an earlier
+    // iterate) is reused while its full step lowers the energy and cuts the force
+    // `chord_contraction`-fold. This saves the factorization, the dominant cost. A factor
+    // from the previous iterate contracts far more than that near the solution, so the
+    // convergence stays superlinear.
     if (may_chord) {
       const Eigen::VectorXd dx = -cholesky_.solve(g);
       if (g.dot(dx) < 0) {
@@ -147,7 +152,7 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
         if (std::isfinite(e_trial) && e_trial <= e + 1e-12 * std::abs(e)) {
           Eigen::VectorXd g_trial = gradient(trial);
           const double r_trial = max_force(g_trial);
-          if (r_trial <= 0.25 * residual) {
+          if (r_trial <= options_.chord_contraction * residual) {
             log.chord = true;
             log.step_length = 1;
             for (int i = 0; i < node_count_; ++i) log.step = std::max(log.step, dx.segment<3>(3 * i).norm());
@@ -161,7 +166,7 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
         }
       }
     }
-    may_chord = false;
+    may_chord = options_.chord_steps;
     // True Hessian at x; it must also give a descent direction.
     Eigen::VectorXd dx;
     if (factor_at(x, false)) {

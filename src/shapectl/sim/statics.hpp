@@ -14,7 +14,9 @@
 
 namespace shapectl {
 
-enum class StaticsStatus { Converged, NotConverged, Inverted, Singular };
+// Unstable: an equilibrium where the Hessian is not positive definite (a saddle, e.g. the
+// bar at the tipping point of a buckle); reported only by StaticsSolver::confirm_stable.
+enum class StaticsStatus { Converged, NotConverged, Inverted, Singular, Unstable };
 const char* to_string(StaticsStatus status);
 
 struct StaticsOptions {
@@ -22,6 +24,10 @@ struct StaticsOptions {
   int max_iterations = 100;
   // Try a step with the last true-Hessian factorization before factoring anew (see newton()).
   bool chord_steps = true;
+  // A chord step is kept if it cuts the largest nodal force at least this much (0.5 beat
+  // 0.25 and 0.8 in `shapectl bench` on the YuMi bar: a failed chord step costs a solve, a
+  // factorization costs ten).
+  double chord_contraction = 0.5;
   // Which sparse Cholesky; by default chosen by system size (SparseCholesky::choose).
   std::optional<SparseCholesky::Backend> backend;
 };
@@ -66,6 +72,10 @@ class StaticsSolver {
   // optimizer iteration).
   Eigen::MatrixXd solve_hessian(const Positions& x, const Eigen::MatrixXd& rhs,
                                 double stale_step = 0);
+  // Whether the true Hessian at x is positive definite, i.e. the equilibrium x is stable.
+  // Leaves that factorization for solve_hessian (same reuse rule), so checking an accepted
+  // state costs nothing extra.
+  bool hessian_positive_definite(const Positions& x, double stale_step = 0);
   // The true Hessian at x, lower triangle, fixed dofs eliminated (for tests and tools).
   SparseMatrix hessian(const Positions& x);
 

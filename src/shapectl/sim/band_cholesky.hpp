@@ -1,0 +1,40 @@
+#pragma once
+// Cholesky factorization of a sparse SPD matrix as a dense band: the unknowns are renumbered
+// by reverse Cuthill–McKee, which makes the band of an elongated mesh (a bar, a frame) narrow,
+// and LAPACK's blocked band Cholesky (dpbtrf, BLAS-3) factors it. On such meshes this runs
+// several times faster than a simplicial sparse factorization of the same matrix, although
+// it does more flops: dense kernels use the vector units, scattered sparse updates do not.
+#include <vector>
+
+#include <shapectl/types.hpp>
+
+namespace shapectl {
+
+// Reverse Cuthill–McKee ordering of the symmetric pattern whose lower triangle is `lower`:
+// order[k] is the old index of the k-th unknown. Each connected part starts from a
+// pseudo-peripheral vertex.
+std::vector<int> reverse_cuthill_mckee(const SparseMatrix& lower);
+
+class BandCholesky {
+ public:
+  // Ordering and band layout for this pattern (lower triangle, compressed).
+  void analyze(const SparseMatrix& lower);
+  int bandwidth() const { return bandwidth_; }  // sub-diagonals in the band
+  // Floating-point operations of one factorization, ~ Σ (column length)².
+  double flops() const;
+  // Memory the band takes (allocated by the first factorize()).
+  double storage_bytes() const { return 8.0 * (bandwidth_ + 1) * size_; }
+  // Numeric factorization; false if the matrix is not (numerically) positive definite.
+  // The matrix must have the analyzed pattern.
+  bool factorize(const SparseMatrix& lower);
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
+
+ private:
+  int size_ = 0;
+  int bandwidth_ = 0;
+  std::vector<int> new_index_;  // new_index_[old] = position in the band
+  std::vector<int> slot_;       // band storage index of each stored entry of `lower`
+  std::vector<double> band_;    // LAPACK lower band storage, (bandwidth_ + 1) × size_
+};
+
+}  // namespace shapectl
