@@ -139,11 +139,12 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
       return result;
     }
     NewtonIterate log{.iteration = it, .residual = residual, .energy = e};
-    // Chord step first: the last factorization (from before this solve, or of an earlier
-    // iterate) is reused while its full step lowers the energy and cuts the force
-    // `chord_contraction`-fold. This saves the factorization, the dominant cost. A factor
-    // from the previous iterate contracts far more than that near the solution, so the
-    // convergence stays superlinear.
+    // Chord steps first: the true Hessian's factor from before this solve (a nearby state) is
+    // kept while its full step lowers the energy and cuts the force 4-fold. This saves the
+    // factorization, the dominant cost, on warm re-solves. Once the solve factors anew it
+    // stays with Newton: chord steps from a factor of an earlier iterate stalled Newton near
+    // buckling (seconds instead of milliseconds in `shapectl bench`), and Newton's last step
+    // leaves a factorization the sensitivities can reuse.
     if (may_chord) {
       const Eigen::VectorXd dx = -cholesky_.solve(g);
       if (g.dot(dx) < 0) {
@@ -166,7 +167,7 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
         }
       }
     }
-    may_chord = options_.chord_steps;
+    may_chord = false;
     // True Hessian at x; it must also give a descent direction.
     Eigen::VectorXd dx;
     if (factor_at(x, false)) {

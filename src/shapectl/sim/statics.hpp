@@ -24,10 +24,8 @@ struct StaticsOptions {
   int max_iterations = 100;
   // Try a step with the last true-Hessian factorization before factoring anew (see newton()).
   bool chord_steps = true;
-  // A chord step is kept if it cuts the largest nodal force at least this much (0.5 beat
-  // 0.25 and 0.8 in `shapectl bench` on the YuMi bar: a failed chord step costs a solve, a
-  // factorization costs ten).
-  double chord_contraction = 0.5;
+  // A chord step is kept if it cuts the largest nodal force at least this much.
+  double chord_contraction = 0.25;
   // Which sparse Cholesky; by default chosen by system size (SparseCholesky::choose).
   std::optional<SparseCholesky::Backend> backend;
 };
