@@ -88,5 +88,28 @@ TEST(ReducedObjective, LeastSquaresFormMatchesObjectiveAndGradient) {
   EXPECT_LT(test::relative_error(J, J_fd), 1e-5);
 }
 
+TEST(ReducedObjective, ConfirmStableRejectsAStateWhoseHessianIsIndefinite) {
+  const Scene scene = test::two_arm_scene();
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  Evaluation held = objective.evaluate(object.reference_joints(), object.reference_positions());
+  ASSERT_TRUE(held.statics.converged());
+  EXPECT_TRUE(objective.confirm_stable(held));
+  EXPECT_EQ(held.statics.status, StaticsStatus::Converged);
+  // The same bar shortened 10 % along its axis, straight: ten times its Euler buckling strain,
+  // so bending has negative stiffness there.
+  Evaluation squeezed = held;
+  const Vec3 centre = scene.T_world_object.translation();
+  const Vec3 axis = scene.T_world_object.linear().col(0);
+  for (int i = 0; i < object.node_count(); ++i) {
+    const Vec3 p = squeezed.positions.segment<3>(3 * i);
+    squeezed.positions.segment<3>(3 * i) = p - 0.1 * axis.dot(p - centre) * axis;
+  }
+  EXPECT_FALSE(objective.confirm_stable(squeezed));
+  EXPECT_EQ(squeezed.statics.status, StaticsStatus::Unstable);
+  EXPECT_FALSE(std::isfinite(squeezed.objective));
+  EXPECT_FALSE(squeezed.safe());
+}
+
 }  // namespace
 }  // namespace shapectl

@@ -2,12 +2,29 @@
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
+#include <atomic>
+#include <cstdlib>
 
 #include <shapectl/sim/band_cholesky.hpp>
 
 namespace shapectl {
 
+// OpenBLAS's thread control, if the BLAS is OpenBLAS (weak: absent otherwise).
+extern "C" void openblas_set_num_threads(int threads) __attribute__((weak));
+extern "C" int openblas_get_num_procs() __attribute__((weak));
+
 namespace {
+// OpenBLAS threads pay off only for large dense blocks; on small ones they cost more in
+// hand-offs and spinning than they save (`shapectl bench` on the YuMi bar: 10 % faster with
+// one thread; a 50k-tet band factorization: 22 % slower). OPENBLAS_NUM_THREADS, if set, wins.
+void use_blas_threads(bool many) {
+  static const bool user_set = std::getenv("OPENBLAS_NUM_THREADS") != nullptr;
+  static std::atomic<int> current{0};
+  if (user_set || !openblas_set_num_threads || !openblas_get_num_procs) return;
+  const int threads = many ? openblas_get_num_procs() : 1;
+  if (current.exchange(threads) != threads) openblas_set_num_threads(threads);
+}
+
 // Eigen's LDLᵀ, plus the flop count of its factorization from the symbolic analysis.
 struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
   double flops() const {
@@ -68,9 +85,13 @@ void SparseCholesky::analyze(const SparseMatrix& lower) {
 }
 
 bool SparseCholesky::factorize(const SparseMatrix& lower) {
+  constexpr int kThreadedBandFrom = 256;  // sub-diagonals; measured crossover on 2 cores
   switch (backend_) {
-    case Backend::Band: return impl_->band.factorize(lower);
+    case Backend::Band:
+      use_blas_threads(impl_->band.bandwidth() >= kThreadedBandFrom);
+      return impl_->band.factorize(lower);
     case Backend::CholmodSupernodal:
+      use_blas_threads(true);
       impl_->cholmod.factorize(lower);
       return impl_->cholmod.info() == Eigen::Success;
     case Backend::SimplicialLDLT: break;
