@@ -68,6 +68,30 @@ TEST(GrippedObject, ReferenceJointsHoldTheObjectAtItsPlacedShape) {
   EXPECT_LT((x - object.reference_positions()).cwiseAbs().maxCoeff(), 1e-9);
 }
 
+TEST(GrippedObject, CarriedGrippedNodesKeepTheirSpringLengths) {
+  const Scene scene = test::two_arm_scene();
+  GrippedObject object(scene);
+  const Eigen::VectorXd from = object.reference_joints();
+  Positions x = object.reference_positions();
+  ASSERT_TRUE(object.solve(from, x).converged());
+  const double springs_before = object.grips().value(x);
+  ASSERT_GT(springs_before, 0);  // gravity stretches them: a non-trivial check
+  Eigen::VectorXd to = from;
+  to << 0.3, -0.1, 0.7, -0.25, -0.45, 1.1;
+  Positions carried = x;
+  object.carry_gripped_nodes(from, to, x, carried);
+  // A rigid motion of nodes and anchors together: every spring keeps its length.
+  Positions probe = carried;
+  object.solve(to, probe, 1);  // moves the anchors to `to` (one Newton step, result unused)
+  EXPECT_NEAR(object.grips().value(carried), springs_before, 1e-9 * springs_before);
+  // Nodes nobody grips stay where they were.
+  std::vector<char> gripped(object.node_count(), 0);
+  for (const auto& g : scene.grips)
+    for (int i : g.nodes) gripped[i] = 1;
+  for (int i = 0; i < object.node_count(); ++i)
+    if (!gripped[i]) EXPECT_EQ(carried.segment<3>(3 * i), x.segment<3>(3 * i));
+}
+
 TEST(GrippedObject, SensitivityMatchesCentralDifferencesOfStatics) {
   Scene scene = test::two_arm_scene();
   scene.statics.relative_tolerance = 1e-11;  // FD of equilibria needs them tight

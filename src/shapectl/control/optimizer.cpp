@@ -58,8 +58,11 @@ StepOutcome GaussNewton::step(ReducedObjective& objective, Evaluation& current) 
     if (largest < 1e-12) return StepOutcome::Converged;
     if (largest > max_step) delta *= max_step / largest;
     const Eigen::VectorXd theta = current.joints + delta;
+    // First-order prediction of the new equilibrium, the gripped nodes carried exactly.
+    Positions predicted_x = current.positions + dx * delta;
+    objective.object().carry_gripped_nodes(current.joints, theta, current.positions, predicted_x);
     Evaluation trial =
-        evaluate_predicted(objective, theta, current.positions, current.positions + dx * delta);
+        evaluate_predicted(objective, theta, current.positions, predicted_x);
     const double predicted = current.objective - 0.5 * (r + J * delta).squaredNorm();
     if (acceptable(trial, current, current.objective) && objective.confirm_stable(trial)) {
       // Gain ratio: how well the linear model predicted the decrease.
@@ -112,7 +115,9 @@ StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
   double t = 1.0;
   for (int k = 0; k < 16; ++k, t *= 0.5) {
     const Eigen::VectorXd theta = current.joints + t * d;
-    Evaluation trial = objective.evaluate(theta, current.positions, 25);
+    Positions carried = current.positions;
+    objective.object().carry_gripped_nodes(current.joints, theta, current.positions, carried);
+    Evaluation trial = evaluate_predicted(objective, theta, current.positions, carried);
     if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
     if (!objective.confirm_stable(trial)) continue;
     const bool tiny = negligible(current.objective, trial.objective);

@@ -30,6 +30,16 @@ StaticsResult GrippedObject::solve(const Eigen::VectorXd& joints, Positions& x, 
   return statics_->solve(x, max_iterations);
 }
 
+void GrippedObject::carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                        const Positions& at_from, Positions& x) const {
+  const KinematicsState a = forward_kinematics(robot(), from), b = forward_kinematics(robot(), to);
+  for (const auto& g : scene_.grips) {
+    const int link = scene_.robot->end_effectors[g.end_effector].link;
+    const Eigen::Isometry3d motion = b.T_world_link[link] * a.T_world_link[link].inverse();
+    for (int i : g.nodes) x.segment<3>(3 * i) = motion * at_from.segment<3>(3 * i);
+  }
+}
+
 Eigen::MatrixXd GrippedObject::sensitivity(const Positions& x) {
   return statics_->solver().solve_hessian(x, grips_->force_jacobian(node_count()));
 }

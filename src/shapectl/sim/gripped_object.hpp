@@ -32,6 +32,12 @@ class GrippedObject {
   const GripSprings& grips() const { return *grips_; }
   ObjectStatics& statics() { return *statics_; }
 
+  // A warm start for the equilibrium at `to` from the one at `from`: every gripped node of `x`
+  // is set to its position in `at_from` moved rigidly with its end effector from `from` to
+  // `to`. A linear prediction dx̂/dθ·Δθ puts them off their anchors by ~ r|Δθ|²/2 — tens of
+  // newtons through stiff grip springs, and Newton iterations to undo.
+  void carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                           const Positions& at_from, Positions& x) const;
   // dx̂/dθ (3n × m) at the last solve's equilibrium x.
   Eigen::MatrixXd sensitivity(const Positions& x);
   // (dx̂/dθ)ᵀ v by the adjoint method, one solve: λ = H⁻¹ v, result = (∂F/∂θ)ᵀ λ.
