@@ -104,11 +104,7 @@ void Controller::State::apply(Inbox in) {
   if (in.jog && paused) {
     const Eigen::VectorXd theta = in.jog->cwiseMax(object->robot().lower_limits())
                                       .cwiseMin(object->robot().upper_limits());
-    Positions carried = current.positions;
-    object->carry_gripped_nodes(current.joints, theta, current.positions, carried);
-    Evaluation e = objective->evaluate(theta, carried);
-    if (e.statics.status == StaticsStatus::Inverted && e.statics.iterations == 0)
-      e = objective->evaluate(theta, current.positions);  // the carried start itself inverted
+    Evaluation e = objective->evaluate(theta, current.positions);
     if (objective->confirm_stable(e)) {
       current = std::move(e);
       last_error.clear();
