@@ -79,6 +79,11 @@ std::vector<int> reverse_cuthill_mckee(const SparseMatrix& lower) {
   order.reserve(n);
   for (int start : by_degree) {
     if (done[start]) continue;
+    if (g[start].empty()) {  // an isolated unknown (e.g. a fixed dof): no search needed
+      done[start] = 1;
+      order.push_back(start);
+      continue;
+    }
     const std::vector<int> part = bfs(g, pseudo_peripheral(g, start, done), done).order;
     for (int v : part) done[v] = 1;
     order.insert(order.end(), part.begin(), part.end());
