@@ -64,14 +64,12 @@ std::vector<LinkChannel> egm_arm_channels(const RobotModel& robot) {
 
 EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck check,
                  std::shared_ptr<SessionLog> log)
-    : period_(config.egm_period),
-      log_(std::move(log)),
-      start_(std::chrono::steady_clock::now()),
-      buffer_(EgmCodec::max_datagram + 1),
-      supervisor_("egm", robot.active_joint_names(), egm_arm_channels(robot), robot.lower_limits(),
-                  robot.upper_limits(), governor_limits(config, robot),
-                  {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance},
-                  std::move(check), log_.get()) {
+    : SupervisedLink(config.egm_period, log,
+                     LinkSupervisor("egm", robot.active_joint_names(), egm_arm_channels(robot),
+                                    robot.lower_limits(), robot.upper_limits(), governor_limits(config, robot),
+                                    {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance},
+                                    std::move(check), log.get())),
+      buffer_(EgmCodec::max_datagram + 1) {
   for (const auto& c : supervisor_.channels()) {
     const int port = c.name == "left" ? config.egm_left_port : config.egm_right_port;
     sockets_.emplace_back(config.egm_address, port, "egm " + c.name + " port");
@@ -85,20 +83,6 @@ EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
 }
 
 EgmLink::~EgmLink() { stop(); }
-
-double EgmLink::now() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-}
-
-void EgmLink::start() {
-  if (!thread_.joinable()) thread_ = std::jthread([this](std::stop_token s) { run(s); });
-}
-
-void EgmLink::stop() {
-  if (!thread_.joinable()) return;
-  thread_.request_stop();
-  thread_.join();
-}
 
 void EgmLink::run(std::stop_token stop) {
   std::vector<pollfd> fds;
@@ -171,22 +155,6 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
     seq = command.seqno;
   }
   if (log_ && sent) log_command(*log_, supervisor_.channels()[c].name, seq, command.joints, measured);
-}
-
-void EgmLink::set_target(const Eigen::VectorXd& joints, bool safe) {
-  const std::string problem = supervisor_.target_problem(joints, safe);
-  std::lock_guard lock(mutex_);
-  supervisor_.set_target(joints, problem);
-}
-
-bool EgmLink::arm(std::string* why_not) {
-  std::lock_guard lock(mutex_);
-  return supervisor_.arm(now(), why_not);
-}
-
-void EgmLink::disarm(const std::string& reason) {
-  std::lock_guard lock(mutex_);
-  supervisor_.disarm(reason);
 }
 
 LinkStatus EgmLink::status() const {

@@ -4,16 +4,13 @@
 // carrying the governor's next command for that arm (one governor step of `egm_period` per
 // message). Nothing is sent unasked: without feedback the robot gets nothing, and EGM's own
 // \CommTimeout stops it. Datagrams that are not valid EgmRobot messages are counted and ignored.
-#include <atomic>
 #include <chrono>
 #include <memory>
-#include <mutex>
-#include <thread>
 #include <vector>
 
 #include <shapectl/link/egm_codec.hpp>
-#include <shapectl/link/link_supervisor.hpp>
 #include <shapectl/link/make_robot_link.hpp>
+#include <shapectl/link/supervised_link.hpp>
 #include <shapectl/link/udp_socket.hpp>
 
 namespace shapectl {
@@ -32,17 +29,12 @@ struct LatencyStats {
   double max_us = 0;
 };
 
-class EgmLink : public RobotLink {
+class EgmLink : public SupervisedLink {
  public:
   EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck check,
           std::shared_ptr<SessionLog> log);  // binds the ports
   ~EgmLink() override;
 
-  void start() override;
-  void stop() override;
-  void set_target(const Eigen::VectorXd& joints, bool safe) override;
-  bool arm(std::string* why_not = nullptr) override;
-  void disarm(const std::string& reason) override;
   LinkStatus status() const override;
 
   const std::vector<LinkChannel>& channels() const { return supervisor_.channels(); }
@@ -50,28 +42,21 @@ class EgmLink : public RobotLink {
   LatencyStats latency() const;  // over the last 65536 replies
 
  private:
-  double now() const;
-  void run(std::stop_token stop);
+  void run(std::stop_token stop) override;
   void handle_datagram(int channel, std::string_view datagram, const sockaddr_in& from,
                        std::chrono::steady_clock::time_point arrived);
 
-  double period_;
-  std::shared_ptr<SessionLog> log_;
-  std::chrono::steady_clock::time_point start_;
   std::vector<UdpSocket> sockets_;  // one per channel
   EgmCodec codec_;                  // link thread only
   std::vector<char> buffer_;        // link thread only
 
-  mutable std::mutex mutex_;  // guards everything below
-  LinkSupervisor supervisor_;
+  // Guarded by mutex_:
   std::vector<std::uint32_t> next_seqno_;          // per channel, ours
   std::vector<std::int64_t> last_robot_seqno_;     // per channel, the controller's; -1: none
-  std::uint64_t commands_sent_ = 0;
   std::uint64_t rejected_ = 0;
   std::uint64_t lost_ = 0;
   std::vector<float> latency_us_;  // ring buffer
   std::size_t latency_next_ = 0;
-  std::jthread thread_;
 };
 
 }  // namespace shapectl

@@ -31,18 +31,16 @@ Eigen::VectorXd sim_initial(const LinkConfig& config, const RobotModel& robot) {
 
 SimLink::SimLink(const LinkConfig& config, const RobotModel& robot, PoseCheck check,
                  std::shared_ptr<SessionLog> log)
-    : period_(config.sim_period),
-      log_(std::move(log)),
-      start_(std::chrono::steady_clock::now()),
-      supervisor_("sim", robot.active_joint_names(),
-                  {{"robot", [&] {
-                      std::vector<int> all(static_cast<std::size_t>(robot.active_count()));
-                      for (int i = 0; i < robot.active_count(); ++i) all[static_cast<std::size_t>(i)] = i;
-                      return all;
-                    }()}},
-                  robot.lower_limits(), robot.upper_limits(), governor_limits(config, robot),
-                  {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance},
-                  std::move(check), log_.get()),
+    : SupervisedLink(config.sim_period, log,
+                     LinkSupervisor("sim", robot.active_joint_names(),
+                                    {{"robot", [&] {
+                                        std::vector<int> all(static_cast<std::size_t>(robot.active_count()));
+                                        for (int i = 0; i < robot.active_count(); ++i) all[static_cast<std::size_t>(i)] = i;
+                                        return all;
+                                      }()}},
+                                    robot.lower_limits(), robot.upper_limits(), governor_limits(config, robot),
+                                    {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance},
+                                    std::move(check), log.get())),
       robot_(sim_robot_limits(config, robot, supervisor_.limits()), sim_initial(config, robot)) {
   if (log_)
     log_link_started(*log_, "sim", robot.active_joint_names(), supervisor_.channels(),
@@ -50,20 +48,6 @@ SimLink::SimLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
 }
 
 SimLink::~SimLink() { stop(); }
-
-double SimLink::now() const {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-}
-
-void SimLink::start() {
-  if (!thread_.joinable()) thread_ = std::jthread([this](std::stop_token s) { run(s); });
-}
-
-void SimLink::stop() {
-  if (!thread_.joinable()) return;
-  thread_.request_stop();
-  thread_.join();
-}
 
 void SimLink::run(std::stop_token stop) {
   const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
@@ -85,22 +69,6 @@ void SimLink::run(std::stop_token stop) {
     }
     if (log_) log_command(*log_, "robot", seq, command, measured);
   }
-}
-
-void SimLink::set_target(const Eigen::VectorXd& joints, bool safe) {
-  const std::string problem = supervisor_.target_problem(joints, safe);
-  std::lock_guard lock(mutex_);
-  supervisor_.set_target(joints, problem);
-}
-
-bool SimLink::arm(std::string* why_not) {
-  std::lock_guard lock(mutex_);
-  return supervisor_.arm(now(), why_not);
-}
-
-void SimLink::disarm(const std::string& reason) {
-  std::lock_guard lock(mutex_);
-  supervisor_.disarm(reason);
 }
 
 LinkStatus SimLink::status() const {
