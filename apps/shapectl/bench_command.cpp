@@ -66,8 +66,8 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
   // 1. Reduced gradient, each method at the same states x̂(θ), each right after the statics
   // solve that reached θ from the reference shape. "reused": the true Hessian at x̂ is already
   // factored, as in an optimizer, which factors it to confirm an accepted state is stable
-  // (or as the last Newton step of a solve leaves it). "factored": that factorization is
-  // counted. "Newton": finite differences whose re-solves factor anew (no chord steps), the
+  // (or as the last Newton step of a solve leaves it). "counted": that factorization is part
+  // of the timed gradient. "Newton": finite differences whose re-solves factor anew (no chord steps), the
   // paper's baseline.
   enum class Factor { Reused, Counted, NewtonResolves, ChordResolves };
   std::vector<double> t_sens, t_sens_factored, t_adj, t_adj_factored, t_fd_chord, t_fd_newton;

@@ -114,7 +114,12 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
 }
 
 Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& rhs) const {
-  return solve(Eigen::MatrixXd(rhs)).col(0);
+  switch (backend_) {
+    case Backend::Band: return impl_->band.solve(rhs).col(0);
+    case Backend::CholmodSupernodal: return impl_->cholmod.solve(rhs);
+    case Backend::SimplicialLDLT: break;
+  }
+  return impl_->ldlt.solve(rhs);
 }
 
 }  // namespace shapectl

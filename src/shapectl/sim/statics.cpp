@@ -153,7 +153,7 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
         if (std::isfinite(e_trial) && e_trial <= e + 1e-12 * std::abs(e)) {
           Eigen::VectorXd g_trial = gradient(trial);
           const double r_trial = max_force(g_trial);
-          if (r_trial <= options_.chord_contraction * residual) {
+          if (r_trial <= 0.25 * residual) {
             log.chord = true;
             log.step_length = 1;
             for (int i = 0; i < node_count_; ++i) log.step = std::max(log.step, dx.segment<3>(3 * i).norm());

@@ -24,8 +24,6 @@ struct StaticsOptions {
   int max_iterations = 100;
   // Try a step with the last true-Hessian factorization before factoring anew (see newton()).
   bool chord_steps = true;
-  // A chord step is kept if it cuts the largest nodal force at least this much.
-  double chord_contraction = 0.25;
   // Which sparse Cholesky; by default chosen by system size (SparseCholesky::choose).
   std::optional<SparseCholesky::Backend> backend;
 };
