@@ -26,16 +26,18 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build build -j "$(nproc)"
-
-# ---- web: the browser GUI's packages (three.js, playwright-core) from web/package-lock.json ----
-if ! command -v npm >/dev/null; then
+# Node.js and npm by command, not by Debian package: a machine may carry another build of
+# Node.js (NodeSource's bundles npm and conflicts with Debian's npm package).
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then
   sudo_cmd=""
   [ "$(id -u)" -ne 0 ] && sudo_cmd="sudo"
+  echo "setup: installing nodejs npm"
   $sudo_cmd apt-get update -q
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -q --no-install-recommends nodejs npm
 fi
+
+# ---- web: the browser GUI's packages (three.js, playwright-core) from web/package-lock.json ----
+# Before CMake configures: it registers the browser tests only when node and these are present.
 # npm ci only when the lock file changed since the last install (stamp inside node_modules).
 lock_sum="$(sha256sum web/package-lock.json | cut -d' ' -f1)"
 if [ "$(cat web/node_modules/.shapectl-lock-sha256 2>/dev/null)" != "$lock_sum" ]; then
@@ -43,3 +45,11 @@ if [ "$(cat web/node_modules/.shapectl-lock-sha256 2>/dev/null)" != "$lock_sum" 
   (cd web && npm ci --no-audit --no-fund)
   echo "$lock_sum" > web/node_modules/.shapectl-lock-sha256
 fi
+
+# CMake's progress lines are dropped; its warnings and errors are shown.
+if ! configure_log=$(cmake -S . -B build -DCMAKE_BUILD_TYPE=Release 2>&1); then
+  echo "$configure_log" >&2
+  exit 1
+fi
+grep -v -e '^-- ' -e '^$' <<<"$configure_log" >&2 || true
+cmake --build build -j "$(nproc)"

@@ -12,6 +12,7 @@
 #include <shapectl/control/optimize.hpp>
 
 #include "commands.hpp"
+#include "result_json.hpp"
 
 namespace shapectl::cli {
 
@@ -54,6 +55,7 @@ bool random_goal(ReducedObjective& objective, const Evaluation& reference, std::
 
 void bench_scene(const std::string& file, const BenchArgs& args) {
   const Scene scene = load_scene(file);
+  print_scene_notes(scene);
   if (!scene.robot) throw InputError(file, "robot", "a scene with a robot (missing key)");
   GrippedObject object(scene);
   ReducedObjective objective(object);

@@ -14,6 +14,7 @@ class SolverFailure : public std::runtime_error {
 
 void add_statics_command(CLI::App& app);
 void add_kinematics_command(CLI::App& app);
+void add_author_command(CLI::App& app);
 void add_solve_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_serve_command(CLI::App& app);    // server area (GUI)

@@ -1,20 +1,21 @@
 // shapectl kinematics ROBOT.urdf [--joints JOINTS.json] [--spheres SPHERES.json] --out OUT.json
 // Link poses at one configuration, and optionally self-collision clearances and limit checks.
-#include <cmath>
-#include <fstream>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_input.hpp>
+#include <shapectl/io/json_output.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/joint_limits.hpp>
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/robot/robot_model.hpp>
 
 #include "commands.hpp"
+#include "result_json.hpp"
 
 namespace shapectl::cli {
 
@@ -63,9 +64,9 @@ nlohmann::ordered_json collision_json(const RobotModel& robot, const CollisionMo
          {"clearance", pair.clearance}});
   }
   nlohmann::ordered_json out;
+  // +inf when no sphere pair is checked: then there is no clearance to report.
   const double min_clearance = collision.min_clearance(state);
-  out["min_clearance"] = std::isfinite(min_clearance) ? nlohmann::ordered_json(min_clearance)
-                                                      : nlohmann::ordered_json(nullptr);
+  if (min_clearance != std::numeric_limits<double>::infinity()) out["min_clearance"] = min_clearance;
   out["margin"] = collision.margin();
   out["closest_pairs"] = closest;
   return out;
@@ -96,10 +97,8 @@ void run(const KinematicsOptions& options) {
     violations.push_back({{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
 
-  std::ofstream file(options.out);
-  if (!file) throw InputError(options.out, "", "cannot write file");
-  file << out.dump(2) << "\n";
-  if (!file) throw InputError(options.out, "", "cannot write file");
+  require_finite(out, "kinematics", "");
+  write_json_file(options.out, out);
 }
 
 }  // namespace

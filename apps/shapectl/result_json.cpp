@@ -1,7 +1,11 @@
 #include "result_json.hpp"
 
-#include <shapectl/io/json_input.hpp>
+#include <iostream>
+
+#include <shapectl/io/json_output.hpp>
+#include <shapectl/robot/joints_file.hpp>
 #include <shapectl/robot/kinematics.hpp>
+#include <shapectl/sim/scene_checks.hpp>
 
 namespace shapectl::cli {
 
@@ -21,19 +25,32 @@ nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints) {
   return out;
 }
 
+void print_scene_notes(const Scene& scene) {
+  for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
+  if (scene.robot)
+    for (const auto& line : describe_grips(scene)) std::cerr << line << "\n";
+}
+
+namespace {
+template <class Json>
+void require_finite_numbers(const Json& result, const std::string& what, const std::string& context) {
+  if (const auto where = first_non_finite(result))
+    throw SolverFailure(what + ": " + (where->empty() ? "the result" : *where) + " is not finite" +
+                        (context.empty() ? "" : " (" + context + ")") + "; nothing written");
+}
+}  // namespace
+
+void require_finite(const nlohmann::json& result, const std::string& what, const std::string& context) {
+  require_finite_numbers(result, what, context);
+}
+void require_finite(const nlohmann::ordered_json& result, const std::string& what,
+                    const std::string& context) {
+  require_finite_numbers(result, what, context);
+}
+
 Eigen::VectorXd read_joints_file(const std::string& file, const RobotModel& robot,
                                  const Eigen::VectorXd& defaults) {
-  const JsonInput root = JsonInput::load(file);
-  root.expect_only({"joints"});
-  const JsonInput joints = root.at("joints");
-  Eigen::VectorXd theta = defaults;
-  for (const auto& name : joints.keys()) {
-    const auto joint = robot.find_joint(name);
-    if (!joint || robot.active_index(*joint) < 0)
-      joints.at(name).fail_problem("not an active joint of the robot");
-    theta[robot.active_index(*joint)] = joints.at(name).number();
-  }
-  return theta;
+  return load_joints_file(file, robot, defaults);
 }
 
 }  // namespace shapectl::cli

@@ -5,10 +5,20 @@
 
 #include <shapectl/sim/scene.hpp>
 
+#include "commands.hpp"
+
 namespace shapectl::cli {
 
 // {"joints": {name: rad}, "tools": {ee name: {"position": [..], "rotation": [[..]..]}}}
 nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints);
+// Throws SolverFailure ("<what>: <field> is not finite (<context>)") if any number in `result` is
+// NaN or infinite: JSON would write it as null, and a result is never written with one.
+void require_finite(const nlohmann::json& result, const std::string& what, const std::string& context);
+void require_finite(const nlohmann::ordered_json& result, const std::string& what,
+                    const std::string& context);
+// The scene's warnings ("warning: <file>: <field>: ...") and the nodes each grip caught, one line
+// each, on stderr: the traps a user must see before trusting a result.
+void print_scene_notes(const Scene& scene);
 // θ from JOINTS.json {"joints": {name: rad}}; joints not named keep `defaults`.
 Eigen::VectorXd read_joints_file(const std::string& file, const RobotModel& robot,
                                  const Eigen::VectorXd& defaults);

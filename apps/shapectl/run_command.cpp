@@ -19,6 +19,7 @@
 #include <shapectl/link/stop_signal.hpp>
 
 #include "commands.hpp"
+#include "result_json.hpp"
 
 namespace shapectl::cli {
 
@@ -48,6 +49,8 @@ nlohmann::json link_json(const LinkStatus& s) {
           {"commands_sent", s.commands_sent},
           {"rejected_datagrams", s.rejected_datagrams},
           {"lost_datagrams", s.lost_datagrams},
+          {"stale_datagrams", s.stale_datagrams},
+          {"foreign_datagrams", s.foreign_datagrams},
           {"commanded", to_list(s.commanded)},
           {"measured", to_list(s.measured)}};
 }
@@ -73,6 +76,7 @@ void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
 
 void run(RunArgs args) {
   const Scene scene = load_scene(args.scene);
+  print_scene_notes(scene);
   if (!scene.robot) throw InputError(args.scene, "robot", "run needs a scene with a robot");
   const TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
   args.link.watchdog_timeout = args.watchdog_ms / 1000;

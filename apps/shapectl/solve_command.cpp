@@ -1,13 +1,16 @@
-// shapectl solve SCENE.json --targets TARGETS.json --out RESULT.json
+// shapectl solve SCENE.json --targets TARGETS.json --out RESULT.json [--vtu DEFORMED.vtu]
 //   [--optimizer lbfgs|gauss-newton] [--gradient sensitivity|adjoint|finite-difference]
 //   [--max-iterations N] [--max-seconds S]
 // Finds joint angles whose equilibrium shape best matches the targets.
 #include <iostream>
+#include <limits>
 
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/control/targets_file.hpp>
+#include <shapectl/io/atomic_file.hpp>
 #include <shapectl/io/json_output.hpp>
+#include <shapectl/io/vtu_writer.hpp>
 
 #include "commands.hpp"
 #include "result_json.hpp"
@@ -17,24 +20,32 @@ namespace shapectl::cli {
 namespace {
 
 struct SolveArgs {
-  std::string scene, targets, out;
+  std::string scene, targets, out, vtu;
   std::string optimizer = "gauss-newton";
   std::string gradient = "sensitivity";
   int max_iterations = 100;
   double max_seconds = 60;
 };
 
+// The targets the file asks for, checked against this object (InputError naming the file).
 ShapeTargets resolve_targets(const TargetsInput& in, const std::string& file, GrippedObject& object) {
-  if (in.centerline.empty()) return in.targets;
+  if (in.centerline.empty()) {
+    check_targets(in.targets, object.node_count(), file);
+    return in.targets;
+  }
   const auto axis = find_bar_axis(object.mesh());
   if (!axis)
     throw InputError(file, "centerline", "an object that is bar-like (length ≥ 3 × thickness)",
                      "a " + std::to_string(object.mesh().node_count()) + "-node object that is not");
-  return centerline_targets(object.mesh(), *axis, in.centerline, object.reference_positions());
+  check_centerline(*axis, in.centerline, file);
+  ShapeTargets targets = centerline_targets(object.mesh(), *axis, in.centerline, object.reference_positions());
+  check_targets(targets, object.node_count(), file);  // the bar's offsets may still reach past the bound
+  return targets;
 }
 
 void run_solve(const SolveArgs& args) {
   const Scene scene = load_scene(args.scene);
+  print_scene_notes(scene);
   if (!scene.robot) throw InputError(args.scene, "robot", "a robot to optimize (missing key)");
   GrippedObject object(scene);
   const TargetsInput input = load_targets(args.targets, object.node_count());
@@ -61,7 +72,8 @@ void run_solve(const SolveArgs& args) {
   out["error_mean"] = best.error.mean;
   out["error_max"] = best.error.max;
   out["objective"] = best.objective;
-  out["min_clearance"] = best.min_clearance;
+  // +inf without collision spheres: nothing to report (JSON has no infinity).
+  if (best.min_clearance != std::numeric_limits<double>::infinity()) out["min_clearance"] = best.min_clearance;
   nlohmann::json violations = nlohmann::json::array();
   const KinematicsState state = forward_kinematics(object.robot(), best.joints);
   for (const auto& v : limit_violations(object.robot(), state.joints))
@@ -80,7 +92,16 @@ void run_solve(const SolveArgs& args) {
   const ObjectiveTiming& t = objective.timing();
   out["timing"] = {{"statics_solves", t.statics_solves}, {"statics_seconds", t.statics_seconds},
                    {"gradient_evaluations", t.gradient_evaluations}, {"gradient_seconds", t.gradient_seconds}};
-  write_json_file(args.out, out);
+  require_finite(out, "solve", result.reason);
+  // With --vtu both files or neither.
+  std::vector<FileContent> files = {{args.out, to_pretty_json(out)}};
+  if (!args.vtu.empty()) {
+    std::vector<std::array<int, 4>> tets;
+    for (const auto& t : object.mesh().tets()) tets.push_back(t.nodes);
+    const Positions rest = scene.world_rest_positions();
+    files.push_back({args.vtu, vtu_text(best.positions, tets, {{"displacement", best.positions - rest}})});
+  }
+  write_files_atomically(files);
   std::cerr << "solve: " << result.reason << "; mean error " << best.error.mean * 1e3 << " mm, max "
             << best.error.max * 1e3 << " mm, min clearance " << best.min_clearance * 1e3 << " mm\n";
 }
@@ -93,6 +114,7 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
   cmd->add_option("--targets", args->targets, "TARGETS.json")->required();
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
+  cmd->add_option("--vtu", args->vtu, "also write the deformed mesh at the best joints as VTU (ParaView)");
   cmd->add_option("--optimizer", args->optimizer, "gauss-newton (default) or lbfgs")
       ->check(CLI::IsMember({"gauss-newton", "lbfgs"}));
   cmd->add_option("--gradient", args->gradient, "sensitivity (default), adjoint or finite-difference")

@@ -3,6 +3,7 @@
 // joints) and writes the deformed positions.
 #include <iostream>
 
+#include <shapectl/io/atomic_file.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/io/vtu_writer.hpp>
 #include <shapectl/sim/gripped_object.hpp>
@@ -21,6 +22,8 @@ struct StaticsArgs {
   std::string vtu;
 };
 
+// Writes RESULT.json (and the VTU) even when Newton failed, so the failure can be inspected,
+// but never with a non-finite number, and with --vtu both files or neither.
 void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMesh& mesh,
                    const Positions& rest, const Positions& x, nlohmann::json result) {
   result["converged"] = r.converged();
@@ -30,12 +33,14 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMes
   result["residual"] = r.residual;
   result["energy"] = r.energy;
   result["positions"] = positions_to_json(x);
-  write_json_file(args.out, result);
+  require_finite(result, "statics", r.reason);
+  std::vector<FileContent> files = {{args.out, to_pretty_json(result)}};
   if (!args.vtu.empty()) {
     std::vector<std::array<int, 4>> tets;
     for (const auto& t : mesh.tets()) tets.push_back(t.nodes);
-    write_vtu(args.vtu, x, tets, {{"displacement", x - rest}});
+    files.push_back({args.vtu, vtu_text(x, tets, {{"displacement", x - rest}})});
   }
+  write_files_atomically(files);
   std::cerr << "statics: " << r.reason << " (" << mesh.tet_count() << " tets, " << mesh.node_count()
             << " nodes)\n";
   if (!r.converged()) throw SolverFailure(r.reason);
@@ -43,6 +48,7 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMes
 
 void run_statics(const StaticsArgs& args) {
   const Scene scene = load_scene(args.scene);
+  print_scene_notes(scene);
   const Positions rest = scene.world_rest_positions();
   Positions x = rest;
   if (!scene.robot) {

@@ -159,5 +159,34 @@ TEST(KinematicsCli, SphereFileErrorsNameTheFileAndTheLink) {
                ignore.string() + ": ignore_pairs[0]: expected a pair of link names");
 }
 
+// Issue 10: a name with an invalid UTF-8 byte made the JSON writer throw (exit 3) after the old
+// result was truncated. Now the byte is written as U+FFFD and the result replaces the old one
+// only once complete.
+TEST(KinematicsCli, InvalidUtf8InALinkNameIsWrittenNotThrown) {
+  const TempDir dir;
+  std::string text = kArmUrdf;
+  text.replace(text.find("name=\"upper\""), 12, "name=\"upp\xff\xfer\"");
+  text.replace(text.find("child link=\"upper\""), 18, "child link=\"upp\xff\xfer\"");
+  const auto urdf = dir.write("utf.urdf", text);
+  const auto out = dir.write("out.json", "precious");
+  const test::CliRun run = run_cli({"kinematics", urdf.string(), "--out", out.string()});
+  ASSERT_NE(run.exit_code, 3) << run.err;
+  if (run.exit_code == 0) {
+    const auto json = nlohmann::json::parse(test::read_text(out));
+    EXPECT_TRUE(json["links"].contains("upp\xef\xbf\xbd\xef\xbf\xbdr")) << json.dump();
+  } else {
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_EQ(test::read_text(out), "precious");
+  }
+}
+
+TEST(KinematicsCli, OutThatIsADirectoryIsNamed) {
+  const TempDir dir;
+  dir.write("out.json/keep.txt", "kept");
+  const auto out = dir.path() / "out.json";
+  expect_error({"kinematics", kYumi, "--out", out.string()}, out.string() + ": cannot write: it is a directory");
+  EXPECT_EQ(test::read_text(out / "keep.txt"), "kept");
+}
+
 }  // namespace
 }  // namespace shapectl

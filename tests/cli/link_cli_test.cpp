@@ -111,6 +111,8 @@ TEST(RunCli, EgmRobotThroughEgmSimSettlesWithinTheLimits) {
   EXPECT_TRUE(result["settled"].get<bool>());
   EXPECT_EQ(result["link"]["kind"], "egm");
   EXPECT_EQ(result["link"]["rejected_datagrams"], 0);
+  EXPECT_EQ(result["link"]["foreign_datagrams"], 0);  // egm-sim sends each arm from one socket
+  EXPECT_EQ(result["link"]["stale_datagrams"], 0);
   EXPECT_GT(result["latency_us"]["samples"].get<int>(), 100);
 
   ASSERT_EQ(sim_exit, 0);

@@ -3,6 +3,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <sstream>
+
 #include "support/test_support.hpp"
 
 namespace shapectl {
@@ -50,6 +52,52 @@ TEST(SolveCli, ReachesTargetsTakenFromAnotherConfiguration) {
   EXPECT_GT(result["timing"]["gradient_seconds"].get<double>(), 0);
 }
 
+TEST(SolveCli, ASolveResultIsAcceptedAsJointsByStatics) {
+  TempDir dir;
+  const auto reference = run_json({"statics", kBar, "--out", (dir.path() / "ref.json").string()}, dir.path() / "ref.json");
+  nlohmann::json targets = nlohmann::json::array();
+  for (int i = 0; i < 425; i += 53) {
+    nlohmann::json p = reference["positions"][i];
+    p[2] = p[2].get<double>() + 0.01;  // lift the bar by 1 cm
+    targets.push_back({{"node", i}, {"position", p}});
+  }
+  const auto targets_file = dir.write("targets.json", nlohmann::json{{"targets", targets}}.dump());
+  const auto solved = dir.path() / "solve.json";
+  const auto vtu = dir.path() / "solve.vtu";
+  const auto result = run_json({"solve", kBar, "--targets", targets_file.string(), "--out", solved.string(),
+                                "--vtu", vtu.string()}, solved);
+  // solve --vtu: the deformed mesh at the best joints, the result's positions exactly.
+  const std::string vtu_text = test::read_text(vtu);
+  EXPECT_NE(vtu_text.find("<VTKFile type=\"UnstructuredGrid\""), std::string::npos);
+  EXPECT_NE(vtu_text.find("NumberOfPoints=\"425\""), std::string::npos);
+  EXPECT_NE(vtu_text.find("NumberOfCells=\"1536\""), std::string::npos);
+  {
+    const std::size_t points = vtu_text.find("<Points>");
+    ASSERT_NE(points, std::string::npos);
+    std::istringstream in(vtu_text.substr(vtu_text.find('>', vtu_text.find("<DataArray", points)) + 1));
+    double x = 0, y = 0, z = 0;
+    in >> x >> y >> z;
+    EXPECT_EQ(x, result["positions"][0][0].get<double>());
+    EXPECT_EQ(z, result["positions"][0][2].get<double>());
+  }
+  // Its joints reproduce its shape.
+  const auto again = run_json({"statics", kBar, "--joints", solved.string(), "--out",
+                               (dir.path() / "again.json").string()}, dir.path() / "again.json");
+  ASSERT_TRUE(again["converged"].get<bool>());
+  EXPECT_EQ(again["joints"], result["joints"]);
+  double largest = 0;
+  for (std::size_t i = 0; i < 425; ++i)
+    for (std::size_t d = 0; d < 3; ++d)
+      largest = std::max(largest, std::abs(again["positions"][i][d].get<double>() -
+                                           result["positions"][i][d].get<double>()));
+  EXPECT_LT(largest, 1e-6);
+  // A hand-written joints file keeps its typo check.
+  const auto typo = dir.write("typo.json", R"({"joints": {}, "jionts": {}})");
+  const auto bad = run_cli({"statics", kBar, "--joints", typo.string(), "--out", (dir.path() / "x.json").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("jionts"), std::string::npos) << bad.err;
+}
+
 TEST(SolveCli, CentreLineIsFollowedOnTheBar) {
   TempDir dir;
   // A gentle arc through the bar's current ends (y = ±0.16), bulging up by 3 cm.
@@ -89,6 +137,38 @@ TEST(SolveCli, CentreLineOnAnObjectThatIsNotBarLikeIsBadInput) {
   const auto run = run_cli({"solve", kFrame, "--targets", file.string(), "--out", (dir.path() / "r.json").string()});
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("line.json: centerline: expected an object that is bar-like"), std::string::npos) << run.err;
+}
+
+// Issue 10: a centre-line of points within 1e-12 m gave NaN targets and exit 0 with nulls.
+TEST(SolveCli, DegenerateCentreLineIsBadInputNamingTheCentreLine) {
+  TempDir dir;
+  const auto out = dir.write("r.json", "precious");
+  for (const std::string line : {R"({"centerline": [[0.39, 0, 0.25], [0.39, 1e-13, 0.25], [0.39, 0, 0.2500000000001]]})",
+                                 R"({"centerline": [[0.39, 0, 0.25], [0.39, 0.00001, 0.25]]})"}) {
+    const auto file = dir.write("line.json", line);
+    const auto run = run_cli({"solve", kBar, "--targets", file.string(), "--out", out.string()});
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find("line.json: centerline: expected a polyline of at least 2 distinct points"),
+              std::string::npos) << run.err;
+    EXPECT_EQ(test::read_text(out), "precious");
+  }
+}
+
+// Issue 10: a target at 1e155 said "converged" with error_mean null; −1e300 crashed L-BFGS.
+TEST(SolveCli, AbsurdTargetsAreRefusedWithoutCrashOrNull) {
+  TempDir dir;
+  const auto out = dir.write("r.json", "precious");
+  for (const std::string optimizer : {"gauss-newton", "lbfgs"})
+    for (const std::string position : {"[1e155, 0, 0.2]", "[0.4, -1e300, 0.2]", "[0.4, 0, 1000.5]"}) {
+      const auto file = dir.write("t.json", R"({"targets": [{"node": 3, "position": [0.4, 0, 0.25]}, {"node": 7, "position": )" +
+                                                position + "}]}");
+      const auto run = run_cli({"solve", kBar, "--targets", file.string(), "--out", out.string(), "--optimizer",
+                                optimizer, "--max-iterations", "3"});
+      EXPECT_EQ(run.exit_code, 1) << run.err;
+      EXPECT_NE(run.err.find("t.json: targets[1].position: expected a"), std::string::npos) << run.err;
+      EXPECT_NE(run.err.find("1000 m"), std::string::npos) << run.err;
+      EXPECT_EQ(test::read_text(out), "precious");
+    }
 }
 
 TEST(StaticsCli, UnknownJointInJointsFileIsNamed) {

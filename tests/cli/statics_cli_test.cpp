@@ -1,6 +1,9 @@
 // The `shapectl statics` contract: result file, exit codes and error messages.
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
+#include <csignal>
 #include <nlohmann/json.hpp>
 
 #include "support/test_support.hpp"
@@ -151,7 +154,79 @@ TEST(StaticsCli, UnheldObjectIsASolverFailure) {
   EXPECT_FALSE(result["converged"].get<bool>());
 }
 
+// Lowers the file size limit of this process (and the CLI it starts) for a scope: a result
+// write then fails half-way with EFBIG (shapectl ignores SIGXFSZ).
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t bytes) {
+    getrlimit(RLIMIT_FSIZE, &saved_);
+    previous_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    rlimit limit = saved_;
+    limit.rlim_cur = bytes;
+    setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &saved_);
+    std::signal(SIGXFSZ, previous_handler_);
+  }
+
+ private:
+  rlimit saved_{};
+  void (*previous_handler_)(int) = nullptr;
+};
+
+int entries(const std::filesystem::path& dir) {
+  return static_cast<int>(std::distance(std::filesystem::directory_iterator(dir), {}));
+}
+
+// The run computes a converged result, then its write fails half-way (the result is larger
+// than the file size limit): the old result stays byte for byte, no temporary is left.
 TEST(StaticsCli, FailedRunLeavesAnExistingResultIntact) {
+  TempDir dir;
+  const auto scene = dir.write("bar.json", kBarScene);
+  const std::string precious = "{\"precious\": [1, 2, 3]}\n";
+  const auto out = dir.write("r.json", precious);
+  test::CliRun run;
+  {
+    const FileSizeLimit limit(1024);
+    run = run_cli({"statics", scene.string(), "--out", out.string()});
+  }
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find(out.string() + ": cannot write: writing"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("File too large"), std::string::npos) << run.err;
+  EXPECT_EQ(test::read_text(out), precious);
+  EXPECT_EQ(entries(dir.path()), 2);  // bar.json and r.json: no temporary left
+}
+
+TEST(StaticsCli, VtuIntoAMissingFolderLeavesOutUntouched) {
+  TempDir dir;
+  const auto scene = dir.write("bar.json", kBarScene);
+  const std::string precious = "precious\n\x01\xff";
+  const auto out = dir.write("r.json", precious);
+  const auto vtu = dir.path() / "missing" / "bar.vtu";
+  const auto run = run_cli({"statics", scene.string(), "--out", out.string(), "--vtu", vtu.string()});
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find(vtu.string() + ": cannot write: directory '" + vtu.parent_path().string() +
+                         "' does not exist"),
+            std::string::npos)
+      << run.err;
+  EXPECT_EQ(test::read_text(out), precious);
+  EXPECT_EQ(entries(dir.path()), 2);
+}
+
+TEST(StaticsCli, OutThatIsADirectoryIsNamed) {
+  TempDir dir;
+  const auto scene = dir.write("bar.json", kBarScene);
+  dir.write("r.json/keep.txt", "kept");
+  const auto out = dir.path() / "r.json";
+  const auto run = run_cli({"statics", scene.string(), "--out", out.string()});
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find(out.string() + ": cannot write: it is a directory"), std::string::npos) << run.err;
+  EXPECT_EQ(test::read_text(out / "keep.txt"), "kept");
+  EXPECT_EQ(entries(dir.path()), 2);
+}
+
+TEST(StaticsCli, MissingSceneLeavesAnExistingResultIntact) {
   TempDir dir;
   const auto out = dir.write("r.json", "precious");
   const auto run = run_cli({"statics", (dir.path() / "missing.json").string(), "--out", out.string()});

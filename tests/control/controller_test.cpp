@@ -99,6 +99,36 @@ TEST(Centerline, StraightSketchAlongTheBarTargetsItsCentreNodes) {
   EXPECT_NEAR((longer.positions.back() - longer.positions.front()).norm(), 2 * axis->length, 1e-9);
 }
 
+TEST(Centerline, DegenerateSketchesAreRefusedNamingTheCentreLine) {
+  const Scene scene = test::two_arm_scene({24, 2, 2});
+  GrippedObject object(scene);
+  const auto axis = find_bar_axis(object.mesh());
+  ASSERT_TRUE(axis.has_value());
+  const Vec3 a = axis->center;
+  const std::vector<std::vector<Vec3>> bad = {
+      {a, a + Vec3(1e-13, 0, 0), a + Vec3(0, 1e-13, 0)},   // points within 1e-12 m: one point
+      {a, a + Vec3(1e-5, 0, 0)},                           // 10 µm: far below the bar's scale
+      {a, a + Vec3(1e155, 0, 0)},                          // absurd and
+      {a, a - Vec3(0, 0, 1e300)},
+      {a, Vec3(0, NAN, 0)},                                // non-finite points
+      {a}};
+  for (const auto& sketch : bad) {
+    try {
+      centerline_targets(object.mesh(), *axis, sketch, object.reference_positions());
+      ADD_FAILURE() << "accepted a sketch of " << sketch.size() << " points";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("centerline"), std::string::npos) << e.what();
+    }
+  }
+  Controller controller(scene);
+  EXPECT_THROW(controller.set_centerline(bad[0]), InputError);
+  EXPECT_THROW(controller.set_centerline(bad[2]), InputError);
+  // A sketch a few millimetres long is short but has a direction: accepted, all finite.
+  const ShapeTargets t = centerline_targets(object.mesh(), *axis, {a, a + Vec3(0.005, 0, 0)},
+                                            object.reference_positions());
+  for (const auto& p : t.positions) EXPECT_TRUE(p.allFinite());
+}
+
 TEST(Centerline, CubeIsNotBarLike) {
   EXPECT_FALSE(find_bar_axis(make_box_mesh({0.1, 0.1, 0.1}, {2, 2, 2})).has_value());
 }

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 #include <random>
 
@@ -95,6 +97,80 @@ TEST_P(OptimizeTest, UnreachableTargetsGiveAnHonestBestEffort) {
   EXPECT_GT(result.best.error.mean, 4.0);
   EXPECT_LE(result.best.objective, start.objective);
   EXPECT_FALSE(result.reason.empty());
+}
+
+// The crash of issue 10: a non-finite objective (here an overflowing or NaN shape weight; from
+// files, a target at 1e155 m did it) reached L-BFGS's restart, which read the gradient it had
+// just cleared. Now no optimizer steps, and none says "converged".
+TEST_P(OptimizeTest, NonFiniteObjectiveNeitherCrashesNorConverges) {
+  for (const double weight : {1e305, std::numeric_limits<double>::quiet_NaN()}) {
+    Scene scene = test::two_arm_scene();
+    scene.weights.shape = weight;
+    GrippedObject object(scene);
+    ReducedObjective objective(object);
+    ShapeTargets t;
+    t.nodes = {0, 10, 20};
+    t.positions = {Vec3(1000, 0, 0), Vec3(0, -1000, 0), Vec3(0, 0, 1000)};
+    objective.set_targets(t);
+    const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
+    ASSERT_TRUE(start.statics.converged());
+    ASSERT_FALSE(std::isfinite(start.objective)) << "the test needs a non-finite objective";
+    for (const GradientMethod method : {GradientMethod::Sensitivity, GradientMethod::Adjoint}) {
+      auto optimizer = make_optimizer(GetParam(), method);
+      Evaluation current = start;
+      EXPECT_EQ(optimizer->step(objective, current), StepOutcome::Stuck) << weight;
+      EXPECT_EQ(current.joints, start.joints);
+      const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 5});
+      EXPECT_FALSE(result.converged) << result.reason;
+      EXPECT_NE(result.reason.find("not finite"), std::string::npos) << result.reason;
+      EXPECT_EQ(result.best.joints, start.joints);
+    }
+  }
+}
+
+// The time budget in simulated time: the clock is the work done so far (statics solves plus
+// gradients). Every solve and gradient is preceded by a budget check, so the work ends at most
+// one unit past the budget, whatever the budget and wherever in a step it runs out.
+TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
+  const Scene scene = test::two_arm_scene();
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  std::mt19937 rng(5);
+  Eigen::VectorXd goal = object.reference_joints();
+  goal << 0.2, -0.5, 1.2, -0.2, -0.1, 0.7;
+  const Evaluation at_goal = objective.evaluate(goal, object.reference_positions());
+  ASSERT_TRUE(at_goal.statics.converged());
+  objective.set_targets(targets_from_shape(at_goal.positions, 12, rng));
+  const ShapeTargets targets = objective.targets();
+  // Each run from scratch, so every run takes the same path until its budget runs out.
+  auto run = [&](double max_seconds, double* work_done) {
+    GrippedObject fresh_object(scene);
+    ReducedObjective fresh(fresh_object);
+    fresh.set_targets(targets);
+    const Evaluation start = fresh.evaluate(fresh_object.reference_joints(), fresh_object.reference_positions());
+    const ObjectiveTiming before = fresh.timing();
+    auto work = [&] {
+      const ObjectiveTiming& now = fresh.timing();
+      return static_cast<double>(now.statics_solves - before.statics_solves + now.gradient_evaluations -
+                                 before.gradient_evaluations);
+    };
+    auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
+    const OptimizeResult result =
+        optimize(fresh, *optimizer, start, {.max_iterations = 1000, .max_seconds = max_seconds, .clock = work});
+    *work_done = work();
+    return result;
+  };
+  double unlimited = 0;
+  const OptimizeResult full = run(1e9, &unlimited);
+  ASSERT_TRUE(full.converged) << full.reason;
+  ASSERT_GE(unlimited, 6) << "too little work to cut short";
+  for (int budget = 0; budget + 2 < unlimited && budget < 40; ++budget) {
+    double work = 0;
+    const OptimizeResult result = run(budget + 0.5, &work);
+    EXPECT_EQ(result.reason, "time limit reached") << "budget " << budget;
+    EXPECT_FALSE(result.converged);
+    EXPECT_LE(work, budget + 1) << "budget " << budget;
+  }
 }
 
 INSTANTIATE_TEST_SUITE_P(BothOptimizers, OptimizeTest,

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
+
+#include <shapectl/io/input_error.hpp>
 
 #include "support/derivative_check.hpp"
 #include "support/two_arm_scene.hpp"
@@ -109,6 +112,36 @@ TEST(ReducedObjective, ConfirmStableRejectsAStateWhoseHessianIsIndefinite) {
   EXPECT_EQ(squeezed.statics.status, StaticsStatus::Unstable);
   EXPECT_FALSE(std::isfinite(squeezed.objective));
   EXPECT_FALSE(squeezed.safe());
+}
+
+TEST(ReducedObjective, AbsurdTargetsAreRefusedNamingTheTargetAndChangeNothing) {
+  GrippedObject object(test::two_arm_scene());
+  ReducedObjective objective(object);
+  ShapeTargets good;
+  good.nodes = {0, 5};
+  good.positions = {Vec3(0.1, 0, 0.2), Vec3(0.2, 0, 0.2)};
+  objective.set_targets(good);
+  const std::vector<std::pair<ShapeTargets, std::string>> bad = {
+      {{{0, 5}, {Vec3(0, 0, 0), Vec3(1e155, 0, 0)}},
+       "targets: targets[1].position: expected a finite point within 1000 m of the origin, got [1e+155, 0, 0]"},
+      {{{0}, {Vec3(0, -1e300, 0)}}, "targets[0].position: expected a finite point within 1000 m"},
+      {{{0}, {Vec3(0, 0, NAN)}}, "targets[0].position: expected a finite point"},
+      {{{0}, {Vec3(1000.5, 0, 0)}}, "targets[0].position: expected a finite point within 1000 m"},
+      {{{object.node_count()}, {Vec3(0, 0, 0)}},
+       "targets[0].node: expected a node from 0 to " + std::to_string(object.node_count() - 1)},
+      {{{0, 1}, {Vec3(0, 0, 0)}}, "targets: expected as many positions as nodes"}};
+  for (const auto& [targets, message] : bad) {
+    try {
+      objective.set_targets(targets);
+      ADD_FAILURE() << "accepted: " << message;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(objective.targets().nodes, good.nodes);
+  }
+  // The bound itself is a valid target.
+  objective.set_targets({{0}, {Vec3(-1000, 1000, 0)}});
+  EXPECT_EQ(objective.targets().size(), 1);
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ struct Fixture {
     t += dt;
     if (with_feedback)
       for (int c = 0; c < 2; ++c) {
-        s.on_feedback(c, robot.segment(c, 1), "", t, dt);
+        s.on_feedback(c, robot.segment(c, 1), "", t);
         robot[c] = s.command(c)[0];
       }
     s.check_watchdog(t);
@@ -56,7 +56,7 @@ TEST(LinkSupervisor, ArmingNeedsFeedbackOnEveryChannel) {
   std::string why;
   EXPECT_FALSE(f.s.arm(0, &why));
   EXPECT_EQ(why, "a: no feedback");
-  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.0), "", 0.001, dt);
+  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.0), "", 0.001);
   EXPECT_FALSE(f.s.arm(0.001, &why));
   EXPECT_EQ(why, "b: no feedback");
 }
@@ -131,7 +131,7 @@ TEST(LinkSupervisor, RobotFaultDisarmsAndBlocksArming) {
   Fixture f;
   f.tick();
   ASSERT_TRUE(f.s.arm(f.t, nullptr));
-  f.s.on_feedback(1, Eigen::VectorXd::Constant(1, -0.2), "motors off", f.t + dt, dt);
+  f.s.on_feedback(1, Eigen::VectorXd::Constant(1, -0.2), "motors off", f.t + dt);
   EXPECT_EQ(f.s.status(f.t).reason, "b: motors off");
   std::string why;
   EXPECT_FALSE(f.s.arm(f.t, &why));
@@ -142,7 +142,7 @@ TEST(LinkSupervisor, TrackingErrorDisarms) {
   Fixture f;
   f.tick();
   ASSERT_TRUE(f.s.arm(f.t, nullptr));
-  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.6), "", f.t + dt, dt);
+  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.6), "", f.t + dt);
   EXPECT_FALSE(f.s.status(f.t).armed);
   EXPECT_EQ(f.s.status(f.t).reason, "a: tracking error 0.3 rad above 0.2 rad");
 }
@@ -170,6 +170,60 @@ TEST(LinkSupervisor, CollidingTargetIsRefusedAndCollidingCommandsAreNeverIssued)
   const LinkStatus st = f.s.status(f.t);
   EXPECT_FALSE(st.armed);
   EXPECT_NE(st.reason.find("commanded pose: collides"), std::string::npos) << st.reason;
+}
+
+TEST(LinkSupervisor, MeasuredBeyondTheHardLimitsGetsNoCommandAndCannotBeArmed) {
+  Fixture f;
+  f.target(Eigen::Vector2d(1, 1));
+  f.robot = Eigen::Vector2d(0.3, -2.05);  // joint 1 reported beyond its limit (-2)
+  for (int k = 0; k < 10; ++k) {
+    f.t += dt;
+    EXPECT_TRUE(f.s.on_feedback(0, f.robot.segment(0, 1), "", f.t).send);
+    EXPECT_FALSE(f.s.on_feedback(1, f.robot.segment(1, 1), "", f.t).send);
+  }
+  std::string why;
+  EXPECT_FALSE(f.s.arm(f.t, &why));
+  EXPECT_EQ(why, "b: j1 measured at -2.05 rad, outside its limits [-2, 2]: move it inside by hand first");
+  // Armed, then the robot reports a pose beyond the limits: disarmed, no command.
+  f.robot = Eigen::Vector2d(0.3, -0.2);
+  for (int k = 0; k < 10; ++k) f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, &why)) << why;
+  for (int k = 0; k < 50; ++k) f.tick();
+  f.t += dt;
+  EXPECT_FALSE(f.s.on_feedback(1, Eigen::VectorXd::Constant(1, 2.3), "", f.t).send);
+  EXPECT_FALSE(f.s.status(f.t).armed);
+  EXPECT_NE(f.s.status(f.t).reason.find("outside its limits"), std::string::npos);
+}
+
+TEST(LinkSupervisor, FromTheMarginCommandsOnlyMoveInwards) {
+  Fixture f;
+  f.robot = Eigen::Vector2d(1.95, -1.97);  // inside the limits (±2), outside the band (±1.9)
+  f.target(Eigen::Vector2d(2.0, -2.0));    // even a target at the limits is clamped to the band
+  f.tick();
+  std::string why;
+  ASSERT_TRUE(f.s.arm(f.t, &why)) << why;
+  Eigen::Vector2d prev = f.robot;
+  for (int k = 0; k < 500; ++k) {
+    f.tick();
+    EXPECT_LE(f.robot[0], prev[0]);
+    EXPECT_GE(f.robot[1], prev[1]);
+    prev = f.robot;
+  }
+  EXPECT_EQ(f.robot, Eigen::Vector2d(1.9, -1.9));
+}
+
+TEST(LinkSupervisor, FeedbackFasterThanTheClockHoldsInsteadOfStepping) {
+  Fixture f;
+  f.target(Eigen::Vector2d(1, 1));
+  f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  for (int k = 0; k < 100; ++k) f.tick();  // moving at full speed now
+  const double before = f.s.command(0)[0];
+  // 40 datagrams within 2 ms (a burst, a flood): at most one step.
+  int advanced = 0;
+  for (int k = 0; k < 40; ++k) advanced += f.s.on_feedback(0, f.s.command(0), "", f.t + 5e-5 * k).advanced;
+  EXPECT_LE(advanced, 1);
+  EXPECT_LE(std::abs(f.s.command(0)[0] - before), 0.5 * dt + 1e-12);
 }
 
 }  // namespace

@@ -46,6 +46,18 @@ TEST(HttpRules, HostMustBeLoopbackAnAddressOrTheBoundName) {
   EXPECT_FALSE(host_allowed("[::1", "127.0.0.1"));
 }
 
+TEST(HttpRules, HostMustBeAWellFormedNameQuadOrBracketedIpv6WithAPortInRange) {
+  for (const char* good : {"127.0.0.1", "0.0.0.0:1", "255.255.255.255:65535", "[::1]", "[fe80::1]:8080",
+                           "[::ffff:127.0.0.1]:80", "LOCALHOST:8080"})
+    EXPECT_TRUE(host_allowed(good, "127.0.0.1")) << good;
+  for (const char* bad : {"[evil.com]", "[evil.com]:8080", "999.999.999.999", "999.999.999.999:8080",
+                          "256.0.0.1", "1.2.3", "1.2.3.4.5", "01.2.3.4", "127.0.0.1:", "127.0.0.1:0",
+                          "127.0.0.1:65536", "127.0.0.1:80x", "[::1]x", "[::1]:", "[]", "localhost.",
+                          "local_host", "-robot:80", "robot-pc:99999", "a..b"})
+    EXPECT_FALSE(host_allowed(bad, "robot-pc")) << bad;
+  EXPECT_TRUE(host_allowed("robot-pc:8080", "robot-pc"));
+}
+
 TEST(HttpRules, OriginMustBeThePagesOwn) {
   EXPECT_TRUE(origin_allowed("", "127.0.0.1:8080"));
   EXPECT_TRUE(origin_allowed("http://127.0.0.1:8080", "127.0.0.1:8080"));

@@ -27,6 +27,13 @@ std::string error_of(const std::string& text) {
   return "";
 }
 
+TEST(Protocol, DegenerateCentrelineIsRefusedWithItsLength) {
+  EXPECT_NE(error_of(R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,1e-13,0.3],[0.4,2e-13,0.3]]})")
+                .find("points: expected a centre-line at least 1 mm long"),
+            std::string::npos);
+  EXPECT_EQ(error_of(R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,0.001,0.3]]})"), "");
+}
+
 TEST(Protocol, ParsesSetTargetWithItsId) {
   const Command c = parse_command(R"({"type":"set_target","id":7,"node":3,"position":[0.1,0.2,0.3]})", context());
   EXPECT_EQ(c.type, Command::Type::SetTarget);
@@ -59,6 +66,10 @@ TEST(Protocol, ErrorsSayWhereWhatWasExpectedAndWhatWasFound) {
   EXPECT_EQ(error_of(R"({"type":"set_paused","paused":1})"), "message: paused: expected true or false, got 1");
   EXPECT_EQ(error_of(R"({"type":"reset","extra":1})"), "message: extra: unknown key; known: type, id");
   EXPECT_EQ(error_of("{\"type\":"), "message: not valid JSON");
+  // A key given twice is an error, never silently the last one (the paused state would flip).
+  const std::string twice = error_of(R"({"type":"set_paused","paused":true,"paused":false})");
+  EXPECT_NE(twice.find("paused"), std::string::npos) << twice;
+  EXPECT_NE(twice.find("duplicate key"), std::string::npos) << twice;
   EXPECT_NE(error_of(R"({"type":"launch"})").find("message: type: expected one of ping, set_target"), std::string::npos);
 }
 

@@ -91,6 +91,34 @@ TEST_F(SessionTest, BadMessagesGetAnErrorReplyAndChangeNothing) {
   EXPECT_EQ(s->targets.nodes[0], 5);
 }
 
+// Issue 10, finding 5: a degenerate centre-line and absurd targets are refused; the session
+// keeps its target and no state message carries a null coordinate.
+TEST_F(SessionTest, DegenerateCentrelineAndAbsurdTargetsGetAnErrorAndChangeNothing) {
+  EXPECT_TRUE(session.handle(R"({"type":"set_target","node":5,"position":[0.4,0.0,0.3]})").ok);
+  wait_until(session, [](const ControllerSnapshot& s) { return s.targets.size() == 1; });
+  for (const char* bad :
+       {R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,1e-13,0.3],[0.4,2e-13,0.3]]})",
+        R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,0,0.3]]})",
+        R"({"type":"set_target","node":5,"position":[1e155,0,0]})",
+        R"({"type":"set_target","node":6,"position":[0,-1e300,0]})",
+        R"({"type":"set_targets","targets":[{"node":5,"position":[1e155,1e155,0]}]})",
+        R"({"type":"set_centerline","points":[[0.4,0,0.3],[1e155,0,0.3]]})"}) {
+    const auto r = session.handle(bad);
+    EXPECT_FALSE(r.ok) << bad;
+    EXPECT_EQ(reply_json(r)["type"], "error") << bad;
+  }
+  for (int k = 0; k < 5; ++k) {
+    session.tick();
+    const std::string state = session.state_message(1);
+    const auto m = nlohmann::json::parse(state);
+    ASSERT_EQ(m["targets"].size(), 1u);
+    EXPECT_EQ(m["targets"][0]["node"], 5);
+    EXPECT_TRUE(m["centerline"].empty());
+    for (const char* field : {"targets", "centerline", "joints", "links", "error"})
+      EXPECT_EQ(m[field].dump().find("null"), std::string::npos) << field << ": " << m[field].dump();
+  }
+}
+
 TEST_F(SessionTest, JoggingNeedsPauseAndArmingNeedsALink) {
   const auto jog = R"({"type":"set_joint","joint":0,"value":0.0})";
   EXPECT_FALSE(session.handle(jog).ok);

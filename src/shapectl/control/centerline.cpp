@@ -4,6 +4,9 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <sstream>
+
+#include <shapectl/io/input_error.hpp>
 
 namespace shapectl {
 
@@ -55,12 +58,38 @@ std::optional<BarAxis> find_bar_axis(const TetMesh& mesh) {
   return axis;
 }
 
-ShapeTargets centerline_targets(const TetMesh& mesh, const BarAxis& axis,
-                                const std::vector<Vec3>& polyline, const Positions& x) {
-  // Arc length at each polyline point; repeated points are dropped.
+namespace {
+// The sketch without repeated points: points closer than round-off of the bar's size to the
+// last one kept are merged (a segment that short would give a tangent of noise).
+std::vector<Vec3> distinct_points(const BarAxis& axis, const std::vector<Vec3>& polyline) {
+  const double merge = 1e-9 * axis.length;
   std::vector<Vec3> points;
   for (const auto& p : polyline)
-    if (points.empty() || (p - points.back()).norm() > 1e-12) points.push_back(p);
+    if (points.empty() || (p - points.back()).norm() > merge) points.push_back(p);
+  return points;
+}
+}  // namespace
+
+void check_centerline(const BarAxis& axis, const std::vector<Vec3>& polyline, const std::string& source) {
+  for (std::size_t k = 0; k < polyline.size(); ++k)
+    check_target_point(polyline[k], source, "centerline[" + std::to_string(k) + "]");
+  const std::vector<Vec3> points = distinct_points(axis, polyline);
+  double length = 0;
+  for (std::size_t k = 1; k < points.size(); ++k) length += (points[k] - points[k - 1]).norm();
+  const double shortest = min_centerline_fraction * axis.length;
+  if (points.size() < 2 || !(length >= shortest)) {
+    std::ostringstream need, found;
+    need << "a polyline of at least 2 distinct points, at least " << shortest << " m long ("
+         << min_centerline_fraction << " × the bar's length)";
+    found << points.size() << " distinct points, " << length << " m long";
+    throw InputError(source, "centerline", need.str(), found.str());
+  }
+}
+
+ShapeTargets centerline_targets(const TetMesh& mesh, const BarAxis& axis,
+                                const std::vector<Vec3>& polyline, const Positions& x) {
+  check_centerline(axis, polyline, "centerline");
+  const std::vector<Vec3> points = distinct_points(axis, polyline);
   std::vector<double> arc(points.size(), 0.0);
   for (std::size_t k = 1; k < points.size(); ++k) arc[k] = arc[k - 1] + (points[k] - points[k - 1]).norm();
   const double total = arc.back();

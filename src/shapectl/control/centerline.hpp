@@ -9,6 +9,7 @@
 // turned by the rotation that takes the rest axis onto the curve's local tangent. The bar end
 // nearer the sketch's first point maps to that point.
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <shapectl/control/shape_targets.hpp>
@@ -28,8 +29,16 @@ struct BarAxis {
 // The axis if the mesh is bar-like (length ≥ 3 × thickness), else nullopt.
 std::optional<BarAxis> find_bar_axis(const TetMesh& mesh);
 
-// Targets for the centre-line nodes of `mesh` (world-placed rest mesh) from a world polyline of
-// at least 2 distinct points. The current shape x decides which bar end maps to the start.
+// Throws InputError naming `source` and "centerline" unless `polyline` is a sketch this bar can
+// follow: every point finite and within max_target_distance, and an arc length of at least
+// min_centerline_fraction × the bar's length (shorter, a sketch has no shape: its direction is
+// round-off, and a bar squeezed onto it would be no shape at all).
+inline constexpr double min_centerline_fraction = 1e-3;
+void check_centerline(const BarAxis& axis, const std::vector<Vec3>& polyline, const std::string& source);
+
+// Targets for the centre-line nodes of `mesh` (world-placed rest mesh) from a world polyline
+// (checked with check_centerline; InputError with source "centerline" if it fails). The
+// current shape x decides which bar end maps to the start.
 ShapeTargets centerline_targets(const TetMesh& mesh, const BarAxis& axis,
                                 const std::vector<Vec3>& polyline, const Positions& x);
 

@@ -67,16 +67,7 @@ struct Controller::State {
 };
 
 void Controller::State::validate(const ShapeTargets& t) const {
-  const int n = object->node_count();
-  if (t.nodes.size() != t.positions.size())
-    throw InputError("targets", "", "as many positions as nodes");
-  for (std::size_t k = 0; k < t.nodes.size(); ++k) {
-    if (t.nodes[k] < 0 || t.nodes[k] >= n)
-      throw InputError("targets", "node " + std::to_string(t.nodes[k]),
-                       "out of range (mesh has " + std::to_string(n) + " nodes)");
-    if (!t.positions[k].allFinite())
-      throw InputError("targets", "node " + std::to_string(t.nodes[k]), "position is not finite");
-  }
+  check_targets(t, object->node_count(), "targets");
 }
 
 void Controller::State::apply(Inbox in) {
@@ -97,8 +88,16 @@ void Controller::State::apply(Inbox in) {
     centerline.clear();
   }
   if (in.centerline) {
-    centerline = *in.centerline;
-    objective->set_targets(centerline_targets(object->mesh(), *bar_axis, centerline, current.positions));
+    // Checked when posted; a target the mapping still puts out of bounds (a sketch at the edge
+    // of the world, the bar's offset beyond it) is refused here, not thrown out of the thread.
+    try {
+      objective->set_targets(centerline_targets(object->mesh(), *bar_axis, *in.centerline, current.positions));
+      centerline = *in.centerline;
+    } catch (const InputError& e) {
+      objective->set_targets({});
+      centerline.clear();
+      last_error = std::string("centre-line refused: ") + e.what();
+    }
   }
   if (in.paused) paused = *in.paused;
   if (in.jog && paused) {
@@ -251,13 +250,7 @@ void Controller::set_targets(ShapeTargets targets) {
 void Controller::set_centerline(std::vector<Vec3> polyline) {
   if (!state_->bar_axis)
     throw InputError("centerline", "", "the object is not bar-like (length < 3 × thickness)");
-  double length = 0;
-  for (std::size_t k = 0; k < polyline.size(); ++k) {
-    if (!polyline[k].allFinite()) throw InputError("centerline", "point " + std::to_string(k), "not finite");
-    if (k) length += (polyline[k] - polyline[k - 1]).norm();
-  }
-  if (polyline.size() < 2 || !(length > 0))
-    throw InputError("centerline", "", "a polyline of at least 2 distinct points");
+  check_centerline(*state_->bar_axis, polyline, "centerline");
   post(*state_, [&](Inbox& in) {
     in.centerline = std::move(polyline);
     in.targets.reset();

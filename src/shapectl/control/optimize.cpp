@@ -1,6 +1,7 @@
 #include <shapectl/control/optimize.hpp>
 
 #include <chrono>
+#include <cmath>
 
 namespace shapectl {
 
@@ -8,17 +9,25 @@ OptimizeResult optimize(ReducedObjective& objective, Optimizer& optimizer, Evalu
                         const OptimizeOptions& options) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
+  const std::function<double()> elapsed =
+      options.clock ? options.clock
+                    : std::function<double()>([t0] { return std::chrono::duration<double>(Clock::now() - t0).count(); });
   OptimizeResult result;
   result.best = std::move(start);
   result.history.push_back({0, 0.0, result.best.error.mean, result.best.objective});
   optimizer.reset();
+  optimizer.out_of_time = [&] { return elapsed() > options.max_seconds; };
+  // The budget refers to this call's locals: gone when it returns or throws.
+  struct ClearBudget {
+    Optimizer& optimizer;
+    ~ClearBudget() { optimizer.out_of_time = nullptr; }
+  } clear_budget{optimizer};
   for (int it = 1;; ++it) {
     if (it > options.max_iterations) {
       result.reason = "iteration limit (" + std::to_string(options.max_iterations) + ") reached";
       break;
     }
-    if (elapsed() > options.max_seconds) {
+    if (optimizer.out_of_time()) {
       result.reason = "time limit reached";
       break;
     }
@@ -26,13 +35,22 @@ OptimizeResult optimize(ReducedObjective& objective, Optimizer& optimizer, Evalu
     result.iterations = it;
     result.history.push_back({it, elapsed(), result.best.error.mean, result.best.objective});
     if (outcome == StepOutcome::Converged) {
-      result.converged = result.best.statics.converged();
-      result.reason = "stationary after " + std::to_string(it) + " iterations";
+      result.converged = result.best.statics.converged() && std::isfinite(result.best.objective);
+      result.reason = result.converged ? "stationary after " + std::to_string(it) + " iterations"
+                                       : "stopped after " + std::to_string(it) +
+                                             " iterations at a state that is no converged equilibrium";
+      break;
+    }
+    if (outcome == StepOutcome::OutOfTime) {
+      result.reason = "time limit reached";
       break;
     }
     if (outcome == StepOutcome::Stuck) {
-      result.reason = "no acceptable step after " + std::to_string(it) +
-                      " iterations (every trial was worse, unsafe or failed statics)";
+      result.reason = std::isfinite(result.best.objective)
+                          ? "no acceptable step after " + std::to_string(it) +
+                                " iterations (every trial was worse, unsafe or failed statics)"
+                          : "no step possible: the objective is not finite (" +
+                                std::to_string(result.best.objective) + ")";
       break;
     }
   }

@@ -1,5 +1,6 @@
 #pragma once
 // Runs an optimizer to convergence (or an iteration/time budget) from a start state.
+#include <functional>
 #include <vector>
 
 #include <shapectl/control/optimizer.hpp>
@@ -8,7 +9,11 @@ namespace shapectl {
 
 struct OptimizeOptions {
   int max_iterations = 100;
+  // Checked before every statics trial and gradient (Optimizer::out_of_time): the run ends at
+  // most one statics solve or gradient after it.
   double max_seconds = 60;
+  // Seconds since the start; empty: the steady clock. Tests pass a simulated clock.
+  std::function<double()> clock = nullptr;
 };
 
 struct HistoryEntry {
@@ -20,7 +25,7 @@ struct HistoryEntry {
 
 struct OptimizeResult {
   Evaluation best;        // the state reached (safe if the start was)
-  bool converged = false;  // stationary, not merely out of budget
+  bool converged = false;  // stationary at a finite objective, not merely out of budget
   std::string reason;
   int iterations = 0;
   std::vector<HistoryEntry> history;  // entry 0 is the start

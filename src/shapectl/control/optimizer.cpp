@@ -10,14 +10,16 @@ const char* to_string(StepOutcome outcome) {
     case StepOutcome::Improved: return "improved";
     case StepOutcome::Converged: return "converged";
     case StepOutcome::Stuck: return "stuck";
+    case StepOutcome::OutOfTime: return "out of time";
   }
   return "?";
 }
 
 namespace {
-// A trial may replace the current state if it is at least as safe and strictly better.
+// A trial may replace the current state if it is at least as safe and strictly better (a
+// non-finite objective is neither).
 bool acceptable(const Evaluation& trial, const Evaluation& current, double required_objective) {
-  if (!trial.statics.converged()) return false;
+  if (!trial.statics.converged() || !std::isfinite(trial.objective)) return false;
   if (current.safe() && !trial.safe()) return false;
   return trial.objective < required_objective;
 }
@@ -30,31 +32,42 @@ bool negligible(double before, double after) {
 }  // namespace
 
 Evaluation evaluate_predicted(ReducedObjective& objective, const Eigen::VectorXd& joints,
-                              const Positions& warm, const Positions& predicted) {
+                              const Positions& warm, const Positions& predicted,
+                              const std::function<bool()>& out_of_time) {
   // A trial whose statics need many Newton steps is far outside the linear model: better
   // rejected (and the step shortened) than solved at length.
   constexpr int kTrialNewtonLimit = 25;
   Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit);
-  if (e.statics.status == StaticsStatus::Inverted && e.statics.iterations == 0)
+  if (e.statics.status == StaticsStatus::Inverted && e.statics.iterations == 0 &&
+      !(out_of_time && out_of_time()))
     e = objective.evaluate(joints, warm, kTrialNewtonLimit);  // the prediction itself inverted
   return e;
 }
 
 StepOutcome GaussNewton::step(ReducedObjective& objective, Evaluation& current) {
+  // At an equilibrium whose objective overflowed (or is NaN) no trial can be "better" and the
+  // derivatives are meaningless. (An unconverged state scores +inf by design: steps may leave it.)
+  if (current.statics.converged() && !std::isfinite(current.objective)) return StepOutcome::Stuck;
+  if (budget_spent()) return StepOutcome::OutOfTime;
   Eigen::VectorXd r;
   Eigen::MatrixXd J, dx;
   objective.least_squares(current, r, J, &dx);
+  // Nothing to linearize around: no step is possible (and none is "converged").
+  if (!r.allFinite() || !J.allFinite() || !dx.allFinite()) return StepOutcome::Stuck;
   const Eigen::VectorXd g = J.transpose() * r;
+  if (!g.allFinite()) return StepOutcome::Stuck;
   if (g.cwiseAbs().maxCoeff() <= 1e-14 + 1e-10 * r.squaredNorm()) return StepOutcome::Converged;
   const Eigen::MatrixXd A = J.transpose() * J;
   // Damping λ·max(diag JᵀJ)·I, not Marquardt's diag(JᵀJ): a 7-joint arm has self-motions
   // that barely move the object, and scaling by their tiny diagonal would let them run away.
   const double scale = std::max(A.diagonal().maxCoeff(), 1e-18);
   for (int attempt = 0; attempt < 12; ++attempt) {
+    if (budget_spent()) return StepOutcome::OutOfTime;
     Eigen::MatrixXd damped = A;
     damped.diagonal().array() += damping_ * scale;
     Eigen::VectorXd delta = damped.ldlt().solve(-g);
     const double largest = delta.cwiseAbs().maxCoeff();
+    if (!std::isfinite(largest)) return StepOutcome::Stuck;
     if (largest < 1e-12) return StepOutcome::Converged;
     if (largest > max_step) delta *= max_step / largest;
     const Eigen::VectorXd theta = current.joints + delta;
@@ -62,7 +75,7 @@ StepOutcome GaussNewton::step(ReducedObjective& objective, Evaluation& current) 
     Positions predicted_x = current.positions + dx * delta;
     objective.object().carry_gripped_nodes(current.joints, theta, current.positions, predicted_x);
     Evaluation trial =
-        evaluate_predicted(objective, theta, current.positions, predicted_x);
+        evaluate_predicted(objective, theta, current.positions, predicted_x, out_of_time);
     const double predicted = current.objective - 0.5 * (r + J * delta).squaredNorm();
     if (acceptable(trial, current, current.objective) && objective.confirm_stable(trial)) {
       // Gain ratio: how well the linear model predicted the decrease.
@@ -85,11 +98,16 @@ void Lbfgs::reset() {
 }
 
 StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
+  if (current.statics.converged() && !std::isfinite(current.objective)) return StepOutcome::Stuck;  // as in GaussNewton
   if (gradient_.size() == 0 || gradient_at_ != current.joints) {
+    if (budget_spent()) return StepOutcome::OutOfTime;
     gradient_ = objective.gradient(current, method_);
     gradient_at_ = current.joints;
   }
-  const Eigen::VectorXd& g = gradient_;
+  // A copy: the accepted step below replaces gradient_.
+  const Eigen::VectorXd g = gradient_;
+  // A non-finite gradient (e.g. the objective itself overflowed) gives no direction to search.
+  if (!g.allFinite()) return StepOutcome::Stuck;
   if (g.cwiseAbs().maxCoeff() <= 1e-14) return StepOutcome::Converged;
   // Two-loop recursion: d = −H g.
   Eigen::VectorXd q = g;
@@ -105,15 +123,18 @@ StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
     q += (alpha[k] - beta) * s_[k];
   }
   Eigen::VectorXd d = -q;
-  if (!(g.dot(d) < 0)) {  // not a descent direction: restart from steepest descent
-    reset();
-    gradient_ = g;
-    gradient_at_ = current.joints;
+  if (!(g.dot(d) < 0) || !d.allFinite()) {  // not a descent direction: restart from steepest descent
+    // Only the curvature pairs are dropped: the gradient at current.joints stays valid (a full
+    // reset() here once emptied the gradient this step still reads).
+    s_.clear();
+    y_.clear();
     d = -g * (max_step / g.cwiseAbs().maxCoeff());
   }
   const double slope = g.dot(d);
+  if (!(slope < 0) || !std::isfinite(slope)) return StepOutcome::Stuck;  // g overflowed in the product
   double t = 1.0;
   for (int k = 0; k < 16; ++k, t *= 0.5) {
+    if (budget_spent()) return StepOutcome::OutOfTime;
     const Eigen::VectorXd theta = current.joints + t * d;
     // Warm start from the current shape: carrying the gripped nodes alone (without dx̂/dθ·Δθ
     // for the rest) measured no faster for these short steps.
@@ -121,9 +142,13 @@ StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
     if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
     if (!objective.confirm_stable(trial)) continue;
     const bool tiny = negligible(current.objective, trial.objective);
-    const Eigen::VectorXd g_new = objective.gradient(trial, method_);
-    const Eigen::VectorXd s = trial.joints - current.joints, y = g_new - g;
-    if (s.dot(y) > 1e-12 * s.norm() * y.norm()) {
+    const Eigen::VectorXd s = trial.joints - current.joints;
+    current = trial;
+    // Out of time: keep the better state; its gradient is computed when (if) a next step comes.
+    if (budget_spent()) return tiny ? StepOutcome::Converged : StepOutcome::Improved;
+    const Eigen::VectorXd g_new = objective.gradient(current, method_);
+    const Eigen::VectorXd y = g_new - g;
+    if (y.allFinite() && s.dot(y) > 1e-12 * s.norm() * y.norm()) {
       s_.push_back(s);
       y_.push_back(y);
       if (static_cast<int>(s_.size()) > memory) {
@@ -131,13 +156,15 @@ StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
         y_.pop_front();
       }
     }
-    current = trial;
     gradient_ = g_new;
     gradient_at_ = current.joints;
     return tiny ? StepOutcome::Converged : StepOutcome::Improved;
   }
   if (s_.empty()) return StepOutcome::Stuck;
-  reset();  // the curvature model misled the search: retry once along the steepest descent
+  // The curvature model misled the search: retry once along the steepest descent (the gradient
+  // at current.joints is kept; nothing moved).
+  s_.clear();
+  y_.clear();
   return step(objective, current);
 }
 

@@ -4,6 +4,7 @@
 // (accepted) state, which keeps the object on its equilibrium branch (paper Fig. 8). Starting
 // from a safe state (converged, collision-free, within limits), only safe states are accepted.
 #include <deque>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -15,6 +16,7 @@ enum class StepOutcome {
   Improved,   // a better θ was accepted into `current`
   Converged,  // stationary: no further progress expected
   Stuck,      // no acceptable step found (e.g. every trial collides or statics failed)
+  OutOfTime,  // the budget ran out (out_of_time) before a step was accepted
 };
 const char* to_string(StepOutcome outcome);
 
@@ -25,6 +27,12 @@ class Optimizer {
   virtual StepOutcome step(ReducedObjective& objective, Evaluation& current) = 0;
   // Forget accumulated curvature/damping, e.g. after the targets changed.
   virtual void reset() = 0;
+  // Asked before every statics trial and every gradient; true ends the step there, so a budget
+  // is overrun by at most one statics solve or gradient. Empty: no budget.
+  std::function<bool()> out_of_time;
+
+ protected:
+  bool budget_spent() const { return out_of_time && out_of_time(); }
 };
 
 enum class OptimizerKind { GaussNewton, Lbfgs };
@@ -67,8 +75,10 @@ class Lbfgs : public Optimizer {
 std::unique_ptr<Optimizer> make_optimizer(OptimizerKind kind, GradientMethod gradient);
 
 // Solves statics at `joints` from `x`, trying the prediction first and falling back to the
-// plain warm start if the predicted state is inverted or does not converge.
+// plain warm start if the predicted state is inverted. The fallback is skipped (the inverted
+// evaluation returned) if `out_of_time` says the budget is spent.
 Evaluation evaluate_predicted(ReducedObjective& objective, const Eigen::VectorXd& joints,
-                              const Positions& warm, const Positions& predicted);
+                              const Positions& warm, const Positions& predicted,
+                              const std::function<bool()>& out_of_time = {});
 
 }  // namespace shapectl

@@ -19,6 +19,11 @@ ReducedObjective::ReducedObjective(GrippedObject& object)
   if (object.scene().robot->collisions) collisions_ = *object.scene().robot->collisions;
 }
 
+void ReducedObjective::set_targets(ShapeTargets targets) {
+  check_targets(targets, object_.node_count(), "targets");
+  targets_ = std::move(targets);
+}
+
 void ReducedObjective::score(Evaluation& e) const {
   e.error = shape_error(targets_, e.positions);
   double sum = 0;

@@ -42,7 +42,9 @@ class ReducedObjective {
  public:
   explicit ReducedObjective(GrippedObject& object);
 
-  void set_targets(ShapeTargets targets) { targets_ = std::move(targets); }
+  // Throws InputError ("targets: targets[k]...", see check_targets) for a node out of range or
+  // a position not finite or beyond max_target_distance; the targets are then unchanged.
+  void set_targets(ShapeTargets targets);
   const ShapeTargets& targets() const { return targets_; }
   GrippedObject& object() { return object_; }
   int joint_count() const { return object_.joint_count(); }

@@ -4,6 +4,10 @@
 
 namespace shapectl {
 
+namespace {
+constexpr double max_distance = 1e3;  // m: targets are in reach of a robot, not kilometres off
+}  // namespace
+
 TargetsInput read_targets(const JsonInput& json, int node_count) {
   json.expect_only({"targets", "centerline"});
   TargetsInput in;
@@ -12,6 +16,9 @@ TargetsInput read_targets(const JsonInput& json, int node_count) {
   if (json.has("targets")) {
     const JsonInput list = json.at("targets");
     if (list.size() == 0) list.fail("a non-empty list of targets");
+    if (list.size() > max_target_count)
+      list.fail_problem(std::to_string(list.size()) + " targets, more than the limit of " +
+                        std::to_string(max_target_count));
     std::set<int> seen;
     for (std::size_t k = 0; k < list.size(); ++k) {
       const JsonInput t = list.at(k);
@@ -19,11 +26,14 @@ TargetsInput read_targets(const JsonInput& json, int node_count) {
       const int node = static_cast<int>(t.at("node").integer_in(0, node_count - 1));
       if (!seen.insert(node).second) t.at("node").fail("a node without another target");
       in.targets.nodes.push_back(node);
-      in.targets.positions.push_back(t.at("position").vec3());
+      in.targets.positions.push_back(t.at("position").vec3_within(max_distance, "a point", "m"));
     }
   } else {
     const JsonInput list = json.at("centerline");
-    for (std::size_t k = 0; k < list.size(); ++k) in.centerline.push_back(list.at(k).vec3());
+    if (list.size() > max_centerline_points)
+      list.fail_problem(std::to_string(list.size()) + " points, more than the limit of " +
+                        std::to_string(max_centerline_points));
+    for (std::size_t k = 0; k < list.size(); ++k) in.centerline.push_back(list.at(k).vec3_within(max_distance, "a point", "m"));
     double length = 0;
     for (std::size_t k = 1; k < in.centerline.size(); ++k)
       length += (in.centerline[k] - in.centerline[k - 1]).norm();

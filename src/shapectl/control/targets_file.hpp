@@ -14,8 +14,13 @@ struct TargetsInput {
   std::vector<Vec3> centerline;  // the polyline (empty for node targets)
 };
 
-// Throws InputError naming the file and field: node out of range, non-finite numbers, empty
-// lists, repeated nodes, a centre-line with fewer than 2 distinct points.
+inline constexpr std::size_t max_target_count = 100'000;
+inline constexpr std::size_t max_centerline_points = 100'000;
+
+// Throws InputError naming the file and field: node out of range, non-finite numbers or points
+// beyond 1000 m, empty lists, repeated nodes, a centre-line with fewer than 2 distinct points,
+// more than max_target_count targets or max_centerline_points points. The file is at most
+// max_json_file_bytes (io/input_file.hpp).
 TargetsInput read_targets(const JsonInput& json, int node_count);
 TargetsInput load_targets(const std::filesystem::path& file, int node_count);
 

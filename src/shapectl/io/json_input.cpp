@@ -1,28 +1,118 @@
 #include <shapectl/io/json_input.hpp>
 
+#include <algorithm>
 #include <cmath>
-#include <fstream>
+#include <set>
 #include <sstream>
+
+#include <shapectl/io/input_file.hpp>
 
 namespace shapectl {
 
-JsonInput JsonInput::load(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "", "cannot open file");
-  std::stringstream text;
-  text << in.rdbuf();
-  try {
-    return JsonInput(nlohmann::json::parse(text.str()), file.string());
-  } catch (const nlohmann::json::parse_error& e) {
-    // nlohmann reports a byte offset; turn it into a line number.
-    const std::string s = text.str();
-    const std::size_t end = std::min<std::size_t>(e.byte, s.size());
-    const long line = 1 + std::count(s.begin(), s.begin() + static_cast<long>(end), '\n');
-    throw InputError(file.string() + ":" + std::to_string(line), "",
-                     std::string("invalid JSON (") + e.what() + ")");
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(file.string(), "", std::string("invalid JSON (") + e.what() + ")");
+namespace {
+
+// The line holding byte `at` of `text`.
+long line_at(std::string_view text, std::size_t at) {
+  at = std::min(at, text.size());
+  return 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
+}
+
+// Byte offset where nesting first exceeds `max_depth`, or npos: one pass, no recursion.
+std::size_t too_deep_at(std::string_view text, int max_depth) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) return i;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
   }
+  return std::string_view::npos;
+}
+
+// Tracks where the parser is ("object.mesh.box", "grips[1]") and refuses a key an object
+// already has: with nlohmann's default the last one would silently win.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(const std::string& source) : source_(source) {}
+
+  bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    switch (event) {
+      case Event::object_start:
+      case Event::array_start:
+        count_element();
+        frames_.push_back({event == Event::object_start, {}, {}, -1});
+        break;
+      case Event::object_end:
+      case Event::array_end:
+        if (!frames_.empty()) frames_.pop_back();
+        break;
+      case Event::key: {
+        Frame& top = frames_.back();
+        top.key = parsed.get<std::string>();
+        if (!top.keys.insert(top.key).second)
+          throw InputError(source_, path(), "duplicate key (each key may appear once)");
+        break;
+      }
+      case Event::value:
+        count_element();
+        break;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool object;
+    std::set<std::string> keys;
+    std::string key;  // the member being read
+    long index;       // the element being read
+  };
+  void count_element() {
+    if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+  }
+  std::string path() const {
+    std::string out;
+    for (const Frame& f : frames_)
+      out += f.object ? (out.empty() ? "" : ".") + bounded_preview(f.key) : "[" + std::to_string(f.index) + "]";
+    return out;
+  }
+  const std::string& source_;
+  std::vector<Frame> frames_;
+};
+
+}  // namespace
+
+nlohmann::json parse_json_text(std::string_view text, const std::string& source,
+                               const JsonLimits& limits) {
+  if (text.size() > limits.max_bytes)
+    throw InputError(source, "", "longer than the " + std::to_string(limits.max_bytes) + " byte limit for JSON");
+  if (const std::size_t at = too_deep_at(text, limits.max_depth); at != std::string_view::npos)
+    throw InputError(source + ":" + std::to_string(line_at(text, at)), "",
+                     "JSON nested deeper than " + std::to_string(limits.max_depth) + " levels");
+  try {
+    return nlohmann::json::parse(text.begin(), text.end(), DuplicateKeyCheck(source));
+  } catch (const nlohmann::json::parse_error& e) {
+    // nlohmann reports a byte offset; turn it into a line number. Its "last read" token can
+    // be the whole rest of the file: the message is cut.
+    throw InputError(source + ":" + std::to_string(line_at(text, e.byte)), "",
+                     "invalid JSON (" + bounded_preview(e.what(), 200) + ")");
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(source, "", "invalid JSON (" + bounded_preview(e.what(), 200) + ")");
+  }
+}
+
+JsonInput JsonInput::load(const std::filesystem::path& file) {
+  const std::string text = read_input_file(file, max_json_file_bytes, "JSON");
+  return JsonInput(parse_json_text(text, file.string()), file.string());
 }
 
 JsonInput::JsonInput(nlohmann::json value, std::string source, std::string path)
@@ -33,12 +123,52 @@ std::filesystem::path JsonInput::directory() const {
 }
 
 std::string JsonInput::child_path(std::string_view key) const {
-  return path_.empty() ? std::string(key) : path_ + "." + std::string(key);
+  // Keys come from the input: a path shows at most 80 bytes of each.
+  const std::string shown_key = bounded_preview(key);
+  return path_.empty() ? shown_key : path_ + "." + shown_key;
 }
 
+namespace {
+
+// A JSON string literal of at most about `max_chars` bytes.
+std::string quoted_preview(std::string_view s, std::size_t max_chars) {
+  return nlohmann::json(bounded_preview(s, max_chars))
+      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
+// Appends a compact rendering of `v` to `out`, stopping soon after `out` reaches `budget`
+// bytes: no recursion deeper than a few levels and no work proportional to a huge value.
+void append_preview(const nlohmann::json& v, std::string& out, std::size_t budget, int depth) {
+  if (out.size() > budget) return;
+  if (v.is_string()) {
+    out += quoted_preview(v.get_ref<const std::string&>(), budget - out.size() + 1);
+  } else if (!v.is_structured()) {
+    out += v.dump();
+  } else if (depth >= 4) {
+    out += v.is_object() ? "{...}" : "[...]";
+  } else {
+    out += v.is_object() ? '{' : '[';
+    bool first = true;
+    for (auto it = v.begin(); it != v.end() && out.size() <= budget; ++it) {
+      if (!first) out += ',';
+      first = false;
+      if (v.is_object()) out += quoted_preview(it.key(), budget) + ':';
+      append_preview(*it, out, budget, depth + 1);
+    }
+    out += v.is_object() ? '}' : ']';
+  }
+}
+
+}  // namespace
+
 std::string JsonInput::shown() const {
-  std::string s = value_.dump();
-  if (s.size() > 60) s = s.substr(0, 57) + "...";
+  std::string s;
+  append_preview(value_, s, 60, 0);
+  if (s.size() > 60) {
+    std::size_t end = 57;  // not inside a UTF-8 character
+    while (end > 0 && (static_cast<unsigned char>(s[end]) & 0xC0) == 0x80) --end;
+    s = s.substr(0, end) + "...";
+  }
   return s;
 }
 
@@ -140,6 +270,27 @@ std::string JsonInput::string() const {
 Eigen::Vector3d JsonInput::vec3() const {
   if (!value_.is_array() || value_.size() != 3) fail("an array of 3 numbers");
   return {at(std::size_t{0}).number(), at(1).number(), at(2).number()};
+}
+
+double JsonInput::number_in(double lo, double hi, const std::string& unit) const {
+  const double v = number();
+  if (!(v >= lo && v <= hi)) {
+    std::ostringstream range;
+    range << "a number from " << lo << " to " << hi << (unit.empty() ? "" : " " + unit);
+    fail(range.str());
+  }
+  return v;
+}
+
+Eigen::Vector3d JsonInput::vec3_within(double radius, const std::string& what,
+                                       const std::string& unit) const {
+  const Eigen::Vector3d v = vec3();
+  if (!(v.norm() <= radius)) {
+    std::ostringstream expected;
+    expected << what << " of length at most " << radius << " " << unit;
+    fail(expected.str());
+  }
+  return v;
 }
 
 std::vector<double> JsonInput::numbers() const {

@@ -10,12 +10,27 @@
 #include <vector>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/input_file.hpp>
 
 namespace shapectl {
 
+// Bounds on JSON text, checked before parsing: the parser and dump() recurse per level.
+struct JsonLimits {
+  std::size_t max_bytes = max_json_file_bytes;
+  int max_depth = 64;  // nested arrays and objects; scenes use 5
+};
+
+// Parses JSON text strictly: size and nesting within `limits`, no key twice in an object.
+// Throws InputError naming `source` (and the line or the key's path): "scene.json:12: invalid
+// JSON (...)", "scene.json:3: JSON nested deeper than 64 levels", "scene.json: object.mesh:
+// duplicate key (each key may appear once)". Usable for any JSON input, files or messages.
+nlohmann::json parse_json_text(std::string_view text, const std::string& source,
+                               const JsonLimits& limits = {});
+
 class JsonInput {
  public:
-  // Reads and parses a file; a missing file or a syntax error is an InputError naming it.
+  // Reads (read_input_file, max_json_file_bytes) and parses (parse_json_text) a file; a
+  // missing, non-regular or oversize file or bad JSON is an InputError naming it.
   static JsonInput load(const std::filesystem::path& file);
   JsonInput(nlohmann::json value, std::string source, std::string path = "");
 
@@ -44,6 +59,10 @@ class JsonInput {
   double non_negative() const;  // finite, >= 0
   long integer() const;         // a whole number
   long integer_in(long lo, long hi) const;  // lo <= value <= hi
+  // lo <= value <= hi; `unit` ("m", "Pa") is shown with the range in the message.
+  double number_in(double lo, double hi, const std::string& unit) const;
+  // [x, y, z] with |(x, y, z)| <= radius; `what` names it ("a point", "a gravity vector").
+  Eigen::Vector3d vec3_within(double radius, const std::string& what, const std::string& unit) const;
   bool boolean() const;
   std::string string() const;
   Eigen::Vector3d vec3() const;             // [x, y, z], finite

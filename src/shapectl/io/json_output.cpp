@@ -1,36 +1,26 @@
 #include <shapectl/io/json_output.hpp>
 
 #include <algorithm>
-#include <fstream>
-#include <unistd.h>
+#include <cmath>
 
-#include <shapectl/io/input_error.hpp>
+#include <shapectl/io/atomic_file.hpp>
 
 namespace shapectl {
 
 void write_text_file_atomically(const std::filesystem::path& file, const std::string& text) {
-  const auto temporary = std::filesystem::path(file.string() + ".tmp" + std::to_string(getpid()));
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    if (!out) throw InputError(file.string(), "", "cannot write file (does the directory exist?)");
-    out << text;
-    out.flush();
-    if (!out) {
-      std::filesystem::remove(temporary);
-      throw InputError(file.string(), "", "writing failed");
-    }
-  }
-  std::error_code ec;
-  std::filesystem::rename(temporary, file, ec);
-  if (ec) {
-    std::filesystem::remove(temporary, ec);
-    throw InputError(file.string(), "", "cannot replace file: " + ec.message());
-  }
+  write_file_atomically(file, text);
 }
 
 namespace {
-// Indented like dump(1), but arrays of numbers stay on one line ([x, y, z]).
-void pretty(const nlohmann::json& v, int depth, std::string& out) {
+
+template <class Json>
+std::string dumped(const Json& v) {
+  return v.dump(-1, ' ', false, Json::error_handler_t::replace);
+}
+
+// Our own results are a few levels deep: plain recursion is fine here.
+template <class Json>
+void pretty(const Json& v, int depth, std::string& out) {
   const std::string pad(depth, ' ');
   const bool flat_array = v.is_array() && std::all_of(v.begin(), v.end(), [](const auto& e) {
                             return e.is_primitive();
@@ -39,7 +29,7 @@ void pretty(const nlohmann::json& v, int depth, std::string& out) {
     out += "{\n";
     std::size_t k = 0;
     for (auto it = v.begin(); it != v.end(); ++it, ++k) {
-      out += pad + " " + nlohmann::json(it.key()).dump() + ": ";
+      out += pad + " " + dumped(Json(it.key())) + ": ";
       pretty(it.value(), depth + 1, out);
       out += k + 1 < v.size() ? ",\n" : "\n";
     }
@@ -53,19 +43,44 @@ void pretty(const nlohmann::json& v, int depth, std::string& out) {
     }
     out += pad + "]";
   } else {
-    out += v.dump();
+    out += dumped(v);
   }
 }
-}  // namespace
 
-std::string to_pretty_json(const nlohmann::json& value) {
+template <class Json>
+std::string pretty_text(const Json& value) {
   std::string out;
   pretty(value, 0, out);
   return out + "\n";
 }
 
+template <class Json>
+std::optional<std::string> non_finite_in(const Json& v, const std::string& where) {
+  if (v.is_number_float() && !std::isfinite(v.template get<double>())) return where;
+  if (v.is_object())
+    for (auto it = v.begin(); it != v.end(); ++it)
+      if (auto found = non_finite_in(it.value(), where + (where.empty() ? "" : ".") + it.key())) return found;
+  if (v.is_array())
+    for (std::size_t k = 0; k < v.size(); ++k)
+      if (auto found = non_finite_in(v[k], where + "[" + std::to_string(k) + "]")) return found;
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::string to_pretty_json(const nlohmann::json& value) { return pretty_text(value); }
+std::string to_pretty_json(const nlohmann::ordered_json& value) { return pretty_text(value); }
+
 void write_json_file(const std::filesystem::path& file, const nlohmann::json& value) {
-  write_text_file_atomically(file, to_pretty_json(value));
+  write_file_atomically(file, pretty_text(value));
+}
+void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_json& value) {
+  write_file_atomically(file, pretty_text(value));
+}
+
+std::optional<std::string> first_non_finite(const nlohmann::json& value) { return non_finite_in(value, ""); }
+std::optional<std::string> first_non_finite(const nlohmann::ordered_json& value) {
+  return non_finite_in(value, "");
 }
 
 nlohmann::json positions_to_json(const Positions& x) {

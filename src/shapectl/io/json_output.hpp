@@ -1,8 +1,10 @@
 #pragma once
-// Writing result files: atomically (a temporary file beside the target, then a rename), so a
-// failure never leaves a half-written or corrupted file where a good one was.
+// Result files as JSON: pretty-printed, written atomically (io/atomic_file.hpp), never with an
+// exception for text that is not valid UTF-8 (such bytes become U+FFFD).
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
 
 #include <shapectl/types.hpp>
 
@@ -10,8 +12,17 @@ namespace shapectl {
 
 // Throws InputError naming the path if it cannot be written (e.g. missing directory).
 void write_text_file_atomically(const std::filesystem::path& file, const std::string& text);
+// Indented like dump(1), but arrays of numbers stay on one line ([x, y, z]). Strings that are
+// not valid UTF-8 are repaired (U+FFFD), not refused: names in results come from input files.
 std::string to_pretty_json(const nlohmann::json& value);
+std::string to_pretty_json(const nlohmann::ordered_json& value);
 void write_json_file(const std::filesystem::path& file, const nlohmann::json& value);
+void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_json& value);
+
+// Where the first NaN or infinite number is ("positions[3][1]"), if any: JSON has no such
+// numbers (they would be written as null), so results are checked before they are written.
+std::optional<std::string> first_non_finite(const nlohmann::json& value);
+std::optional<std::string> first_non_finite(const nlohmann::ordered_json& value);
 
 // [[x,y,z], ...] from stacked positions.
 nlohmann::json positions_to_json(const Positions& x);

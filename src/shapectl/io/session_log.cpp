@@ -1,8 +1,8 @@
 #include <shapectl/io/session_log.hpp>
 
-#include <fstream>
-
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/input_file.hpp>
+#include <shapectl/io/json_input.hpp>
 
 namespace shapectl {
 
@@ -31,27 +31,35 @@ void SessionLog::write(std::string_view event, const nlohmann::json& fields) {
 }
 
 std::vector<LoggedEvent> read_session_log(const std::filesystem::path& file, int* truncated_lines) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(file.string(), "", "cannot open");
+  // An hour at 250 Hz on two arms is ~400 MB; a FIFO or anything larger is refused, not read.
+  const std::string content = read_input_file(file, max_session_log_bytes, "session log");
   std::vector<LoggedEvent> events;
-  std::string text;
-  int line = 0;
   if (truncated_lines) *truncated_lines = 0;
-  while (std::getline(in, text)) {
+  int line = 0;
+  for (std::size_t begin = 0; begin < content.size();) {
+    const std::size_t newline = content.find('\n', begin);
+    const bool last_unterminated = newline == std::string::npos;
+    const std::size_t end = last_unterminated ? content.size() : newline;
+    const std::string_view text(content.data() + begin, end - begin);
+    begin = end + 1;
     ++line;
-    const bool last_unterminated = in.eof();
     if (text.empty()) continue;
     const std::string where = file.string() + ":" + std::to_string(line);
-    nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    const bool valid = !j.is_discarded() && j.is_object() && j.contains("t") &&
-                       j["t"].is_number() && j.contains("event") && j["event"].is_string();
+    nlohmann::json j;
+    try {
+      j = parse_json_text(text, where, {.max_bytes = 1u << 20, .max_depth = 16});
+    } catch (const InputError&) {
+      j = nlohmann::json();  // reported below, or skipped when a crash cut the last line short
+    }
+    const bool valid = j.is_object() && j.contains("t") && j["t"].is_number() &&
+                       j.contains("event") && j["event"].is_string();
     if (!valid) {
       if (last_unterminated) {  // the line a crash cut short
         if (truncated_lines) ++*truncated_lines;
         break;
       }
       throw InputError(where, "", "expected a JSON object with a number \"t\" and a string "
-                                  "\"event\", got: " + text.substr(0, 80));
+                                  "\"event\", got: " + bounded_preview(text));
     }
     events.push_back({line, j["t"].get<double>(), j["event"].get<std::string>(), std::move(j)});
   }

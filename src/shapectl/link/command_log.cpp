@@ -1,5 +1,6 @@
 #include <shapectl/link/command_log.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -41,11 +42,15 @@ void log_link_started(SessionLog& log, const std::string& kind,
 }
 
 void log_command(SessionLog& log, const std::string& channel, std::uint64_t seq,
-                 const Eigen::VectorXd& joints, const Eigen::VectorXd& measured) {
-  log.write("command", {{"channel", channel},
-                        {"seq", seq},
-                        {"joints", to_list(joints)},
-                        {"measured", to_list(measured)}});
+                 const Eigen::VectorXd& joints, const Eigen::VectorXd& measured,
+                 const FeedbackStep& step) {
+  nlohmann::json fields = {{"channel", channel},
+                           {"seq", seq},
+                           {"joints", to_list(joints)},
+                           {"measured", to_list(measured)}};
+  if (!step.advanced) fields["hold"] = true;
+  if (step.from_rest) fields["from_rest"] = true;
+  log.write("command", fields);
 }
 
 CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
@@ -91,11 +96,19 @@ CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
         violation(e, name + ": command is not " + std::to_string(c.limits.size()) + " finite values");
         continue;
       }
-      for (Eigen::Index i = 0; i < q.size(); ++i) {
+      const bool hold = f.value("hold", false);
+      if (hold && !c.last.empty() && q != c.last.back())
+        violation(e, name + ": a hold that moved");
+      // Restarted from rest: the step before counts as zero.
+      if (!c.last.empty() && f.value("from_rest", false)) c.last = {c.last.back(), c.last.back()};
+      for (Eigen::Index i = 0; i < q.size() && !hold; ++i) {
         const std::string joint = name + " joint " + std::to_string(i);
-        const bool outside = q[i] < c.limits.lower[i] - slack || q[i] > c.limits.upper[i] + slack;
-        if (outside && (c.last.empty() || q[i] != c.last.back()[i]))
-          violation(e, joint + ": " + std::to_string(q[i]) + " rad outside the band");
+        // Outside the band (started in the margin) only ever inwards.
+        auto out = [&](double x) {
+          return std::max({0.0, c.limits.lower[i] - x, x - c.limits.upper[i]});
+        };
+        if (out(q[i]) > slack && !c.last.empty() && out(q[i]) > out(c.last.back()[i]) + slack)
+          violation(e, joint + ": " + std::to_string(q[i]) + " rad outside the band, moving outwards");
         if (c.last.empty()) continue;
         const double dq = std::abs(q[i] - c.last.back()[i]);
         const double v_ratio = dq / (c.limits.velocity[i] * dt);
@@ -109,6 +122,7 @@ CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
         if (ddq > c.limits.acceleration[i] * dt * dt + slack)
           violation(e, joint + ": second difference " + std::to_string(ddq) + " rad above a·dt²");
       }
+      if (hold) continue;
       if (c.last.size() == 2) c.last.erase(c.last.begin());
       c.last.push_back(q);
     }

@@ -4,6 +4,8 @@
 //   {"event":"link","kind":"egm","joint_names":[..],"channels":[{"name":"left","joints":[..]}],
 //    "period":0.004,"lower":[..],"upper":[..],"velocity":[..],"acceleration":[..]}
 //   {"event":"command","channel":"left","seq":17,"joints":[..],"measured":[..]}   (rad)
+//   (+ "hold":true when the command repeats the previous one because real time did not allow
+//    a step, "from_rest":true when the governor restarted from rest after the pose was held)
 //   {"event":"connect"|"feedback_lost"|"arm"|"disarm"|"arm_refused"|"target_rejected", ..}
 #include <string>
 #include <vector>
@@ -20,7 +22,8 @@ void log_link_started(SessionLog& log, const std::string& kind,
                       const std::vector<LinkChannel>& channels, const GovernorLimits& limits,
                       double period);
 void log_command(SessionLog& log, const std::string& channel, std::uint64_t seq,
-                 const Eigen::VectorXd& joints, const Eigen::VectorXd& measured);
+                 const Eigen::VectorXd& joints, const Eigen::VectorXd& measured,
+                 const FeedbackStep& step = {.send = true, .advanced = true});
 
 struct CommandLogCheck {
   int links = 0;     // "link" events (a log may hold several sessions)
@@ -33,9 +36,11 @@ struct CommandLogCheck {
 };
 
 // Checks every command of every channel: velocity and acceleration within the limits of the
-// "link" event before it (consecutive commands are dt apart), and position inside the band
-// unless holding still. A "connect" event restarts that channel's sequence (the governor
-// is reset to the measured position then).
+// "link" event before it, per controller cycle (consecutive advancing commands are one
+// governor step of dt apart; a "hold" is skipped; "from_rest" means the
+// previous step counts as zero), and position inside the band unless holding still. A
+// "connect" event restarts that channel's sequence (the governor is reset to the measured
+// position then).
 CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
                                   const std::string& source);
 

@@ -1,5 +1,6 @@
 #include <shapectl/link/egm_link.hpp>
 
+#include <arpa/inet.h>
 #include <poll.h>
 
 #include <algorithm>
@@ -21,6 +22,16 @@ constexpr int max_logged_rejections = 20;
 constexpr std::array<int, 7> chain_axes = {1, 2, 7, 3, 4, 5, 6};
 
 Eigen::VectorXd to_vector(const ArmJoints& q) { return q; }
+
+std::uint64_t sender_key(const sockaddr_in& a) {
+  return std::uint64_t{ntohl(a.sin_addr.s_addr)} << 16 | ntohs(a.sin_port);
+}
+
+std::string address_text(const sockaddr_in& a) {
+  char host[INET_ADDRSTRLEN] = "?";
+  ::inet_ntop(AF_INET, &a.sin_addr, host, sizeof host);
+  return std::string(host) + ":" + std::to_string(ntohs(a.sin_port));
+}
 
 }  // namespace
 
@@ -67,7 +78,8 @@ EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
     : SupervisedLink(config.egm_period, log,
                      LinkSupervisor("egm", robot.active_joint_names(), egm_arm_channels(robot),
                                     robot.lower_limits(), robot.upper_limits(), governor_limits(config, robot),
-                                    {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance},
+                                    {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance,
+                                     config.egm_period},
                                     std::move(check), log.get())),
       buffer_(EgmCodec::max_datagram + 1) {
   for (const auto& c : supervisor_.channels()) {
@@ -75,7 +87,7 @@ EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
     sockets_.emplace_back(config.egm_address, port, "egm " + c.name + " port");
   }
   next_seqno_.assign(sockets_.size(), 1);
-  last_robot_seqno_.assign(sockets_.size(), -1);
+  filters_.resize(sockets_.size());
   latency_us_.reserve(latency_capacity);
   if (log_)
     log_link_started(*log_, "egm", robot.active_joint_names(), supervisor_.channels(),
@@ -127,19 +139,37 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
   }
   EgmCommand command;
   Eigen::VectorXd measured = to_vector(feedback.joints);
+  FeedbackVerdict verdict;
+  FeedbackStep step;
+  bool log_foreign = false;
+  std::string bound_to;
   {
     std::lock_guard lock(mutex_);
-    if (last_robot_seqno_[c] >= 0) {
-      const std::uint32_t gap = feedback.seqno - static_cast<std::uint32_t>(last_robot_seqno_[c]);
-      if (gap > 1 && gap < 1000) lost_ += gap - 1;
+    FeedbackFilter& filter = filters_[c];
+    // After a feedback loss the controller may have restarted its counter.
+    if (!supervisor_.connected(channel)) filter.forget_sequence();
+    const bool first = !filter.bound();
+    verdict = filter.accept(sender_key(from), feedback.seqno, feedback.tm);
+    if (first) bound_to = address_text(from);
+    if (verdict == FeedbackVerdict::foreign && foreign_logged_ < max_logged_rejections) {
+      ++foreign_logged_;
+      log_foreign = true;
     }
-    last_robot_seqno_[c] = feedback.seqno;
-    supervisor_.on_feedback(channel, measured, feedback.fault(), now(), period_);
-    command.joints = supervisor_.command(channel);
-    command.velocity = supervisor_.command_velocity(channel);
-    command.seqno = next_seqno_[c]++;
-    command.tm = static_cast<std::uint32_t>(now() * 1000);
+    if (verdict == FeedbackVerdict::accepted) {
+      step = supervisor_.on_feedback(channel, measured, feedback.fault(), now());
+      command.joints = supervisor_.command(channel);
+      command.velocity = step.advanced ? supervisor_.command_velocity(channel) : ArmJoints::Zero();
+      if (step.send) command.seqno = next_seqno_[c]++;
+      command.tm = static_cast<std::uint32_t>(now() * 1000);
+    }
   }
+  if (log_ && !bound_to.empty())
+    log_->write("controller_bound", {{"channel", supervisor_.channels()[c].name}, {"address", bound_to}});
+  if (log_ && log_foreign)
+    log_->write("foreign_sender", {{"channel", supervisor_.channels()[c].name},
+                                   {"address", address_text(from)},
+                                   {"note", "ignored; at most 20 such lines are logged"}});
+  if (verdict != FeedbackVerdict::accepted || !step.send) return;
   const std::string_view bytes = codec_.encode_sensor(command);
   const bool sent = !bytes.empty() && sockets_[c].send_to(bytes, from);
   const auto done = std::chrono::steady_clock::now();
@@ -154,7 +184,8 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
     if (sent) ++commands_sent_;
     seq = command.seqno;
   }
-  if (log_ && sent) log_command(*log_, supervisor_.channels()[c].name, seq, command.joints, measured);
+  if (log_ && sent)
+    log_command(*log_, supervisor_.channels()[c].name, seq, command.joints, measured, step);
 }
 
 LinkStatus EgmLink::status() const {
@@ -162,7 +193,11 @@ LinkStatus EgmLink::status() const {
   LinkStatus s = supervisor_.status(now());
   s.commands_sent = commands_sent_;
   s.rejected_datagrams = rejected_;
-  s.lost_datagrams = lost_;
+  for (const auto& f : filters_) {
+    s.lost_datagrams += f.counts().lost;
+    s.stale_datagrams += f.counts().stale;
+    s.foreign_datagrams += f.counts().foreign;
+  }
   return s;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <shapectl/link/egm_codec.hpp>
+#include <shapectl/link/feedback_filter.hpp>
 #include <shapectl/link/make_robot_link.hpp>
 #include <shapectl/link/supervised_link.hpp>
 #include <shapectl/link/udp_socket.hpp>
@@ -51,10 +52,10 @@ class EgmLink : public SupervisedLink {
   std::vector<char> buffer_;        // link thread only
 
   // Guarded by mutex_:
-  std::vector<std::uint32_t> next_seqno_;          // per channel, ours
-  std::vector<std::int64_t> last_robot_seqno_;     // per channel, the controller's; -1: none
+  std::vector<std::uint32_t> next_seqno_;  // per channel, ours
+  std::vector<FeedbackFilter> filters_;    // per channel
   std::uint64_t rejected_ = 0;
-  std::uint64_t lost_ = 0;
+  int foreign_logged_ = 0;
   std::vector<float> latency_us_;  // ring buffer
   std::size_t latency_next_ = 0;
 };

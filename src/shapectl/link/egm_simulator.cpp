@@ -74,20 +74,24 @@ void EgmSimulator::run(std::stop_token stop) {
   while (!stop.stop_requested()) {
     next += period;
     std::this_thread::sleep_until(next);
+    // A late tick (this machine is busy; a real controller's cycle is exact) is not checked.
+    const bool late = std::chrono::steady_clock::now() - next > period / 2;
     const bool paused = paused_;
     for (auto& arm : arms_) {
       if (!arm->socket) continue;
       if (was_paused && !paused) arm->resumed = true;
-      tick(*arm, paused);
+      tick(*arm, paused, late);
     }
     was_paused = paused;
   }
 }
 
-void EgmSimulator::tick(Arm& arm, bool paused) {
+void EgmSimulator::tick(Arm& arm, bool paused, bool late) {
   const GovernorLimits limits = yumi_arm_limits(config_.acceleration);
   std::array<char, EgmCodec::max_datagram + 1> buffer;
-  // Replies to earlier feedback: the newest valid one is the arm's command.
+  // Replies to earlier feedback: the newest valid one is the arm's command, as on a real
+  // controller, which uses the latest correction each cycle.
+  std::optional<ArmJoints> newest;
   long n;
   while ((n = arm.socket->receive(buffer, nullptr)) >= 0) {
     EgmCommand command;
@@ -97,13 +101,21 @@ void EgmSimulator::tick(Arm& arm, bool paused) {
       ++arm.stats.rejected;
       continue;
     }
-    EgmSimArmStats& s = arm.stats;
-    ++s.commands;
-    s.last_command = command.joints;
+    ++arm.stats.commands;
     const ArmJoints& q = command.joints;
     if ((q.array() < limits.lower.array()).any() || (q.array() > limits.upper.array()).any())
-      ++s.outside_limits;
-    if (arm.resumed) arm.recent.clear(), arm.resumed = false;
+      ++arm.stats.outside_limits;
+    newest = q;
+  }
+  std::lock_guard lock(mutex_);
+  EgmSimArmStats& s = arm.stats;
+  // The checks cover runs of cycles that each brought a new command; a cycle without one (the
+  // link held or its reply came late) restarts them, as does our own late tick.
+  if (arm.resumed || !newest || (!arm.recent.empty() && *newest == arm.recent.back()) || late)
+    arm.recent.clear(), arm.resumed = false;
+  if (newest) {
+    const ArmJoints& q = *newest;
+    s.last_command = q;
     const double dt = config_.period;
     if (!arm.recent.empty())
       s.max_speed = std::max(s.max_speed, (q - arm.recent.back()).cwiseAbs().maxCoeff() / dt);
@@ -115,18 +127,15 @@ void EgmSimulator::tick(Arm& arm, bool paused) {
     arm.recent.push_back(q);
     arm.robot.command(q);
   }
+  arm.robot.step(config_.period);
+  s.position = arm.robot.position();
+  if (paused) return;
   EgmFeedback feedback;
-  {
-    std::lock_guard lock(mutex_);
-    arm.robot.step(config_.period);
-    arm.stats.position = arm.robot.position();
-    feedback.joints = arm.stats.position;
-    if (paused) return;
-    feedback.seqno = ++arm.seqno;
-    feedback.tm = static_cast<std::uint32_t>(arm.seqno * config_.period * 1000);
-    feedback.motors_on = feedback.egm_running = feedback.rapid_running = true;
-    ++arm.stats.feedback_sent;
-  }
+  feedback.joints = s.position;
+  feedback.seqno = ++arm.seqno;
+  feedback.tm = static_cast<std::uint32_t>(arm.seqno * config_.period * 1000);
+  feedback.motors_on = feedback.egm_running = feedback.rapid_running = true;
+  ++s.feedback_sent;
   arm.socket->send_to(codec_.encode_robot(feedback), arm.sensor);
 }
 

@@ -1,9 +1,10 @@
 #pragma once
 // A stand-in for the YuMi controller's side of EGM, to try the whole chain without hardware:
 // every `period` each arm sends an EgmRobot (measured joints, motors on, EGM running) from its
-// own UDP socket to the sensor's port and moves its simulated arm towards the last EgmSensor
-// command received, within YuMi's joint speeds and `acceleration`. It also checks the command
-// stream it receives (speed and acceleration implied by consecutive commands, joint limits).
+// own UDP socket to the sensor's port and moves its simulated arm towards the newest EgmSensor
+// command received, within YuMi's joint speeds and `acceleration`. It also checks the commands
+// it uses, one per cycle (speed and acceleration implied by consecutive cycles' commands, over
+// runs of cycles that each brought a new command), and every command against the joint limits.
 #include <atomic>
 #include <memory>
 #include <mutex>
@@ -37,7 +38,8 @@ struct EgmSimArmStats {
   std::uint64_t rejected = 0;       // replies that were not valid EgmSensor messages
   ArmJoints position = ArmJoints::Zero();      // the simulated arm, rad
   ArmJoints last_command = ArmJoints::Zero();  // rad
-  // From consecutive commands (period apart), over all joints; restarted after a pause.
+  // From consecutive cycles' commands (period apart), over all joints; restarted after a
+  // pause, a cycle without a new command, or a late tick of the simulator's own.
   double max_speed = 0;         // rad/s
   double max_acceleration = 0;  // rad/s²
   std::uint64_t outside_limits = 0;  // commands outside the arm's joint limits
@@ -57,7 +59,7 @@ class EgmSimulator {
  private:
   struct Arm;
   void run(std::stop_token stop);
-  void tick(Arm& arm, bool paused);
+  void tick(Arm& arm, bool paused, bool late);
 
   EgmSimulatorConfig config_;
   std::vector<std::unique_ptr<Arm>> arms_;  // [left, right]

@@ -36,7 +36,8 @@ LinkSupervisor::LinkSupervisor(std::string kind, std::vector<std::string> joint_
       log_(log) {
   assert(static_cast<int>(joint_names_.size()) == limits_.size());
   for (const auto& spec : channels_) {
-    Channel c{spec, MotionGovernor(limits_.subset(spec.joints)), {}, {}, false, {}};
+    Channel c{spec, MotionGovernor(limits_.subset(spec.joints)), MotionPacer(settings_.period),
+              {}, -std::numeric_limits<double>::infinity(), false, {}, {}};
     c.measured = c.governor.position();
     state_.push_back(std::move(c));
   }
@@ -101,6 +102,7 @@ bool LinkSupervisor::arm(double now, std::string* why_not) {
   std::string why;
   for (const auto& c : state_) {
     if (!c.connected) why = c.spec.name + ": no feedback";
+    else if (!c.outside.empty()) why = c.spec.name + ": " + c.outside;
     else if (!c.fault.empty()) why = c.spec.name + ": " + c.fault;
     if (!why.empty()) break;
   }
@@ -127,18 +129,38 @@ void LinkSupervisor::disarm(const std::string& reason) {
   log("disarm", {{"reason", reason_}});
 }
 
-void LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& measured,
-                                 std::string_view fault, double now, double dt) {
+std::string LinkSupervisor::outside_limits(const Channel& c, const Eigen::VectorXd& measured) const {
+  for (std::size_t i = 0; i < c.spec.joints.size(); ++i) {
+    const int j = c.spec.joints[i];
+    const double q = measured[static_cast<Eigen::Index>(i)];
+    if (q < hard_lower_[j] || q > hard_upper_[j])
+      return joint_names_[static_cast<std::size_t>(j)] + " measured at " + format(q) +
+             " rad, outside its limits [" + format(hard_lower_[j]) + ", " + format(hard_upper_[j]) +
+             "]: move it inside by hand first";
+  }
+  return {};
+}
+
+FeedbackStep LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& measured,
+                                         std::string_view fault, double now) {
   Channel& c = state_[static_cast<std::size_t>(channel)];
   assert(measured.size() == c.governor.limits().size() && measured.allFinite());
-  const bool resumed = !c.connected;
+  const bool resumed = !c.connected || !c.outside.empty();
   c.connected = true;
   c.last_feedback = now;
   c.measured = measured;
   c.fault = fault;
+  if (std::string why = outside_limits(c, measured); !why.empty()) {
+    if (c.outside != why) log("outside_limits", {{"channel", c.spec.name}, {"reason", why}});
+    c.outside = std::move(why);
+    if (armed_) disarm(c.spec.name + ": " + c.outside);
+    return {};
+  }
+  c.outside.clear();
   if (resumed) {
     // No jump on (re)connect: command the robot where it is.
     c.governor.reset(measured);
+    c.pacer.restart();
     log("connect", {{"channel", c.spec.name}, {"measured", to_list(measured)}});
   }
   if (armed_ && !c.fault.empty()) disarm(c.spec.name + ": " + c.fault);
@@ -148,7 +170,15 @@ void LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& measured,
       disarm(c.spec.name + ": tracking error " + format(error) + " rad above " +
              format(settings_.max_tracking_error) + " rad");
   }
+  const PaceStep pace = c.pacer.on_send(now);
+  FeedbackStep step{.send = true, .advanced = pace.advance, .from_rest = false};
+  if (!pace.advance) return step;
+  if (pace.from_rest && !c.governor.at_rest()) {
+    c.governor.halt();
+    step.from_rest = true;
+  }
   const Eigen::VectorXd before = c.governor.position();
+  const double dt = settings_.period;
   if (armed_ && has_target_) c.governor.step_towards(channel_part(target_, c), dt);
   else c.governor.step_stop(dt);
   std::string why;
@@ -156,6 +186,7 @@ void LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& measured,
     c.governor.reset(before);  // stop at the last good pose at once
     disarm(c.spec.name + ": commanded pose: " + why);
   }
+  return step;
 }
 
 const Eigen::VectorXd& LinkSupervisor::command(int channel) const {

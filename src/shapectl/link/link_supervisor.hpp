@@ -12,6 +12,13 @@
 //   failing the pose check), feedback missing longer than the watchdog time, a robot fault,
 //   a tracking error above the limit, a commanded pose failing the pose check (then it stops
 //   at the last good pose at once).
+// - Real time: a channel's governor advances one step of `period` only as fast as the clock
+//   allows (MotionPacer), whatever the arrival pattern of the feedback; the rest are holds.
+// - Hard limits: while a channel's measured joints are outside the robot's joint limits it gets
+//   no command at all (none may lie outside them, and jumping inside is no option), it is
+//   disarmed and arming is refused; once measured inside again it restarts from there. From
+//   the margin (inside the limits, outside the band) commands only move inwards: targets are
+//   clamped into the band.
 // Not thread-safe: the links call it under their own mutex. Times are seconds on one clock.
 #include <functional>
 #include <limits>
@@ -23,6 +30,7 @@
 #include <nlohmann/json.hpp>
 
 #include <shapectl/link/motion_governor.hpp>
+#include <shapectl/link/motion_pacing.hpp>
 #include <shapectl/link/robot_link.hpp>
 
 namespace shapectl {
@@ -38,6 +46,14 @@ struct SupervisorSettings {
   double watchdog_timeout = 0.1;    // s without feedback on a channel: hold and disarm
   double max_tracking_error = 0.2;  // rad between commanded and measured while armed
   double arrive_tolerance = 1e-3;   // rad: measured this close to the commanded target
+  double period = 0.004;            // s, the controller cycle: one governor step's time
+};
+
+// What to do with one feedback sample.
+struct FeedbackStep {
+  bool send = false;       // reply with command(); false: send nothing
+  bool advanced = false;   // the governor took a step (else the command is the previous one)
+  bool from_rest = false;  // ... after zeroing its velocity (the pose was held over a gap)
 };
 
 // Full-θ check of a pose (e.g. self-collision): true when fine, else false and `why` set.
@@ -66,9 +82,10 @@ class LinkSupervisor {
 
   // One feedback sample of `channel` (its joints, rad, channel order) arrived at `now`;
   // `fault` is non-empty when the robot says it cannot follow. Advances that channel's
-  // governor by `dt` and returns the command to send (channel order): positions, velocities.
-  void on_feedback(int channel, const Eigen::VectorXd& measured, std::string_view fault,
-                   double now, double dt);
+  // governor as far as real time allows; command() is then the command to send.
+  FeedbackStep on_feedback(int channel, const Eigen::VectorXd& measured, std::string_view fault,
+                           double now);
+  bool connected(int channel) const { return state_[static_cast<std::size_t>(channel)].connected; }
   const Eigen::VectorXd& command(int channel) const;
   const Eigen::VectorXd& command_velocity(int channel) const;
 
@@ -82,11 +99,14 @@ class LinkSupervisor {
   struct Channel {
     LinkChannel spec;
     MotionGovernor governor;
+    MotionPacer pacer;
     Eigen::VectorXd measured;
     double last_feedback = -std::numeric_limits<double>::infinity();
     bool connected = false;
     std::string fault;
+    std::string outside;  // why the measured joints are outside the hard limits; empty: inside
   };
+  std::string outside_limits(const Channel& c, const Eigen::VectorXd& measured) const;
   void log(std::string_view event, const nlohmann::json& fields) const;
   Eigen::VectorXd channel_part(const Eigen::VectorXd& full, const Channel& c) const;
   Eigen::VectorXd full_commanded() const;

@@ -28,6 +28,9 @@ class MotionGovernor {
   void reset(const Eigen::VectorXd& position);
   // One sample towards `target` (clamped into the band). `dt` > 0, seconds.
   void step_towards(const Eigen::VectorXd& target, double dt);
+  // Velocity to zero at once, position kept: the robot's reference already stood still
+  // (its controller held our last command through a feedback gap).
+  void halt() { velocity_.setZero(); }
   // One sample of braking to a standstill, at the acceleration limit; then it holds.
   void step_stop(double dt);
 

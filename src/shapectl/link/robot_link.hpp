@@ -24,7 +24,9 @@ struct LinkStatus {
   bool arrived = false;          // armed, at rest on the target, measured within tolerance
   std::uint64_t commands_sent = 0;
   std::uint64_t rejected_datagrams = 0;  // egm: malformed, truncated, oversized, wrong type
-  std::uint64_t lost_datagrams = 0;      // egm: gaps in the controller's sequence numbers
+  std::uint64_t lost_datagrams = 0;      // egm: controller sequence numbers never received
+  std::uint64_t stale_datagrams = 0;     // egm: duplicates, reordered, older than the newest
+  std::uint64_t foreign_datagrams = 0;   // egm: from another sender than the bound controller
 };
 
 class RobotLink {

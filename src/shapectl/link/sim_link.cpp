@@ -39,7 +39,8 @@ SimLink::SimLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
                                         return all;
                                       }()}},
                                     robot.lower_limits(), robot.upper_limits(), governor_limits(config, robot),
-                                    {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance},
+                                    {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance,
+                                     config.sim_period},
                                     std::move(check), log.get())),
       robot_(sim_robot_limits(config, robot, supervisor_.limits()), sim_initial(config, robot)) {
   if (log_)
@@ -58,16 +59,19 @@ void SimLink::run(std::stop_token stop) {
     next += period;
     std::this_thread::sleep_until(next);
     std::uint64_t seq = 0;
+    FeedbackStep step;
     {
       std::lock_guard lock(mutex_);
       robot_.step(period_);
       measured = robot_.position();
-      supervisor_.on_feedback(0, measured, {}, now(), period_);
-      command = supervisor_.command(0);
-      robot_.command(command);
-      seq = ++commands_sent_;
+      step = supervisor_.on_feedback(0, measured, {}, now());
+      if (step.send) {
+        command = supervisor_.command(0);
+        robot_.command(command);
+        seq = ++commands_sent_;
+      }
     }
-    if (log_) log_command(*log_, "robot", seq, command, measured);
+    if (log_ && step.send) log_command(*log_, "robot", seq, command, measured, step);
   }
 }
 

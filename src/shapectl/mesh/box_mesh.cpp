@@ -4,6 +4,7 @@
 #include <string>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/mesh/mesh_limits.hpp>
 
 namespace shapectl {
 
@@ -18,6 +19,11 @@ TetMesh make_box_mesh(const Vec3& size, const std::array<int, 3>& cells,
       throw InputError("box mesh", std::string("cells.") + axis_names[a], "at least 1 cell",
                        cells[a]);
   }
+  const long long tet_count = 6LL * cells[0] * cells[1] * cells[2];
+  if (tet_count > max_mesh_tets)
+    throw InputError("box mesh", "cells",
+                     "at most " + std::to_string(max_mesh_tets) + " tetrahedra (6 per cell)",
+                     tet_count);
   const int nx = cells[0], ny = cells[1], nz = cells[2];
   auto index = [&](int i, int j, int k) { return i + (nx + 1) * (j + (ny + 1) * k); };
 

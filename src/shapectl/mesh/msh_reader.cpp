@@ -7,6 +7,7 @@
 #include <vector>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/mesh/mesh_limits.hpp>
 #include <shapectl/mesh/text_lines.hpp>
 
 namespace shapectl {
@@ -52,6 +53,8 @@ int read_format(TextLines& in) {
 
 void add_node(TextLines& in, MshContent& msh, long long tag, const Vec3& x) {
   const std::string where = "node " + std::to_string(tag);
+  if (static_cast<long>(msh.positions.size()) >= max_mesh_nodes)
+    in.fail(where, "more than " + std::to_string(max_mesh_nodes) + " nodes (the limit for a mesh)");
   const auto [it, inserted] = msh.index_of_tag.emplace(tag, static_cast<int>(msh.positions.size()));
   if (!inserted) in.fail(where, "tag appears twice in $Nodes");
   msh.positions.push_back(x);
@@ -60,6 +63,8 @@ void add_node(TextLines& in, MshContent& msh, long long tag, const Vec3& x) {
 // A tetrahedron's four node tags, from tokens first..first+3 of the current line.
 void add_tet(TextLines& in, MshContent& msh, long long tag, std::size_t first) {
   const std::string where = "element " + std::to_string(tag);
+  if (static_cast<long>(msh.tets.size()) >= max_mesh_tets)
+    in.fail(where, "more than " + std::to_string(max_mesh_tets) + " tetrahedra (the limit for a mesh)");
   std::array<int, 4> tet;
   for (int a = 0; a < 4; ++a) {
     const long long node = in.integer(first + a, where, "node tag");

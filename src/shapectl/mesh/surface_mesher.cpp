@@ -5,6 +5,7 @@
 #include <tetgen.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
@@ -18,6 +19,7 @@
 #include <string_view>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/mesh/mesh_limits.hpp>
 #include <shapectl/mesh/text_lines.hpp>
 
 namespace shapectl {
@@ -28,7 +30,11 @@ namespace {
 // polygons into triangle fans, and finally drops vertices no face uses.
 class SurfaceBuilder {
  public:
+  explicit SurfaceBuilder(const std::string& name) : name_(name) {}
   void add_vertex(const Vec3& x) {
+    if (static_cast<long>(unique_of_read_.size()) >= 3 * max_surface_triangles)
+      throw InputError(name_, "", "more than " + std::to_string(3 * max_surface_triangles) +
+                                      " vertices (the limit for a surface)");
     const auto [it, inserted] =
         merged_.emplace(std::array<double, 3>{x.x(), x.y(), x.z()}, int(surface_.vertices.size()));
     if (inserted) surface_.vertices.push_back(x);
@@ -37,6 +43,9 @@ class SurfaceBuilder {
   int vertex_count() const { return static_cast<int>(unique_of_read_.size()); }
   // `corners` index the vertices in the order they were read; false if a vertex repeats.
   bool add_polygon(const std::vector<int>& corners) {
+    if (static_cast<long>(surface_.triangles.size() + corners.size()) - 2 > max_surface_triangles)
+      throw InputError(name_, "", "more than " + std::to_string(max_surface_triangles) +
+                                      " triangles (the limit for a surface)");
     std::vector<int> unique;
     for (int c : corners) unique.push_back(unique_of_read_[c]);
     std::vector<int> sorted = unique;
@@ -63,6 +72,7 @@ class SurfaceBuilder {
   }
 
  private:
+  std::string name_;
   TriangleSurface surface_;
   std::map<std::array<double, 3>, int> merged_;
   std::vector<int> unique_of_read_;  // for each vertex read, its index in surface_.vertices
@@ -72,7 +82,7 @@ class SurfaceBuilder {
 // everything else (vt, vn, g, o, s, usemtl, ...) is ignored.
 TriangleSurface read_obj(const std::string& name, const std::string& text) {
   TextLines in(name, text, TextLines::Comments::Hash);
-  SurfaceBuilder builder;
+  SurfaceBuilder builder(name);
   while (in.next()) {
     if (in[0] == "v") {
       if (in.size() < 4) in.fail("", "expected 'v x y z', found " + std::to_string(in.size() - 1) + " values");
@@ -110,7 +120,7 @@ TriangleSurface read_off(const std::string& name, const std::string& text) {
   if (in.size() < first + 2) in.fail("", "expected the counts 'vertices faces edges'");
   const long long vertices = in.count(first, "vertex count");
   const long long faces = in.count(first + 1, "face count");
-  SurfaceBuilder builder;
+  SurfaceBuilder builder(name);
   for (long long v = 0; v < vertices; ++v) {
     const std::string where = "vertex " + std::to_string(v);
     in.next(where + " of " + std::to_string(vertices));
@@ -139,7 +149,7 @@ TriangleSurface read_off(const std::string& name, const std::string& text) {
 // ASCII STL: "solid", then facets of "outer loop", three "vertex x y z", "endloop", "endfacet".
 TriangleSurface read_ascii_stl(const std::string& name, const std::string& text) {
   TextLines in(name, text, TextLines::Comments::Hash);
-  SurfaceBuilder builder;
+  SurfaceBuilder builder(name);
   std::vector<int> corners;
   bool in_facet = false;
   while (in.next()) {
@@ -179,7 +189,10 @@ TriangleSurface read_binary_stl(const std::string& name, const std::string& byte
     return static_cast<double>(value);
   };
   const std::size_t count = (bytes.size() - 84) / 50;
-  SurfaceBuilder builder;
+  if (count > static_cast<std::size_t>(max_surface_triangles))
+    throw InputError(name, "", std::to_string(count) + " triangles, more than the limit of " +
+                                   std::to_string(max_surface_triangles) + " for a surface");
+  SurfaceBuilder builder(name);
   for (std::size_t t = 0; t < count; ++t) {
     std::vector<int> corners;
     for (int c = 0; c < 3; ++c) {
@@ -380,20 +393,52 @@ TriangleSurface read_surface(const std::filesystem::path& file) {
   return read_off(name, text);
 }
 
+namespace {
+
+// The volume a closed triangle surface encloses (divergence theorem), m^3.
+double enclosed_volume(const TriangleSurface& surface) {
+  double six_volume = 0;
+  for (const auto& t : surface.triangles)
+    six_volume += surface.vertices[t[0]].dot(surface.vertices[t[1]].cross(surface.vertices[t[2]]));
+  return std::abs(six_volume) / 6;
+}
+
+}  // namespace
+
 TetMesh tetrahedralize_surface(const TriangleSurface& surface, const SurfaceMeshOptions& options,
                                const std::string& source) {
   const double ratio = options.max_radius_edge_ratio, volume = options.max_tet_volume;
+  const std::string option_file = options.origin_file.empty() ? source : options.origin_file;
+  auto option = [&](const std::string& name) {
+    return options.origin_path.empty() ? name : options.origin_path + "." + name;
+  };
   if (!(std::isfinite(ratio) && (ratio == 0 || ratio >= 1)))
-    throw InputError(source, "max_radius_edge_ratio", "0 (off) or a ratio >= 1", ratio);
+    throw InputError(option_file, option("max_radius_edge_ratio"), "0 (off) or a ratio >= 1", ratio);
   if (!(std::isfinite(volume) && volume >= 0))
-    throw InputError(source, "max_tet_volume", "0 (no bound) or a positive volume in m^3", volume);
+    throw InputError(option_file, option("max_tet_volume"), "0 (no bound) or a positive volume in m^3", volume);
   const int n = static_cast<int>(surface.vertices.size());
   for (const auto& t : surface.triangles)
     for (int v : t)
       if (v < 0 || v >= n)
         throw InputError(source, "", "triangle vertex " + std::to_string(v) + " out of range");
+  // TetGen's exact predicates overflow on huge coordinates (products of four of them).
+  for (int i = 0; i < n; ++i)
+    if (!(surface.vertices[i].cwiseAbs().maxCoeff() <= 1e6))
+      throw InputError(source, "vertex " + std::to_string(i), "coordinates within 1e6 m of the origin",
+                       shown_point(surface.vertices[i]));
   if (surface.triangles.empty()) throw InputError(source, "", "no triangles");
+  if (static_cast<long>(surface.triangles.size()) > max_surface_triangles)
+    throw InputError(source, "", "more than " + std::to_string(max_surface_triangles) + " triangles");
   expect_closed(surface, source);
+  // Refuse a volume bound that asks for more tets than a mesh may have, before TetGen runs.
+  const double enclosed = enclosed_volume(surface);
+  if (volume > 0 && enclosed / volume > max_tetgen_volume_ratio) {
+    std::ostringstream expected;
+    expected << "0 (no bound) or at least " << enclosed / max_tetgen_volume_ratio
+             << " m^3 (the surface " << source << " encloses " << enclosed << " m^3; at most "
+             << max_tetgen_volume_ratio << " times smaller)";
+    throw InputError(option_file, option("max_tet_volume"), expected.str(), volume);
+  }
 
   // tetgenio frees these arrays with delete[] when it dies.
   tetgenio in;
@@ -418,7 +463,7 @@ TetMesh tetrahedralize_surface(const TriangleSurface& surface, const SurfaceMesh
   // p: the input is a surface; z: number from 0; Q: quiet.
   std::ostringstream switches;
   switches.precision(17);
-  switches << "pzQ";
+  switches << "pzQS" << max_tetgen_added_points;
   if (ratio > 0) switches << "q" << ratio;
   if (volume > 0) switches << "a" << volume;
   if (options.keep_surface) switches << "Y";
@@ -427,6 +472,15 @@ TetMesh tetrahedralize_surface(const TriangleSurface& surface, const SurfaceMesh
   if (!behavior.parse_commandline(text.data()))
     throw std::logic_error("TetGen rejected the switches " + text);
   TetgenResult out = tetrahedralize_isolated(behavior, in, source);
+  // TetGen quietly stops refining when -S runs out: the mesh would not meet the options.
+  if (static_cast<long>(out.points.size()) - n >= max_tetgen_added_points)
+    throw InputError(option_file, options.origin_path,
+                     "TetGen needed more than " + std::to_string(max_tetgen_added_points) +
+                         " added points for these options; allow larger or less regular "
+                         "tets (a larger max_tet_volume or max_radius_edge_ratio)");
+  if (static_cast<long>(out.tets.size()) > max_mesh_tets)
+    throw InputError(source, "", "TetGen made " + std::to_string(out.tets.size()) +
+                                     " tetrahedra, more than the limit of " + std::to_string(max_mesh_tets));
 
   // TetGen keeps the input points first; a surface vertex it dropped would break that promise.
   for (int i = 0; i < n; ++i)

@@ -17,6 +17,10 @@ struct SurfaceMeshOptions {
   double max_tet_volume = 0;
   // Keep the input triangles as the boundary, adding no Steiner points on it (TetGen -Y).
   bool keep_surface = false;
+  // Where these options were given, for messages about them: e.g. "scene.json" and
+  // "object.mesh" give "scene.json: object.mesh.max_tet_volume: ..."; empty: the surface's name.
+  std::string origin_file = "";
+  std::string origin_path = "";
 };
 
 struct TriangleSurface {
@@ -33,6 +37,9 @@ TriangleSurface read_surface(const std::filesystem::path& file);
 // Tetrahedralizes a closed surface. Node order: the surface vertices first, in order, then the
 // points TetGen added. Throws InputError naming `source` if the surface is not closed (every edge
 // shared by exactly two triangles), or if TetGen refuses it (e.g. it intersects itself).
+// Vertices must lie within 1e6 m of the origin (TetGen's predicates overflow beyond).
+// Bounded work: a max_tet_volume below enclosed volume / max_tetgen_volume_ratio is refused
+// before TetGen runs, and TetGen adds at most max_tetgen_added_points (needing more is an error).
 TetMesh tetrahedralize_surface(const TriangleSurface& surface, const SurfaceMeshOptions& options,
                                const std::string& source = "surface");
 

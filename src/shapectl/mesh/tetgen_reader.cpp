@@ -6,6 +6,7 @@
 #include <vector>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/mesh/mesh_limits.hpp>
 #include <shapectl/mesh/text_lines.hpp>
 
 namespace shapectl {
@@ -32,7 +33,7 @@ Points read_node_file(const std::filesystem::path& file) {
   in.next("the header '<points> <dimension> <attributes> <boundary markers>'");
   if (in.size() < 2 || in.size() > 4)
     in.fail("header", "expected '<points> <dimension> [<attributes> [<boundary markers>]]'");
-  const long long n = header_field(in, 0, "point count", 1LL << 31);
+  const long long n = header_field(in, 0, "point count", max_mesh_nodes);
   const long long dimension = in.integer(1, "header", "dimension");
   if (dimension != 3) in.fail("header", "dimension must be 3, got " + std::to_string(dimension));
   const long long attributes = in.size() > 2 ? header_field(in, 2, "attribute count", 1000) : 0;
@@ -71,7 +72,7 @@ Elements read_ele_file(const std::filesystem::path& file, const Points& points) 
   in.next("the header '<tetrahedra> <nodes per tetrahedron> <region attribute>'");
   if (in.size() < 2 || in.size() > 3)
     in.fail("header", "expected '<tetrahedra> <nodes per tetrahedron> [<region attribute>]'");
-  const long long n = header_field(in, 0, "tetrahedron count", 1LL << 31);
+  const long long n = header_field(in, 0, "tetrahedron count", max_mesh_tets);
   const long long corners = in.integer(1, "header", "nodes per tetrahedron");
   if (corners != 4 && corners != 10)
     in.fail("header", "nodes per tetrahedron must be 4 or 10, got " + std::to_string(corners));

@@ -4,10 +4,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
-#include <sstream>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/input_file.hpp>
 
 namespace shapectl {
 
@@ -16,11 +15,7 @@ std::string read_text_file(const std::filesystem::path& file) {
   std::error_code ec;
   if (!std::filesystem::exists(file, ec)) throw InputError(name, "", "file not found");
   if (std::filesystem::is_directory(file, ec)) throw InputError(name, "", "is a directory");
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(name, "", "cannot open file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
+  return read_input_file(file, max_mesh_file_bytes, "mesh");
 }
 
 std::string shown(std::string_view token) {

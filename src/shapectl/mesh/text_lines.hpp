@@ -12,7 +12,8 @@
 namespace shapectl {
 
 // The whole file as bytes. Throws InputError naming the file: "file not found",
-// "is a directory" or "cannot open file".
+// "is a directory", "cannot open file", "not a regular file" (a FIFO, a device) or larger than
+// max_mesh_file_bytes.
 std::string read_text_file(const std::filesystem::path& file);
 
 // A token as it may appear in a message: at most 40 characters (then "..."), unprintable

@@ -1,5 +1,7 @@
 #include <shapectl/robot/collision_spheres.hpp>
 
+#include <shapectl/io/input_file.hpp>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -204,15 +206,19 @@ CollisionModel CollisionModel::from_json(const RobotModel& robot, const JsonInpu
   const double stiffness = json.has("stiffness") ? json.at("stiffness").positive() : default_stiffness;
   auto link_named = [&](const JsonInput& where, const std::string& name) {
     const auto link = robot.find_link(name);
-    if (!link) where.fail_problem("unknown link '" + name + "' (not in " + robot.source() + ")");
+    if (!link) where.fail_problem("unknown link '" + bounded_preview(name) + "' (not in " + robot.source() + ")");
     return *link;
   };
 
+  // Pairs grow with the square of the sphere count: bound it (YuMi has 155).
+  constexpr std::size_t max_spheres = 2000;
   std::vector<CollisionSphere> spheres;
   const JsonInput all = json.at("spheres");
   for (const auto& name : all.keys()) {
     const JsonInput list = all.at(name);
     const int link = link_named(list, name);
+    if (spheres.size() + list.size() > max_spheres)
+      list.fail_problem("more than " + std::to_string(max_spheres) + " spheres in all (the limit)");
     for (std::size_t i = 0; i < list.size(); ++i) {
       const JsonInput sphere = list.at(i);
       sphere.expect_only({"center", "radius"});

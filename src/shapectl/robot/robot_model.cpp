@@ -5,13 +5,14 @@
 #include <cmath>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/input_file.hpp>
 
 namespace shapectl {
 
 namespace {
 
 std::string quoted(std::string_view kind, std::string_view name) {
-  return std::string(kind) + " '" + std::string(name) + "'";
+  return std::string(kind) + " '" + bounded_preview(name) + "'";  // names come from input
 }
 
 }  // namespace

@@ -5,14 +5,15 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
-#include <fstream>
 #include <limits>
 #include <mutex>
-#include <regex>
+#include <optional>
+#include <string_view>
 #include <set>
 #include <sstream>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/input_file.hpp>
 #include <shapectl/robot/robot_model.hpp>
 
 namespace shapectl {
@@ -28,26 +29,101 @@ class CapturedLog : public console_bridge::OutputHandler {
   std::vector<std::string> lines;
 };
 
+// Bounds checked before urdfdom sees the text: TinyXML recurses once per nested element, and
+// urdfdom's links free each other recursively down a chain.
+constexpr int max_xml_depth = 100;
+constexpr std::size_t max_urdf_elements = 2000;  // links and joints each; YuMi has 38 links
+
+// Where `xml` nests elements deeper than `max_depth` (byte offset), or npos. One pass, no
+// recursion: skips comments, CDATA, declarations and quoted attribute values.
+std::size_t xml_too_deep_at(std::string_view xml, int max_depth) {
+  int depth = 0;
+  auto skip_past = [&](std::size_t from, std::string_view end) {
+    const std::size_t at = xml.find(end, from);
+    return at == std::string_view::npos ? xml.size() : at + end.size();
+  };
+  for (std::size_t i = xml.find('<'); i < xml.size(); i = xml.find('<', i)) {
+    const std::string_view rest = xml.substr(i);
+    if (rest.starts_with("<!--")) { i = skip_past(i + 4, "-->"); continue; }
+    if (rest.starts_with("<![CDATA[")) { i = skip_past(i + 9, "]]>"); continue; }
+    if (rest.starts_with("<?")) { i = skip_past(i + 2, "?>"); continue; }
+    if (rest.starts_with("<!")) { i = skip_past(i + 2, ">"); continue; }
+    if (rest.starts_with("</")) { --depth; i = skip_past(i + 2, ">"); continue; }
+    // An opening tag: find its end outside quoted attribute values.
+    char quote = 0;
+    std::size_t j = i + 1;
+    for (; j < xml.size(); ++j) {
+      const char c = xml[j];
+      if (quote) { if (c == quote) quote = 0; }
+      else if (c == '"' || c == '\'') quote = c;
+      else if (c == '>') break;
+    }
+    if (j >= xml.size()) return std::string_view::npos;  // unterminated: TinyXML reports it
+    if (xml[j - 1] != '/' && ++depth > max_depth) return i;
+    i = j + 1;
+  }
+  return std::string_view::npos;
+}
+
+// The value of attribute `name` in an element's opening tag `head`, or nullopt.
+std::optional<std::string> attribute(std::string_view head, std::string_view name) {
+  for (std::size_t at = head.find(name); at != std::string_view::npos; at = head.find(name, at + 1)) {
+    if (at == 0 || !std::isspace(static_cast<unsigned char>(head[at - 1]))) continue;
+    std::size_t k = at + name.size();
+    while (k < head.size() && std::isspace(static_cast<unsigned char>(head[k]))) ++k;
+    if (k >= head.size() || head[k] != '=') continue;
+    ++k;
+    while (k < head.size() && std::isspace(static_cast<unsigned char>(head[k]))) ++k;
+    if (k >= head.size() || (head[k] != '"' && head[k] != '\'')) continue;
+    const std::size_t end = head.find_first_of("\"'", k + 1);
+    if (end == std::string_view::npos) return std::nullopt;
+    return std::string(head.substr(k + 1, end - k - 1));
+  }
+  return std::nullopt;
+}
+
 // First line of each top-level <tag name="..."> element, for messages and sibling order.
 // <joint> elements inside <transmission> carry no type attribute, so joints need `type=`.
+// Throws when there are more than max_urdf_elements of them.
 std::map<std::string, int> element_lines(const std::string& xml, const std::string& tag,
-                                         bool need_type) {
+                                         bool need_type, const std::string& source) {
   std::map<std::string, int> lines;
   const std::string open = "<" + tag;
+  std::size_t counted_to = 0;  // lines are counted incrementally: one pass over the text
+  int line = 1;
+  std::size_t elements = 0;
   for (std::size_t at = xml.find(open); at != std::string::npos; at = xml.find(open, at + 1)) {
     const char next = at + open.size() < xml.size() ? xml[at + open.size()] : '>';
     if (!std::isspace(static_cast<unsigned char>(next))) continue;
-    const std::size_t end = xml.find('>', at);
-    const std::string head = xml.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    // The tag ends at '>'; stopping at the next '<' too keeps the scan linear in bad text.
+    const std::size_t end = xml.find_first_of("<>", at + 1);
+    const std::string_view head =
+        std::string_view(xml).substr(at, end == std::string::npos ? std::string::npos : end - at);
     if (need_type && head.find("type") == std::string::npos) continue;
-    static const std::regex name_attribute(R"(\sname\s*=\s*["']([^"']*)["'])");
-    std::smatch match;
-    if (!std::regex_search(head, match, name_attribute)) continue;
-    const std::string name = match[1];
-    const int line = 1 + static_cast<int>(std::count(xml.begin(), xml.begin() + static_cast<long>(at), '\n'));
-    lines.emplace(name, line);  // keeps the first
+    if (++elements > max_urdf_elements)
+      throw InputError(source, "", "more than " + std::to_string(max_urdf_elements) + " <" + tag +
+                                       "> elements (the limit for a robot)");
+    const auto name = attribute(head, "name");
+    if (!name) continue;
+    line += static_cast<int>(std::count(xml.begin() + static_cast<long>(counted_to),
+                                        xml.begin() + static_cast<long>(at), '\n'));
+    counted_to = at;
+    lines.emplace(*name, line);  // keeps the first
   }
   return lines;
+}
+
+// The XML must nest no deeper than max_xml_depth before TinyXML parses it.
+const std::string& checked_depth(const std::string& xml, const std::string& source) {
+  if (const std::size_t at = xml_too_deep_at(xml, max_xml_depth); at != std::string_view::npos)
+    throw InputError(source + ":" + std::to_string(1 + std::count(xml.begin(), xml.begin() + static_cast<long>(at), '\n')),
+                     "", "XML elements nested deeper than " + std::to_string(max_xml_depth) + " levels");
+  return xml;
+}
+
+// "link 'name'" with the name cut to a readable length.
+std::string named(std::string_view kind, std::string_view name) {
+  return std::string(kind) + " '" + bounded_preview(name) + "'";
 }
 
 }  // namespace
@@ -56,8 +132,8 @@ class UrdfReader {
  public:
   UrdfReader(const std::string& xml, const std::string& source)
       : source_(source),
-        joint_lines_(element_lines(xml, "joint", true)),
-        link_lines_(element_lines(xml, "link", false)) {}
+        joint_lines_(element_lines(checked_depth(xml, source), "joint", true, source)),
+        link_lines_(element_lines(xml, "link", false, source)) {}
 
   RobotModel read(const std::string& xml) {
     const urdf::ModelInterfaceSharedPtr urdf = parse(xml);
@@ -65,12 +141,12 @@ class UrdfReader {
     RobotModel model;
     model.name_ = urdf->getName();
     model.source_ = source_;
-    add_subtree(*urdf, urdf->getRoot(), -1, model);
+    add_tree(*urdf, model);
     for (const auto& [name, link] : urdf->links_)
       if (!model.find_link(name))
-        throw InputError(where_link(name), "link '" + name + "'",
-                         "not reachable from the root link '" + urdf->getRoot()->name +
-                             "' (a kinematic loop?)");
+        throw InputError(where_link(name), named("link", name),
+                         "not reachable from the root " + named("link", urdf->getRoot()->name) +
+                             " (a kinematic loop?)");
     resolve_mimics(*urdf, model);
     if (skipped_meshes_ > 0)
       model.warnings_.push_back(source_ + ": " + std::to_string(skipped_meshes_) +
@@ -110,44 +186,61 @@ class UrdfReader {
     for (const auto& [name, joint] : urdf.joints_) {
       const auto [it, fresh] = parent_joint.emplace(joint->child_link_name, name);
       if (!fresh)
-        throw InputError(where_joint(name), "joint '" + name + "'",
-                         "link '" + joint->child_link_name + "' already has parent joint '" +
-                             it->second + "' (kinematic loop; URDF must be a tree)");
+        throw InputError(where_joint(name), named("joint", name),
+                         named("link", joint->child_link_name) + " already has parent " +
+                             named("joint", it->second) + " (kinematic loop; URDF must be a tree)");
     }
   }
 
-  void add_subtree(const urdf::ModelInterface& urdf, const urdf::LinkConstSharedPtr& link,
-                   int parent_joint, RobotModel& model) {
+  // Depth first from the root, siblings in file order, with an explicit stack: a URDF chain
+  // may be long. Each joint is added just before its child link's subtree.
+  void add_tree(const urdf::ModelInterface& urdf, RobotModel& model) {
+    add_link(*urdf.getRoot(), -1, model);
+    std::vector<std::pair<urdf::JointSharedPtr, int>> pending;  // joint, its parent link
+    push_children(*urdf.getRoot(), 0, pending);
+    while (!pending.empty()) {
+      const auto [joint, parent_link] = pending.back();
+      pending.pop_back();
+      const int j = model.joint_count();
+      model.joints_.push_back(convert_joint(*joint, parent_link));
+      model.joint_by_name_[joint->name] = j;
+      const urdf::LinkConstSharedPtr child = urdf.getLink(joint->child_link_name);
+      const int child_index = add_link(*child, j, model);
+      push_children(*child, child_index, pending);
+    }
+  }
+
+  int add_link(const urdf::Link& link, int parent_joint, RobotModel& model) {
     const int index = model.link_count();
     Link out;
-    out.name = link->name;
+    out.name = link.name;
     out.parent_joint = parent_joint;
-    for (const auto& visual : link->visual_array)
-      if (visual) add_shape(link->name, "visual", visual->geometry, visual->origin, out.visual_shapes);
-    for (const auto& collision : link->collision_array)
+    for (const auto& visual : link.visual_array)
+      if (visual) add_shape(link.name, "visual", visual->geometry, visual->origin, out.visual_shapes);
+    for (const auto& collision : link.collision_array)
       if (collision)
-        add_shape(link->name, "collision", collision->geometry, collision->origin,
+        add_shape(link.name, "collision", collision->geometry, collision->origin,
                   out.collision_shapes);
     model.links_.push_back(std::move(out));
-    model.link_by_name_[link->name] = index;
+    model.link_by_name_[link.name] = index;
     if (parent_joint >= 0) model.joints_[static_cast<std::size_t>(parent_joint)].child_link = index;
+    return index;
+  }
 
-    std::vector<urdf::JointSharedPtr> children = link->child_joints;
+  // Pushes the link's child joints so that the first in file order is popped first.
+  void push_children(const urdf::Link& link, int index,
+                     std::vector<std::pair<urdf::JointSharedPtr, int>>& pending) const {
+    std::vector<urdf::JointSharedPtr> children = link.child_joints;
     std::sort(children.begin(), children.end(), [&](const auto& a, const auto& b) {
       return std::pair(line_of(joint_lines_, a->name), a->name) <
              std::pair(line_of(joint_lines_, b->name), b->name);
     });
-    for (const auto& joint : children) {
-      const int j = model.joint_count();
-      model.joints_.push_back(convert_joint(*joint, index));
-      model.joint_by_name_[joint->name] = j;
-      add_subtree(urdf, urdf.getLink(joint->child_link_name), j, model);
-    }
+    for (auto it = children.rbegin(); it != children.rend(); ++it) pending.emplace_back(*it, index);
   }
 
   Joint convert_joint(const urdf::Joint& in, int parent_link) const {
     const std::string where = where_joint(in.name);
-    const std::string element = "joint '" + in.name + "'";
+    const std::string element = named("joint", in.name);
     Joint out;
     out.name = in.name;
     out.parent_link = parent_link;
@@ -198,7 +291,7 @@ class UrdfReader {
       const auto in = urdf.getJoint(joint.name);
       if (!in->mimic || !joint.movable()) continue;
       const std::string where = where_joint(joint.name);
-      const std::string element = "joint '" + joint.name + "': mimic";
+      const std::string element = named("joint", joint.name) + ": mimic";
       double multiplier = 1, offset = 0;
       urdf::JointConstSharedPtr current = in;
       std::set<std::string> seen{joint.name};
@@ -209,11 +302,11 @@ class UrdfReader {
         offset = current->mimic->multiplier * offset + current->mimic->offset;
         multiplier *= current->mimic->multiplier;
         if (!seen.insert(master).second)
-          throw InputError(where, element, "mimic joints form a cycle through '" + master + "'");
+          throw InputError(where, element, "mimic joints form a cycle through '" + bounded_preview(master) + "'");
         current = urdf.getJoint(master);
-        if (!current) throw InputError(where, element, "unknown joint '" + master + "'");
+        if (!current) throw InputError(where, element, "unknown " + named("joint", master));
         if (current->type == urdf::Joint::FIXED)
-          throw InputError(where, element, "joint '" + master + "' is fixed");
+          throw InputError(where, element, named("joint", master) + " is fixed");
       }
       joint.mimic_master = model.joint_index(current->name);
       joint.mimic_multiplier = multiplier;
@@ -226,7 +319,7 @@ class UrdfReader {
                  std::vector<Shape>& shapes) {
     if (!geometry) return;
     const std::string where = where_link(link);
-    const std::string element = "link '" + link + "': " + kind;
+    const std::string element = named("link", link) + ": " + kind;
     Shape shape;
     shape.T_link_shape = pose(origin, where, element + " origin");
     auto positive = [&](double v, const std::string& what) {
@@ -256,7 +349,7 @@ class UrdfReader {
       default: {
         if (skipped_meshes_++ == 0)
           first_skipped_ = element + " mesh '" +
-                           static_cast<const urdf::Mesh&>(*geometry).filename + "'";
+                           bounded_preview(static_cast<const urdf::Mesh&>(*geometry).filename) + "'";
         return;
       }
     }
@@ -306,11 +399,7 @@ RobotModel RobotModel::from_urdf_string(const std::string& xml, const std::strin
 }
 
 RobotModel RobotModel::load_urdf_file(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "", "cannot open file");
-  std::stringstream text;
-  text << in.rdbuf();
-  return from_urdf_string(text.str(), file.string());
+  return from_urdf_string(read_input_file(file, max_urdf_file_bytes, "URDF"), file.string());
 }
 
 }  // namespace shapectl

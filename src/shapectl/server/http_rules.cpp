@@ -1,5 +1,7 @@
 #include <shapectl/server/http_rules.hpp>
 
+#include <arpa/inet.h>
+
 #include <algorithm>
 #include <cctype>
 
@@ -14,23 +16,69 @@ std::string lower(std::string_view s) {
   return out;
 }
 
-// "host:port" or "[v6]:port" without the port; empty when malformed.
-std::string host_name(std::string_view host_header) {
-  if (host_header.starts_with('[')) {
-    const auto close = host_header.find(']');
-    if (close == std::string_view::npos) return "";
-    return lower(host_header.substr(0, close + 1));
-  }
-  return lower(host_header.substr(0, host_header.find(':')));
+bool all_digits(std::string_view s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
 }
 
+// A dotted quad, each octet 0-255 without leading zeros (which some resolvers read as octal).
 bool is_ipv4_literal(std::string_view h) {
-  int dots = 0;
-  for (char c : h) {
-    if (c == '.') ++dots;
-    else if (!std::isdigit(static_cast<unsigned char>(c))) return false;
+  for (int octet = 0; octet < 4; ++octet) {
+    const std::size_t end = octet < 3 ? h.find('.') : h.size();
+    if (end == std::string_view::npos) return false;
+    const std::string_view part = h.substr(0, end);
+    if (!all_digits(part) || part.size() > 3 || (part.size() > 1 && part[0] == '0')) return false;
+    if (std::stoi(std::string(part)) > 255) return false;
+    h = octet < 3 ? h.substr(end + 1) : std::string_view();
   }
-  return dots == 3 && !h.empty();
+  return true;
+}
+
+// Hex digits and colons with at most one "::", or an IPv4 tail: checked by inet_pton.
+bool is_ipv6_literal(std::string_view h) {
+  if (h.empty() || h.size() > 45) return false;
+  in6_addr address{};
+  return inet_pton(AF_INET6, std::string(h).c_str(), &address) == 1;
+}
+
+// RFC 1123 labels; a name whose last label is numeric would be an IPv4 address, not a name.
+bool is_hostname(std::string_view h) {
+  if (h.empty() || h.size() > 253 || h.back() == '.') return false;
+  std::string_view last;
+  while (!h.empty()) {
+    const std::size_t end = std::min(h.find('.'), h.size());
+    const std::string_view label = h.substr(0, end);
+    if (label.empty() || label.size() > 63 || label.front() == '-' || label.back() == '-') return false;
+    for (unsigned char c : label)
+      if (!std::isalnum(c) && c != '-') return false;
+    last = label;
+    h = end < h.size() ? h.substr(end + 1) : std::string_view();
+  }
+  return !all_digits(last);
+}
+
+// The host part of a Host header ("name", "1.2.3.4" or "[v6]", lower case) if the header is
+// well formed with an optional port 1-65535; empty otherwise.
+std::string host_name(std::string_view header) {
+  std::string_view host = header, port;
+  if (header.starts_with('[')) {
+    const auto close = header.find(']');
+    if (close == std::string_view::npos || !is_ipv6_literal(header.substr(1, close - 1))) return "";
+    host = header.substr(0, close + 1);
+    const std::string_view rest = header.substr(close + 1);
+    if (!rest.empty() && !rest.starts_with(':')) return "";
+    if (!rest.empty()) port = rest.substr(1);
+    if (rest == ":") return "";
+  } else if (const auto colon = header.find(':'); colon != std::string_view::npos) {
+    host = header.substr(0, colon);
+    port = header.substr(colon + 1);
+    if (port.empty()) return "";
+  }
+  if (!port.empty() && (!all_digits(port) || port.size() > 5 || std::stoi(std::string(port)) < 1 ||
+                        std::stoi(std::string(port)) > 65535))
+    return "";
+  const std::string h = lower(host);
+  if (h.starts_with('[') || is_ipv4_literal(h) || is_hostname(h)) return h;
+  return "";
 }
 
 }  // namespace

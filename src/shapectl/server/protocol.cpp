@@ -40,9 +40,10 @@ nlohmann::json parse_json(std::string_view text) {
     throw InputError(source, "", "longer than " + std::to_string(max_message_bytes) + " bytes");
   if (!nesting_within(text, max_json_depth))
     throw InputError(source, "", "JSON nested deeper than " + std::to_string(max_json_depth));
-  nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
-  if (j.is_discarded()) throw InputError(source, "", "not valid JSON");
-  return j;
+  if (!nlohmann::json::accept(text.begin(), text.end()))
+    throw InputError(source, "", "not valid JSON");
+  // Strictly: a key given twice is an error naming it, never silently the last one.
+  return parse_json_text(text, source, {.max_bytes = max_message_bytes, .max_depth = max_json_depth});
 }
 
 bool valid_id(const nlohmann::json& id) {
@@ -169,7 +170,14 @@ Command parse_command(std::string_view text, const ProtocolContext& context) {
       const JsonInput list = message.at("points");
       if (list.size() < 2 || list.size() > max_centerline_points)
         list.fail("from 2 to " + std::to_string(max_centerline_points) + " points");
-      for (std::size_t k = 0; k < list.size(); ++k) c.points.push_back(read_point(list.at(k)));
+      double length = 0;
+      for (std::size_t k = 0; k < list.size(); ++k) {
+        c.points.push_back(read_point(list.at(k)));
+        if (k > 0) length += (c.points[k] - c.points[k - 1]).norm();
+      }
+      if (!(length >= min_centerline_length))
+        list.fail("a centre-line at least 1 mm long (the points are all within " +
+                  std::to_string(length) + " m of each other)");
       break;
     }
     case T::SetPaused:

@@ -25,6 +25,9 @@ inline constexpr int max_json_depth = 16;
 inline constexpr std::size_t max_centerline_points = 2000;
 // Targets and centre-line points must lie within this distance of the world origin (m).
 inline constexpr double max_coordinate = 10.0;
+// A sketched centre-line shorter than this (m, summed over its segments) is degenerate: the
+// targets built from it would have no direction.
+inline constexpr double min_centerline_length = 1e-3;
 
 // What a command may refer to in the current scene.
 struct ProtocolContext {

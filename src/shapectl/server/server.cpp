@@ -1,16 +1,22 @@
 #include <shapectl/server/server.hpp>
 
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <deque>
 #include <iostream>
+#include <list>
 #include <set>
+#include <utility>
 
 #include <boost/asio.hpp>
 #include <boost/beast.hpp>
 
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/server/http_rules.hpp>
+#include <shapectl/server/log_limiter.hpp>
 
 namespace shapectl::server {
 
@@ -24,22 +30,53 @@ using Clock = std::chrono::steady_clock;
 
 constexpr std::size_t max_queued_frames = 1024;  // a client this far behind is dropped
 constexpr std::size_t max_queued_stream = 4;     // state/position frames dropped beyond this
-constexpr int max_log_lines_per_second = 10;     // per client
+constexpr int max_client_log_lines_per_second = 10;
+constexpr int max_log_lines_per_second = 20;  // everything together
+// A request must arrive complete this long after the connection opened or the previous
+// response went out: half-sent requests and idle keep-alive connections are closed early.
+constexpr auto request_timeout = std::chrono::seconds(5);
+constexpr auto response_timeout = std::chrono::seconds(30);  // slow readers are dropped
+// After a failed accept() (EMFILE: out of descriptors), accepting again at once would spin.
+constexpr auto accept_pause = std::chrono::milliseconds(100);
 
 class Client;
+class HttpConnection;
+
+// HTTP connections that fit the open-file limit: a reserve for the process itself and the
+// WebSocket pages, then two descriptors per connection (its socket and the file it sends).
+std::size_t http_connection_cap(int configured, int max_clients) {
+  rlimit limit{};
+  if (getrlimit(RLIMIT_NOFILE, &limit) != 0 || limit.rlim_cur == RLIM_INFINITY)
+    return static_cast<std::size_t>(configured);
+  const long files = static_cast<long>(std::min<rlim_t>(limit.rlim_cur, 1 << 20));
+  return static_cast<std::size_t>(std::clamp<long>((files - 64 - max_clients) / 2, 4, configured));
+}
 
 std::string_view view(beast::string_view s) { return {s.data(), s.size()}; }
+
+bool out_of_descriptors(const beast::error_code& ec) {
+  return ec == beast::errc::too_many_files_open || ec == beast::errc::too_many_files_open_in_system;
+}
 }  // namespace
 
 struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
-  Impl(Session& s, ServerOptions o) : session(s), options(std::move(o)) {}
+  Impl(Session& s, ServerOptions o)
+      : session(s),
+        options(std::move(o)),
+        http_cap(http_connection_cap(options.max_http_connections, options.max_clients)) {}
   Session& session;
   ServerOptions options;
+  std::size_t http_cap;
+  // Open HTTP connections, oldest first (each one adds and removes itself).
+  std::list<HttpConnection*> http_connections;
+  LogLimiter log_limit{max_log_lines_per_second, std::chrono::seconds(1)};
+  LogLimiter accept_log_limit{1, std::chrono::seconds(1)};  // a failing accept() says so once a second
   // Client objects alive, handshakes under way included; declared before ioc so it outlives the
   // handlers that ioc destroys.
   int websockets = 0;
   net::io_context ioc{1};
   tcp::acceptor acceptor{ioc};
+  net::steady_timer accept_timer{ioc};
   net::steady_timer ticker{ioc};
   net::signal_set signals{ioc, SIGINT, SIGTERM};
   Clock::time_point next_tick;
@@ -47,6 +84,9 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   int next_client_id = 1;
 
   void accept();
+  void admit(tcp::socket socket);
+  bool evict_idle_http();
+  void log(const std::string& line);
   void tick();
   void handle_message(const std::shared_ptr<Client>& client, std::string_view text);
   void broadcast_scene();
@@ -97,17 +137,13 @@ class Client : public std::enable_shared_from_this<Client> {
   }
   bool behind() const { return queue_.size() >= max_queued_stream; }
 
+  // Per client first, so one noisy page does not use up the server's whole log budget.
   void log(const std::string& line) {
-    const auto now = Clock::now();
-    if (now - log_window_ > std::chrono::seconds(1)) {
-      if (suppressed_ > 0) log_line("client " + std::to_string(id_) + ": " +
-                                    std::to_string(suppressed_) + " more lines suppressed");
-      log_window_ = now;
-      logged_ = 0;
-      suppressed_ = 0;
-    }
-    if (++logged_ <= max_log_lines_per_second) log_line("client " + std::to_string(id_) + ": " + line);
-    else ++suppressed_;
+    const std::string prefix = "client " + std::to_string(id_) + ": ";
+    int dropped = 0;
+    const bool admitted = log_limit_.admit(Clock::now(), dropped);
+    if (dropped > 0) server_.log(prefix + std::to_string(dropped) + " more lines suppressed");
+    if (admitted) server_.log(prefix + line);
   }
 
  private:
@@ -163,29 +199,50 @@ class Client : public std::enable_shared_from_this<Client> {
   int id_;
   std::deque<Frame> queue_;
   bool closed_ = false;
-  Clock::time_point log_window_{};
-  int logged_ = 0;
-  int suppressed_ = 0;
+  LogLimiter log_limit_{max_client_log_lines_per_second, std::chrono::seconds(1)};
 };
 
 // One HTTP connection: static files, or the upgrade to a Client on /ws.
 class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
  public:
   HttpConnection(tcp::socket socket, Server::Impl& server)
-      : stream_(std::move(socket)), server_(server) {}
+      : stream_(std::move(socket)), server_(server) {
+    server_.http_connections.push_back(this);
+    place_ = std::prev(server_.http_connections.end());
+  }
+  ~HttpConnection() { forget(); }
+  HttpConnection(const HttpConnection&) = delete;
+  HttpConnection& operator=(const HttpConnection&) = delete;
 
   void read() {
     parser_.emplace();
     parser_->header_limit(16 * 1024);
     parser_->body_limit(16 * 1024);
-    stream_.expires_after(std::chrono::seconds(30));
+    waiting_ = true;
+    stream_.expires_after(request_timeout);
     http::async_read(stream_, buffer_, *parser_,
                      [self = shared_from_this()](beast::error_code ec, std::size_t) {
+                       self->waiting_ = false;
                        self->on_read(ec);
                      });
   }
 
+  // Idle or in the middle of a request, rather than sending a response.
+  bool waiting_for_request() const { return waiting_; }
+  // Closes the socket now, freeing its descriptor; the pending read ends with an error.
+  void evict() {
+    forget();
+    stream_.close();
+  }
+
  private:
+  // No longer counted among the server's HTTP connections.
+  void forget() {
+    if (!listed_) return;
+    server_.http_connections.erase(place_);
+    listed_ = false;
+  }
+
   void on_read(beast::error_code ec) {
     if (ec) return shutdown();
     http::request<http::string_body> request = parser_->release();
@@ -199,6 +256,10 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     if (!file) return reply_text(request, http::status::not_found, "not found\n");
     http::file_body::value_type body;
     body.open(file->c_str(), beast::file_mode::scan, ec);
+    if (out_of_descriptors(ec) && server_.evict_idle_http())
+      body.open(file->c_str(), beast::file_mode::scan, ec);
+    if (out_of_descriptors(ec))
+      return reply_text(request, http::status::service_unavailable, "busy, try again\n");
     if (ec) return reply_text(request, http::status::not_found, "not found\n");
     const auto size = body.size();
     if (request.method() == http::verb::head) {
@@ -221,6 +282,7 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     if (server_.websockets >= server_.options.max_clients)
       return reply_text(request, http::status::service_unavailable, "too many clients\n");
     stream_.expires_never();
+    forget();  // a WebSocket page now, counted by max_clients
     auto client = std::make_shared<Client>(stream_.release_socket(), server_, server_.next_client_id++);
     client->accept(std::move(request));
   }
@@ -249,6 +311,7 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
   void send(Response&& response) {
     auto held = std::make_shared<std::decay_t<Response>>(std::forward<Response>(response));
     response_ = held;
+    stream_.expires_after(response_timeout);
     http::async_write(stream_, *held, [self = shared_from_this(), held](beast::error_code ec, std::size_t) {
       self->response_.reset();
       if (ec || !held->keep_alive()) return self->shutdown();
@@ -266,20 +329,72 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
   std::optional<http::request_parser<http::string_body>> parser_;
   std::shared_ptr<void> response_;
   Server::Impl& server_;
+  std::list<HttpConnection*>::iterator place_;
+  bool listed_ = true;
+  bool waiting_ = false;
 };
+
+// Beyond the cap with every connection busy: a short 503 without blocking, then close.
+void refuse(tcp::socket socket) {
+  static constexpr std::string_view busy =
+      "HTTP/1.1 503 Service Unavailable\r\nContent-Type: text/plain\r\nContent-Length: 5\r\n"
+      "Connection: close\r\n\r\nbusy\n";
+  beast::error_code ignored;
+  socket.non_blocking(true, ignored);
+  socket.write_some(net::buffer(busy.data(), busy.size()), ignored);
+  socket.shutdown(tcp::socket::shutdown_both, ignored);
+  socket.close(ignored);
+}
 
 }  // namespace
 
 void Server::Impl::accept() {
   acceptor.async_accept([self = shared_from_this()](beast::error_code ec, tcp::socket socket) {
-    if (ec) {
-      if (ec == net::error::operation_aborted) return;
-      log_line("accept failed: " + ec.message());
-    } else {
-      std::make_shared<HttpConnection>(std::move(socket), *self)->read();
+    if (ec == net::error::operation_aborted) return;
+    if (!ec) {
+      self->admit(std::move(socket));
+      return self->accept();
     }
-    self->accept();
+    // Out of descriptors (EMFILE) or the like: free one by closing an idle connection and try
+    // again; with nothing to close, pause instead of spinning.
+    int dropped = 0;
+    if (self->accept_log_limit.admit(Clock::now(), dropped))
+      self->log("accept failed: " + ec.message() +
+                (dropped > 0 ? " (" + std::to_string(dropped) + " times more)" : std::string()));
+    if (self->evict_idle_http()) return self->accept();
+    self->accept_timer.expires_after(accept_pause);
+    self->accept_timer.async_wait([self](beast::error_code wait_ec) {
+      if (!wait_ec) self->accept();
+    });
   });
+}
+
+void Server::Impl::admit(tcp::socket socket) {
+  if (http_connections.size() >= http_cap) {
+    if (!evict_idle_http()) {
+      log("HTTP connection limit (" + std::to_string(http_cap) + ") reached, all busy: refused one");
+      return refuse(std::move(socket));
+    }
+    log("HTTP connection limit (" + std::to_string(http_cap) + ") reached: closed the oldest idle one");
+  }
+  std::make_shared<HttpConnection>(std::move(socket), *this)->read();
+}
+
+// The oldest connection still waiting for (the rest of) a request makes room for a new one, so
+// half-sent requests cannot lock pages out.
+bool Server::Impl::evict_idle_http() {
+  const auto it = std::find_if(http_connections.begin(), http_connections.end(),
+                               [](const HttpConnection* c) { return c->waiting_for_request(); });
+  if (it == http_connections.end()) return false;
+  (*it)->evict();
+  return true;
+}
+
+void Server::Impl::log(const std::string& line) {
+  int dropped = 0;
+  const bool admitted = log_limit.admit(Clock::now(), dropped);
+  if (dropped > 0) log_line(std::to_string(dropped) + " more log lines suppressed");
+  if (admitted) log_line(line);
 }
 
 void Server::Impl::handle_message(const std::shared_ptr<Client>& client, std::string_view text) {
@@ -287,7 +402,7 @@ void Server::Impl::handle_message(const std::shared_ptr<Client>& client, std::st
   if (!reply.ok) client->log("bad message: " + reply.log);
   client->send(std::make_shared<const std::string>(reply.text), false);
   if (reply.scene_changed) {
-    log_line("scene " + session.scene_name() + " loaded");
+    log("scene " + session.scene_name() + " loaded");
     broadcast_scene();
   }
 }
@@ -315,8 +430,10 @@ void Server::Impl::tick() {
       c->send(positions, true, true);
     }
   } catch (const std::exception& e) {
-    log_line(std::string("streaming failed: ") + e.what());
+    log(std::string("streaming failed: ") + e.what());
   }
+  if (const int dropped = log_limit.take_dropped(Clock::now()); dropped > 0)
+    log_line(std::to_string(dropped) + " more log lines suppressed");
   // Fixed-rate schedule; after a stall, start again from now rather than bursting.
   const auto period = std::chrono::duration_cast<Clock::duration>(
       std::chrono::duration<double>(1.0 / options.state_rate));

@@ -16,6 +16,9 @@ struct ServerOptions {
   std::filesystem::path web_root;  // index.html and node_modules/ live here
   double state_rate = 30;          // Hz, state messages to each page
   int max_clients = 32;            // further WebSocket upgrades get 503
+  // Concurrent HTTP connections, lowered to fit the open-file limit (RLIMIT_NOFILE). At the cap
+  // a new connection closes the oldest one still waiting for its request, else it gets a 503.
+  int max_http_connections = 256;
 };
 
 class Server {

@@ -255,8 +255,23 @@ void Session::apply(const Command& c) {
   }
 }
 
+namespace {
+// Everything a state or positions frame carries, finite and within float range: a snapshot
+// that is not is never sent (the last good one stays).
+bool publishable(const ControllerSnapshot& s) {
+  auto ok = [](const auto& m) { return (m.array().abs() <= 1e30).all(); };
+  for (const auto& T : s.T_world_link)
+    if (!ok(T.matrix())) return false;
+  for (const auto& p : s.targets.positions)
+    if (!ok(p)) return false;
+  for (const auto& p : s.centerline)
+    if (!ok(p)) return false;
+  return ok(s.joints) && ok(s.positions) && std::isfinite(s.error.mean) && std::isfinite(s.error.max);
+}
+}  // namespace
+
 void Session::tick() {
-  snapshot_ = controller_->snapshot();
+  if (auto next = controller_->snapshot(); publishable(*next)) snapshot_ = std::move(next);
   const double t = now();
   history_.push_back({t, snapshot_->error.mean, t - last_edit_time_ < editing_window});
   while (history_.size() > history_capacity) history_.pop_front();

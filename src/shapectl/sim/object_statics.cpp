@@ -1,5 +1,8 @@
 #include <shapectl/sim/object_statics.hpp>
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace shapectl {
@@ -26,6 +29,31 @@ std::string find_unheld_part(const TetMesh& mesh, const std::vector<char>& held)
              ", " + std::to_string(size) + " nodes, has no fixed or gripped node)";
     }
   return "";
+}
+
+RoundoffScale roundoff_scale(const TetMesh& mesh, const Material& material, double weight) {
+  // Deformation gradients come from differences of coordinates of magnitude X over edges of
+  // length h, so they carry a relative error ~ eps X / h; the stress error is that times the
+  // moduli, and a node sums the forces (stress x area ~ h^2) of its ~20 elements. The same
+  // error is what the rounding of x̂ itself to doubles leaves in the force. 16 ulps: in a sweep
+  // of E and density Newton's quadratic steps go far below it (it does not stall there).
+  double h_min = std::numeric_limits<double>::infinity(), h_max = 0;
+  for (const auto& t : mesh.tets())
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b) {
+        const double h = (mesh.rest_positions()[t.nodes[a]] - mesh.rest_positions()[t.nodes[b]]).norm();
+        h_min = std::min(h_min, h);
+        h_max = std::max(h_max, h);
+      }
+  if (mesh.tets().empty()) return {};
+  const double X = std::max(mesh.bounds_max().cwiseAbs().maxCoeff(), mesh.bounds_min().cwiseAbs().maxCoeff());
+  const double moduli = std::abs(material.mu) + std::abs(material.kappa);
+  const double eps = std::numeric_limits<double>::epsilon();
+  const double extent = (mesh.bounds_max() - mesh.bounds_min()).norm();
+  RoundoffScale r;
+  r.force = 16 * eps * moduli * h_max * (h_max + X);
+  r.energy = 256 * eps * (moduli * mesh.total_volume() * (1 + X / h_min) + std::abs(weight) * (X + extent));
+  return r;
 }
 
 namespace {
@@ -56,10 +84,13 @@ ObjectStatics::ObjectStatics(const Scene& scene, std::vector<const EnergyTerm*> 
   std::vector<const EnergyTerm*> terms = {&elasticity_, &gravity_};
   terms.insert(terms.end(), extra_terms.begin(), extra_terms.end());
   // Converged when every nodal force is a tiny fraction of the weight (or, for a weightless
-  // object, of the force that strains it by 0.1 %).
+  // object, of the force that strains it by 0.1 %) — but never below what round-off leaves.
   const double size = (mesh_->bounds_max() - mesh_->bounds_min()).norm();
   const double scale = gravity_.weight() > 0 ? gravity_.weight() : 1e-3 * scene.material.mu * size * size;
+  const RoundoffScale roundoff = roundoff_scale(*mesh_, scene.material, gravity_.weight());
   StaticsOptions options{.force_tolerance = scene.statics.relative_tolerance * scale,
+                         .force_roundoff = roundoff.force,
+                         .energy_roundoff = roundoff.energy,
                          .max_iterations = scene.statics.max_iterations,
                          .backend = scene.statics.backend};
   solver_ = std::make_unique<StaticsSolver>(mesh_->node_count(), terms, fixed_node_, options);

@@ -25,7 +25,8 @@ class ObjectStatics {
   const TetMesh& mesh() const { return *mesh_; }
   const std::vector<char>& fixed_node() const { return fixed_node_; }
   double weight() const { return gravity_.weight(); }
-  double force_tolerance() const { return solver_->options().force_tolerance; }
+  // The force Newton stops at: the scene's tolerance, or the round-off floor if larger.
+  double force_tolerance() const { return solver_->effective_tolerance(); }
 
  private:
   std::shared_ptr<const TetMesh> mesh_;
@@ -35,6 +36,15 @@ class ObjectStatics {
   std::string unheld_reason_;
   std::unique_ptr<StaticsSolver> solver_;
 };
+
+// What round-off alone leaves in a nodal force (N) and in the energy (J) of `mesh` (placed in
+// the world) of `material` with total weight `weight`: the floor of the force tolerance and
+// the line search's energy resolution (see statics.hpp).
+struct RoundoffScale {
+  double force = 0;
+  double energy = 0;
+};
+RoundoffScale roundoff_scale(const TetMesh& mesh, const Material& material, double weight);
 
 // Empty if every connected part of the mesh has a held node; otherwise says which is free.
 std::string find_unheld_part(const TetMesh& mesh, const std::vector<char>& held);

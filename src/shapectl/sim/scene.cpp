@@ -1,9 +1,31 @@
 #include <shapectl/sim/scene.hpp>
 
+#include <cctype>
+#include <sstream>
+
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/mesh/load_mesh.hpp>
+#include <shapectl/mesh/mesh_limits.hpp>
+#include <shapectl/mesh/surface_mesher.hpp>
+#include <shapectl/sim/scene_checks.hpp>
 
 namespace shapectl {
+
+namespace {
+
+// Generous bounds on scene numbers: finite but absurd values (gravity 1e300) are typos.
+constexpr double max_distance = 1e3;        // m, positions and sizes
+constexpr double max_gravity = 1e3;         // m/s^2 (100 g)
+constexpr double max_stiffness = 1e12;      // N/m, and the barrier stiffnesses
+constexpr double max_weight = 1e12;         // objective weights
+
+// A positive number from lo to hi; "a positive number" for zero or negative values.
+double positive_in(const JsonInput& j, double lo, double hi, const std::string& unit) {
+  j.positive();
+  return j.number_in(lo, hi, unit);
+}
+
+}  // namespace
 
 std::vector<int> NodeSelection::resolve(const TetMesh& mesh) const {
   std::vector<char> chosen(mesh.node_count(), 0);
@@ -26,7 +48,8 @@ Positions Scene::world_rest_positions() const {
 
 AlignedBox read_box(const JsonInput& j) {
   j.expect_only({"min", "max"});
-  AlignedBox box{j.at("min").vec3(), j.at("max").vec3()};
+  AlignedBox box{j.at("min").vec3_within(max_distance, "a point", "m"),
+                 j.at("max").vec3_within(max_distance, "a point", "m")};
   if ((box.max - box.min).minCoeff() < 0) j.at("max").fail("a corner not below min in any axis");
   return box;
 }
@@ -47,10 +70,10 @@ NodeSelection read_node_selection(const JsonInput& j, int node_count) {
 Eigen::Isometry3d read_pose(const JsonInput& j) {
   j.expect_only({"position", "rpy"});
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  if (j.has("position")) T.translation() = j.at("position").vec3();
+  if (j.has("position")) T.translation() = j.at("position").vec3_within(max_distance, "a position", "m");
   if (j.has("rpy")) {
     // URDF convention: fixed-axis roll about x, then pitch about y, then yaw about z.
-    const Vec3 rpy = j.at("rpy").vec3();
+    const Vec3 rpy = j.at("rpy").vec3_within(1e3, "angles", "rad");
     T.linear() = (Eigen::AngleAxisd(rpy.z(), Vec3::UnitZ()) * Eigen::AngleAxisd(rpy.y(), Vec3::UnitY()) *
                   Eigen::AngleAxisd(rpy.x(), Vec3::UnitX()))
                      .toRotationMatrix();
@@ -60,50 +83,123 @@ Eigen::Isometry3d read_pose(const JsonInput& j) {
 
 namespace {
 
-std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j) {
+// A generated box: sizes and cell counts bounded, cells not so flat that a tet degenerates.
+std::shared_ptr<const TetMesh> read_box_mesh(const JsonInput& box) {
+  box.expect_only({"size", "cells", "hole"});
+  const JsonInput size_json = box.at("size");
+  if (size_json.size() != 3) size_json.fail("an array of 3 numbers");
+  Vec3 size;
+  for (int k = 0; k < 3; ++k) size[k] = positive_in(size_json.at(k), 1e-6, max_distance, "m");
+  const JsonInput cells = box.at("cells");
+  if (cells.size() != 3) cells.fail("an array of 3 whole numbers");
+  std::array<int, 3> n{};
+  for (int k = 0; k < 3; ++k) n[k] = static_cast<int>(cells.at(k).integer_in(1, 1000));
+  if (6LL * n[0] * n[1] * n[2] > max_mesh_tets)
+    cells.fail("at most " + std::to_string(max_mesh_tets / 6) + " cells in all (6 tetrahedra each, at most " +
+               std::to_string(max_mesh_tets) + " tetrahedra)");
+  // Each tet of a cell h has volume hx hy hz / 6 and its diagonal as longest edge; TetMesh
+  // calls a tet degenerate below 1e-9 × edge³: refuse with margin, naming the field.
+  const Vec3 h = size.cwiseQuotient(Vec3(n[0], n[1], n[2]));
+  if (!(h.prod() / 6 > 1e-8 * std::pow(h.norm(), 3))) {
+    std::ostringstream got;
+    got << "cells of " << h.x() << " x " << h.y() << " x " << h.z() << " m";
+    throw InputError(box.source(), size_json.path(),
+                     "a size whose cells (size / cells) are not too flat for tetrahedra",
+                     got.str());
+  }
+  std::optional<BoxHole> hole;
+  if (box.has("hole")) {
+    const AlignedBox b = read_box(box.at("hole"));
+    hole = BoxHole{b.min, b.max};
+  }
+  try {
+    return std::make_shared<const TetMesh>(make_box_mesh(size, n, hole));
+  } catch (const InputError& e) {
+    throw InputError(box.source(), box.path(), e.what());
+  }
+}
+
+// "units" or "scale" of a mesh file: the factor from file coordinates to metres.
+double read_mesh_scale(const JsonInput& j) {
+  if (j.has("units") && j.has("scale")) j.at("scale").fail_problem("give \"units\" or \"scale\", not both");
+  if (j.has("scale")) return positive_in(j.at("scale"), 1e-9, 1e9, "");
+  if (!j.has("units")) return 1;
+  const std::string units = j.at("units").string();
+  if (units == "m") return 1;
+  if (units == "cm") return 1e-2;
+  if (units == "mm") return 1e-3;
+  j.at("units").fail("\"m\", \"cm\" or \"mm\" (or give \"scale\": factor to metres)");
+}
+
+bool is_surface_file(const std::filesystem::path& file) {
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension == ".obj" || extension == ".stl" || extension == ".off";
+}
+
+// A mesh file, its coordinates scaled to metres: a surface before TetGen sees it (so
+// max_tet_volume is in m^3 either way), a volume mesh node by node.
+std::shared_ptr<const TetMesh> read_mesh_file(const std::filesystem::path& file, double scale,
+                                              const SurfaceMeshOptions& options, const MeshOrigin& origin) {
+  if (is_surface_file(file)) {
+    TriangleSurface surface = read_surface(file);
+    Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+    for (Vec3& v : surface.vertices) {
+      v *= scale;
+      lo = lo.cwiseMin(v);
+      hi = hi.cwiseMax(v);
+    }
+    // Before TetGen: a surface in mm would otherwise fail on its volume bound, or take long.
+    if (!surface.vertices.empty()) check_object_extent(options.origin_file, origin, hi - lo, nullptr);
+    return std::make_shared<const TetMesh>(tetrahedralize_surface(surface, options, file.string()));
+  }
+  const TetMesh mesh = load_mesh(file, options);
+  if (scale == 1) return std::make_shared<const TetMesh>(mesh);
+  std::vector<Vec3> nodes = mesh.rest_positions();
+  for (Vec3& x : nodes) x *= scale;
+  std::vector<std::array<int, 4>> tets;
+  for (const TetRest& t : mesh.tets()) tets.push_back(t.nodes);
+  return std::make_shared<const TetMesh>(std::move(nodes), std::move(tets), file.string());
+}
+
+std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j, MeshOrigin& origin) {
+  origin.field = j.path();
   if (j.is_string()) {
     const auto path = j.directory() / j.string();
-    return std::make_shared<const TetMesh>(load_mesh(path, {}));
+    origin.kind = is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
+    return read_mesh_file(path, 1, {.origin_file = j.source(), .origin_path = j.path()}, origin);
   }
   if (!j.is_object()) j.fail("a mesh file name or an object with \"box\" or \"file\"");
   if (j.has("box")) {
     j.expect_only({"box"});
-    const JsonInput box = j.at("box");
-    box.expect_only({"size", "cells", "hole"});
-    const Vec3 size = box.at("size").vec3();
-    for (int k = 0; k < 3; ++k)
-      if (!(size[k] > 0)) box.at("size").at(k).fail("a positive number");
-    const JsonInput cells = box.at("cells");
-    if (cells.size() != 3) cells.fail("an array of 3 whole numbers");
-    std::array<int, 3> n{};
-    for (int k = 0; k < 3; ++k) n[k] = static_cast<int>(cells.at(k).integer_in(1, 1000));
-    std::optional<BoxHole> hole;
-    if (box.has("hole")) {
-      const AlignedBox b = read_box(box.at("hole"));
-      hole = BoxHole{b.min, b.max};
-    }
-    return std::make_shared<const TetMesh>(make_box_mesh(size, n, hole));
+    origin.kind = MeshOrigin::Kind::Box;
+    return read_box_mesh(j.at("box"));
   }
-  j.expect_only({"file", "max_radius_edge_ratio", "max_tet_volume", "keep_surface"});
-  SurfaceMeshOptions options;
+  j.expect_only({"file", "units", "scale", "max_radius_edge_ratio", "max_tet_volume", "keep_surface"});
+  SurfaceMeshOptions options{.origin_file = j.source(), .origin_path = j.path()};
   if (j.has("max_radius_edge_ratio"))
     options.max_radius_edge_ratio = j.at("max_radius_edge_ratio").non_negative();
   if (j.has("max_tet_volume")) options.max_tet_volume = j.at("max_tet_volume").non_negative();
   if (j.has("keep_surface")) options.keep_surface = j.at("keep_surface").boolean();
-  return std::make_shared<const TetMesh>(load_mesh(j.directory() / j.at("file").string(), options));
+  const double scale = read_mesh_scale(j);
+  const auto path = j.directory() / j.at("file").string();
+  origin.kind = is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
+  origin.units_given = j.has("units") || j.has("scale");
+  return read_mesh_file(path, scale, options, origin);
 }
 
 Material read_material(const JsonInput& j) {
   if (j.has("youngs_modulus") || j.has("poisson_ratio")) {
     j.expect_only({"youngs_modulus", "poisson_ratio", "density"});
-    const double E = j.at("youngs_modulus").positive();
+    const double E = positive_in(j.at("youngs_modulus"), 1, 1e13, "Pa");
     const double nu = j.at("poisson_ratio").number();
     if (!(nu > 0 && nu < 0.5)) j.at("poisson_ratio").fail("a number between 0 and 0.5 (exclusive)");
-    return material_from_youngs(E, nu, j.at("density").non_negative());
+    return material_from_youngs(E, nu, positive_in(j.at("density"), 1e-3, 1e5, "kg/m^3"));
   }
   j.expect_only({"mu", "kappa", "density"});
-  return {.mu = j.at("mu").positive(), .kappa = j.at("kappa").positive(),
-          .density = j.at("density").non_negative()};
+  return {.mu = positive_in(j.at("mu"), 0.1, 1e13, "Pa"),
+          .kappa = positive_in(j.at("kappa"), 0.1, 1e16, "Pa"),
+          .density = positive_in(j.at("density"), 1e-3, 1e5, "kg/m^3")};
 }
 
 RobotSetup read_robot(const JsonInput& j) {
@@ -114,7 +210,7 @@ RobotSetup read_robot(const JsonInput& j) {
   r.model = std::make_shared<RobotModel>(RobotModel::load_urdf_file(urdf));
   auto read_map = [](const JsonInput& m) {
     std::map<std::string, double> values;
-    for (const auto& name : m.keys()) values[name] = m.at(name).number();
+    for (const auto& name : m.keys()) values[name] = m.at(name).number_in(-1e3, 1e3, "rad or m");
     return values;
   };
   if (j.has("active_joints")) {
@@ -142,7 +238,7 @@ RobotSetup read_robot(const JsonInput& j) {
     const auto index = r.model->find_link(link);
     if (!index) e.at("link").fail("a link of " + urdf.filename().string());
     ee.link = *index;
-    if (e.has("tcp")) ee.tcp_link = e.at("tcp").vec3();
+    if (e.has("tcp")) ee.tcp_link = e.at("tcp").vec3_within(max_distance, "a point", "m");
     for (const auto& other : r.end_effectors)
       if (other.name == ee.name) e.at("name").fail("a name not used by another end effector");
     r.end_effectors.push_back(ee);
@@ -150,8 +246,12 @@ RobotSetup read_robot(const JsonInput& j) {
   if (j.has("collision_spheres"))
     r.collisions = std::make_shared<const CollisionModel>(
         CollisionModel::load_json_file(*r.model, j.directory() / j.at("collision_spheres").string()));
-  if (j.has("joint_limit_margin")) r.joint_limit_margin = j.at("joint_limit_margin").non_negative();
-  if (j.has("joint_limit_stiffness")) r.joint_limit_stiffness = j.at("joint_limit_stiffness").positive();
+  if (j.has("joint_limit_margin")) {
+    j.at("joint_limit_margin").non_negative();
+    r.joint_limit_margin = j.at("joint_limit_margin").number_in(0, 10, "rad or m");
+  }
+  if (j.has("joint_limit_stiffness"))
+    r.joint_limit_stiffness = positive_in(j.at("joint_limit_stiffness"), 1e-12, max_stiffness, "");
   return r;
 }
 
@@ -174,7 +274,7 @@ std::vector<Grip> read_grips(const JsonInput& list, const RobotSetup& robot, con
     }
     if (!g.has("region") && !g.has("nodes")) g.fail("a grip with \"region\" or \"nodes\"");
     grip.nodes = selection.resolve(mesh);
-    if (grip.nodes.empty()) g.fail_problem("the grip region contains no node of the mesh");
+    // An empty region is reported by check_scene, after the object size (a mesh in mm misses it).
     grips.push_back(grip);
   }
   return grips;
@@ -190,10 +290,16 @@ Scene load_scene(const std::filesystem::path& file) {
   scene.source = file;
   const JsonInput object = root.at("object");
   object.expect_only({"mesh", "material", "pose"});
-  scene.object_mesh = read_mesh(object.at("mesh"));
+  scene.object_mesh = read_mesh(object.at("mesh"), scene.mesh_origin);
+  const double reach = std::max(scene.object_mesh->bounds_min().cwiseAbs().maxCoeff(),
+                                scene.object_mesh->bounds_max().cwiseAbs().maxCoeff());
+  if (!(reach <= max_distance))
+    object.at("mesh").fail_problem("node coordinates beyond " + std::to_string(int(max_distance)) +
+                                   " m of the origin (coordinates are metres; a mesh file drawn in mm or cm "
+                                   "needs \"units\")");
   scene.material = read_material(object.at("material"));
   if (object.has("pose")) scene.T_world_object = read_pose(object.at("pose"));
-  if (root.has("gravity")) scene.gravity = root.at("gravity").vec3();
+  if (root.has("gravity")) scene.gravity = root.at("gravity").vec3_within(max_gravity, "a gravity vector", "m/s^2");
   if (root.has("fixed")) scene.fixed = read_node_selection(root.at("fixed"), scene.object_mesh->node_count());
   if (root.has("statics")) {
     const JsonInput s = root.at("statics");
@@ -206,21 +312,28 @@ Scene load_scene(const std::filesystem::path& file) {
       else if (name != "auto") s.at("linear_solver").fail("\"auto\", \"ldlt\", \"band\" or \"cholmod\"");
     }
     if (s.has("max_iterations")) scene.statics.max_iterations = static_cast<int>(s.at("max_iterations").integer_in(1, 100000));
-    if (s.has("relative_tolerance")) scene.statics.relative_tolerance = s.at("relative_tolerance").positive();
+    if (s.has("relative_tolerance"))
+      scene.statics.relative_tolerance = positive_in(s.at("relative_tolerance"), 1e-300, 1, "");
   }
   if (root.has("robot")) scene.robot = read_robot(root.at("robot"));
   if (root.has("grips")) {
     if (!scene.robot) root.at("grips").fail_problem("grips need a \"robot\"");
     scene.grips = read_grips(root.at("grips"), *scene.robot, *scene.object_mesh);
   }
-  if (root.has("grip_stiffness")) scene.grip_stiffness = root.at("grip_stiffness").positive();
+  if (root.has("grip_stiffness"))
+    scene.grip_stiffness = positive_in(root.at("grip_stiffness"), 1e-12, max_stiffness, "N/m");
   if (root.has("objective")) {
     const JsonInput o = root.at("objective");
     o.expect_only({"shape_weight", "collision_weight", "joint_limit_weight"});
-    if (o.has("shape_weight")) scene.weights.shape = o.at("shape_weight").positive();
-    if (o.has("collision_weight")) scene.weights.collision = o.at("collision_weight").non_negative();
-    if (o.has("joint_limit_weight")) scene.weights.joint_limits = o.at("joint_limit_weight").non_negative();
+    auto weight = [&](const char* key) {
+      o.at(key).non_negative();
+      return o.at(key).number_in(0, max_weight, "");
+    };
+    if (o.has("shape_weight")) scene.weights.shape = positive_in(o.at("shape_weight"), 1e-12, max_weight, "");
+    if (o.has("collision_weight")) scene.weights.collision = weight("collision_weight");
+    if (o.has("joint_limit_weight")) scene.weights.joint_limits = weight("joint_limit_weight");
   }
+  scene.warnings = check_scene(scene);
   return scene;
 }
 

@@ -66,6 +66,14 @@ struct ObjectiveWeights {
   double joint_limits = 1.0;  // × joint-limit barrier
 };
 
+// Where the object's mesh came from: the scene checks tailor their advice to it.
+struct MeshOrigin {
+  enum class Kind { InCode, Box, VolumeFile, SurfaceFile };
+  Kind kind = Kind::InCode;
+  std::string field = "object.mesh";  // JSON path of the mesh in the scene file
+  bool units_given = false;           // "units" or "scale" was set (file meshes only)
+};
+
 struct Scene {
   std::filesystem::path source;                // the scene file
   std::shared_ptr<const TetMesh> object_mesh;  // rest mesh in object coordinates
@@ -78,12 +86,19 @@ struct Scene {
   std::vector<Grip> grips;
   double grip_stiffness = 1e4;  // K, N/m
   ObjectiveWeights weights;
+  MeshOrigin mesh_origin;
+  // Findings of check_scene where results might be wrong, one line each, "file: field: what";
+  // for the commands to print. (Where they would be wrong, load_scene throws instead.)
+  std::vector<std::string> warnings;
 
   // Rest positions placed in the world, stacked (3n).
   Positions world_rest_positions() const;
 };
 
-// Reads and validates a scene; throws InputError naming the file and field.
+// Reads and validates a scene, then runs check_scene (sim/scene_checks.hpp) on it: throws
+// InputError naming the file and field for bad or implausible input, fills `warnings`.
+// A mesh file may give "units" ("m", "cm", "mm") or "scale" (a factor): its nodes are scaled to
+// metres before anything else (TetGen included) sees them.
 Scene load_scene(const std::filesystem::path& file);
 
 // Parsers shared by scene-like files.

@@ -112,22 +112,60 @@ StaticsResult StaticsSolver::solve(Positions& x, int max_iterations) {
   return result;
 }
 
+std::string StaticsSolver::singular_reason(const Positions& x) {
+  // Structural checks (every part held) belong to the caller; here the matrix itself is
+  // judged: the spread of its diagonal over free dofs measures how ill-conditioned it is.
+  triplets_.clear();
+  for (const auto* t : terms_) t->add_hessian(x, triplets_, true);
+  const SparseMatrix& H = assembler_.assemble(triplets_);
+  const auto& fixed = assembler_.fixed_dof();
+  double lo = std::numeric_limits<double>::infinity(), hi = 0;
+  for (int d = 0; d < H.rows(); ++d)
+    if (!fixed[d]) {
+      const double v = std::abs(H.coeff(d, d));
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  const double ratio = hi > 0 && std::isfinite(hi) ? lo / hi : 0;
+  return "singular system: the Hessian is numerically singular even after projection (smallest/"
+         "largest diagonal stiffness " + sci(ratio) + (ratio < 1e-12
+             ? "; an extreme material, grip stiffness or gravity makes it ill-conditioned)"
+             : "; the held nodes may leave a rigid motion free, e.g. a rotation about one node)");
+}
+
 StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
   StaticsResult result;
   double e = energy(x);
   if (!std::isfinite(e)) {
     result.status = StaticsStatus::Inverted;
-    result.reason = "the starting state has an inverted element";
+    result.reason = "the starting state has an inverted element or a non-finite energy";
     return result;
   }
   Eigen::VectorXd g = gradient(x);
   double residual = max_force(g);
+  const double tolerance = effective_tolerance();
+  if (!(tolerance < std::numeric_limits<double>::infinity())) {
+    result.status = StaticsStatus::NotConverged;
+    result.residual = residual;
+    result.energy = e;
+    result.reason = "not converged: the force tolerance " + sci(tolerance) + " N is non-finite";
+    return result;
+  }
+  // Energy differences below this are round-off (see the header).
+  auto energy_noise = [&](double energy) {
+    return std::max(options_.energy_roundoff, 1e-12 * std::abs(energy)) + 1e-300;
+  };
   bool may_chord = options_.chord_steps && factor_is_true_;
   for (int it = 0;; ++it) {
     result.iterations = it;
     result.residual = residual;
     result.energy = e;
-    if (residual <= options_.force_tolerance) {
+    if (!std::isfinite(residual)) {
+      result.status = StaticsStatus::NotConverged;
+      result.reason = "not converged: non-finite force after " + std::to_string(it) + " iterations";
+      return result;
+    }
+    if (residual <= tolerance && x.allFinite()) {
       result.status = StaticsStatus::Converged;
       result.reason = "residual " + sci(residual) + " N after " + std::to_string(it) + " iterations";
       return result;
@@ -150,7 +188,7 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
       if (g.dot(dx) < 0) {
         Positions trial = x + dx;
         const double e_trial = energy(trial);
-        if (std::isfinite(e_trial) && e_trial <= e + 1e-12 * std::abs(e)) {
+        if (std::isfinite(e_trial) && e_trial <= e + energy_noise(e)) {
           Eigen::VectorXd g_trial = gradient(trial);
           const double r_trial = max_force(g_trial);
           if (r_trial <= 0.25 * residual) {
@@ -178,15 +216,15 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
       log.projected = true;
       if (!factor_at(x, true)) {
         result.status = StaticsStatus::Singular;
-        result.reason =
-            "singular system: the Hessian is singular even after projection (is the object "
-            "held? every part of it needs fixed or gripped nodes)";
+        result.reason = singular_reason(x);
         return result;
       }
       dx = -cholesky_.solve(g);
     }
-    // Backtracking line search on the energy (Armijo). Inverted trial states have E = +inf.
+    // Backtracking line search (see the header). Inverted trial states have E = +inf.
     const double slope = g.dot(dx);
+    const double noise = energy_noise(e);
+    const double force_norm2 = g.squaredNorm();
     double alpha = 1.0;
     Positions trial;
     double e_trial = 0;
@@ -198,13 +236,12 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
       e_trial = energy(trial);
       if (!std::isfinite(e_trial)) continue;
       const bool armijo = e_trial <= e + 1e-4 * alpha * slope;
-      // Near the solution the energy change drowns in round-off: then accept a step that
-      // does not raise the energy beyond round-off and lowers the force.
-      const bool roundoff = e_trial <= e + 1e-12 * std::abs(e) + 1e-300;
-      if (!armijo && !roundoff) continue;
+      if (!armijo && e_trial > e + noise) continue;
       g_trial = gradient(trial);
       r_trial = max_force(g_trial);
-      accepted = armijo || r_trial < residual;
+      if (!std::isfinite(r_trial)) continue;
+      // Energy within round-off of the start: the force norm decides.
+      accepted = armijo || g_trial.squaredNorm() <= (1 - 1e-4 * alpha) * force_norm2;
     }
     if (!accepted) {
       result.status = StaticsStatus::NotConverged;

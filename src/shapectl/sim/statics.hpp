@@ -2,6 +2,18 @@
 // Quasi-static equilibrium x̂ = argmin_x E(x) (paper eq. 1) by Newton's method with a
 // backtracking line search. Newton factors the true Hessian; only a step where that fails
 // (indefinite far from equilibrium) falls back to element-wise PSD-projected Hessians.
+//
+// Convergence criterion: every free node's force (the energy gradient) is at most
+// max(force_tolerance, force_roundoff), and the residual, the energy and every position are
+// finite. force_roundoff is the force that round-off alone leaves at the exact equilibrium
+// (tens of ulps of the largest elastic force contributions, see roundoff_scale): a
+// tolerance below it could never be met, and an answer within it is as exact as doubles allow.
+// Line search: Armijo on the energy while the energy change a step predicts is above the
+// energy's round-off (energy_roundoff); below that, energy differences are noise, and a step is
+// accepted when the energy does not rise beyond round-off and the force norm falls (Armijo on
+// |∇E|², which Newton's step with the true Hessian descends: d/dα |∇E|² = −2|∇E|²).
+// "Not converged" thus means a force above that tolerance, never a tolerance out of reach.
+#include <algorithm>
 #include <limits>
 #include <memory>
 #include <optional>
@@ -21,6 +33,10 @@ const char* to_string(StaticsStatus status);
 
 struct StaticsOptions {
   double force_tolerance = 1e-6;  // N: converged when every free node's force is below this
+  // N: the force round-off leaves at the equilibrium; the effective tolerance is never lower.
+  double force_roundoff = 0;
+  // J: energy differences below this are round-off (at least 1e-12 |E|).
+  double energy_roundoff = 0;
   int max_iterations = 100;
   // Try a step with the last true-Hessian factorization before factoring anew (see newton()).
   bool chord_steps = true;
@@ -78,6 +94,8 @@ class StaticsSolver {
   const std::vector<char>& fixed_dof() const { return assembler_.fixed_dof(); }
   const StaticsOptions& options() const { return options_; }
   void set_force_tolerance(double tolerance) { options_.force_tolerance = tolerance; }
+  // The tolerance Newton stops at: the larger of force_tolerance and force_roundoff.
+  double effective_tolerance() const { return std::max(options_.force_tolerance, options_.force_roundoff); }
   void set_chord_steps(bool on) { options_.chord_steps = on; }
   int factorizations() const { return factorizations_; }
 
@@ -86,6 +104,8 @@ class StaticsSolver {
   double max_force(const Eigen::VectorXd& gradient) const;
   // Assembles and factors at x; projected = use PSD-projected element Hessians.
   bool factor_at(const Positions& x, bool projected);
+  // Why the projected Hessian at x could not be factored, with its conditioning.
+  std::string singular_reason(const Positions& x);
 
   int node_count_;
   std::vector<const EnergyTerm*> terms_;

@@ -1,0 +1,54 @@
+// Mutated scene and targets files: each loads or throws InputError, never anything else.
+#include <gtest/gtest.h>
+
+#include <shapectl/control/targets_file.hpp>
+#include <shapectl/sim/scene.hpp>
+
+#include "io/text_mutator.hpp"
+#include "support/test_support.hpp"
+
+namespace shapectl {
+namespace {
+
+const test::TextMutator kSceneMutator({"{", "[", "]", "}", ",", ":", "\"", "1e999", "-1e308", "1e-400",
+                                       "1e300", "-0", "0", "-1", "NaN", "null", "true", "\"x\"", "[]",
+                                       "{}", "[1000, 1000, 1000]", "[0, 0, 0]", "1e-300", "2147483648",
+                                       "\"hole\": {\"min\": [-1, -1, -1], \"max\": [1, 1, 1]}",
+                                       "\"density\": 1, \"density\": 2", "\"nodes\": [0, 1, 99999]",
+                                       "\"linear_solver\": \"band\"", "\"max_tet_volume\": 1e-20"});
+
+// The bundled scenes with their relative paths made absolute, so they load from a temp dir.
+std::string bundled_scene(const std::string& name) {
+  std::string text = test::read_text(test::source_path("scenes/" + name));
+  const std::string data = test::source_path("data").string();
+  for (std::size_t at = text.find("../data"); at != std::string::npos; at = text.find("../data", at + 1))
+    text.replace(at, 7, data);
+  return text;
+}
+
+TEST(SceneFuzz, MutatedScenesLoadOrAreInputErrors) {
+  const test::TempDir dir;
+  const std::vector<std::string> seeds = {bundled_scene("foam_bar_clamped.json"), bundled_scene("foam_bar_clamped.json"),
+                                          bundled_scene("yumi_bar.json"), bundled_scene("yumi_frame.json")};
+  for (const auto& seed : seeds) ASSERT_NO_THROW(load_scene(dir.write("seed.json", seed)));
+  const test::FuzzCounts counts = test::fuzz_parser(seeds, kSceneMutator, 1600, 3, [&](const std::string& text) {
+    load_scene(dir.write("scene.json", text));
+  });
+  EXPECT_GT(counts.refused, 300);
+  EXPECT_GT(counts.parsed, 30);  // scenes are checked strictly: few mutations survive
+}
+
+TEST(SceneFuzz, MutatedTargetsLoadOrAreInputErrors) {
+  const std::vector<std::string> seeds = {
+      R"({"targets": [{"node": 3, "position": [0.1, 0.2, 0.3]}, {"node": 7, "position": [0, 0, 1]},
+                      {"node": 12, "position": [0.4, 0.0, 0.25]}]})",
+      R"({"centerline": [[0, 0, 0], [0.1, 0, 0.01], [0.2, 0, 0.02], [0.3, 0.01, 0.02]]})"};
+  const test::FuzzCounts counts = test::fuzz_parser(seeds, kSceneMutator, 3000, 4, [](const std::string& text) {
+    read_targets(JsonInput(parse_json_text(text, "targets.json"), "targets.json"), 425);
+  });
+  EXPECT_GT(counts.refused, 500);
+  EXPECT_GT(counts.parsed, 100);
+}
+
+}  // namespace
+}  // namespace shapectl

@@ -1,0 +1,82 @@
+// Statics reports only what it found: never "converged" with non-finite numbers, and a
+// singular system says whether nothing holds the object or the numbers are ill-conditioned.
+#include <shapectl/sim/gripped_object.hpp>
+#include <shapectl/sim/object_statics.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <shapectl/mesh/box_mesh.hpp>
+
+#include "support/two_arm_scene.hpp"
+
+namespace shapectl {
+namespace {
+
+Scene clamped_bar(double youngs, double density) {
+  Scene s;
+  s.source = "clamped_bar";
+  s.object_mesh = std::make_shared<const TetMesh>(make_box_mesh({0.32, 0.03, 0.03}, {8, 2, 2}));
+  s.material = material_from_youngs(youngs, 0.3, density);
+  s.fixed = NodeSelection{.box = AlignedBox{Vec3(-0.161, -0.02, -0.02), Vec3(-0.139, 0.02, 0.02)}};
+  return s;
+}
+
+TEST(StaticsHonesty, AbsurdGravityIsNeverReportedConverged) {
+  // 1e300 overflows the weight, 1e150 the energy of the first Newton step.
+  for (double g : {1e300, 1e200, 1e150}) {
+    Scene scene = clamped_bar(2e5, 40);
+    scene.gravity = Vec3(0, 0, -g);
+    ObjectStatics statics(scene);
+    Positions x = scene.world_rest_positions();
+    const StaticsResult r = statics.solve(x);
+    EXPECT_FALSE(r.converged()) << "gravity " << g << ": " << r.reason;
+    EXPECT_EQ(r.status, StaticsStatus::NotConverged) << r.reason;
+  }
+}
+
+TEST(StaticsHonesty, ConvergedMeansFiniteResidualEnergyAndPositions) {
+  for (double g : {9.81, 1e6, 1e12}) {
+    Scene scene = clamped_bar(2e5, 40);
+    scene.gravity = Vec3(0, 0, -g);
+    ObjectStatics statics(scene);
+    Positions x = scene.world_rest_positions();
+    const StaticsResult r = statics.solve(x);
+    if (g == 9.81) EXPECT_TRUE(r.converged()) << r.reason;  // so the checks below run
+    if (!r.converged()) continue;
+    EXPECT_TRUE(std::isfinite(r.residual) && std::isfinite(r.energy) && x.allFinite()) << g;
+    EXPECT_LE(r.residual, statics.force_tolerance()) << g;
+  }
+}
+
+GrippedObject held_bar(double youngs) {
+  Scene scene = test::two_arm_scene({12, 2, 2});
+  scene.material = material_from_youngs(youngs, 0.3, 40);
+  return GrippedObject(scene);
+}
+
+TEST(StaticsHonesty, ExtremeMaterialOfAHeldObjectIsNotCalledUnheld) {
+  // 1 mPa foam in 1e4 N/m grips: stiffnesses 16 orders apart, beyond what doubles resolve.
+  GrippedObject object = held_bar(1e-3);
+  Positions x = object.reference_positions();
+  const StaticsResult r = object.solve(object.reference_joints(), x);
+  ASSERT_EQ(r.status, StaticsStatus::Singular) << r.reason;
+  EXPECT_EQ(r.reason.find("held"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("ill-conditioned"), std::string::npos) << r.reason;
+  EXPECT_NE(r.reason.find("diagonal stiffness"), std::string::npos) << r.reason;
+  EXPECT_TRUE(x.allFinite());
+}
+
+TEST(StaticsHonesty, HeldObjectWithoutGripsStillSaysNothingHoldsIt) {
+  Scene scene = test::two_arm_scene({12, 2, 2});
+  scene.grips.clear();
+  GrippedObject object(scene);
+  Positions x = object.reference_positions();
+  const StaticsResult r = object.solve(object.reference_joints(), x);
+  EXPECT_EQ(r.status, StaticsStatus::Singular);
+  EXPECT_NE(r.reason.find("nothing holds"), std::string::npos) << r.reason;
+}
+
+}  // namespace
+}  // namespace shapectl
