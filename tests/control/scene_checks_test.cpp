@@ -20,14 +20,7 @@ namespace {
 using Json = nlohmann::json;
 using test::TempDir;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const std::function<void()>& f) { return test::input_error_of(f); }
 
 // A bundled scene as JSON, its relative paths made absolute so it loads from a temp dir.
 Json bundled(const std::string& name) {

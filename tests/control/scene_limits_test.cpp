@@ -18,14 +18,7 @@ namespace {
 
 using test::TempDir;
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const std::function<void()>& f) { return test::input_error_of(f); }
 
 // The clamped bar with `mesh`, `material` and `gravity` replaceable.
 std::string bar_scene(const std::string& mesh = R"({"box": {"size": [0.32, 0.03, 0.03], "cells": [8, 2, 2]}})",

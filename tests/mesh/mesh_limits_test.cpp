@@ -17,14 +17,7 @@
 namespace shapectl {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const std::function<void()>& f) { return test::input_error_of(f); }
 
 // The unit cube as 12 outward triangles.
 TriangleSurface unit_cube() {

@@ -15,14 +15,7 @@
 namespace shapectl {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "";
-}
+std::string error_of(const std::function<void()>& f) { return test::input_error_of(f); }
 
 // A chain of `links` links joined by revolute joints about z, each 0.1 m along x.
 std::string chain_urdf(int links) {

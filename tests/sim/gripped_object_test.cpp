@@ -89,7 +89,9 @@ TEST(GrippedObject, CarriedGrippedNodesKeepTheirSpringLengths) {
   for (const auto& g : scene.grips)
     for (int i : g.nodes) gripped[i] = 1;
   for (int i = 0; i < object.node_count(); ++i)
-    if (!gripped[i]) EXPECT_EQ(carried.segment<3>(3 * i), x.segment<3>(3 * i));
+    if (!gripped[i]) {
+      EXPECT_EQ(carried.segment<3>(3 * i), x.segment<3>(3 * i));
+    }
 }
 
 TEST(GrippedObject, SensitivityMatchesCentralDifferencesOfStatics) {

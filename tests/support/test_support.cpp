@@ -1,5 +1,7 @@
 #include "support/test_support.hpp"
 
+#include <shapectl/io/input_error.hpp>
+
 #include <fcntl.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -71,6 +73,15 @@ CliRun run_cli(const std::vector<std::string>& args) {
 
 std::filesystem::path source_path(const std::string& relative) {
   return std::filesystem::path(SHAPECTL_SOURCE_DIR) / relative;
+}
+
+std::string input_error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
 }
 
 }  // namespace shapectl::test

@@ -1,6 +1,7 @@
 #pragma once
 // Helpers shared by the tests: temporary files and running the CLI.
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -33,5 +34,8 @@ CliRun run_cli(const std::vector<std::string>& args);
 
 // Path of a file in the source tree, e.g. source_path("scenes/yumi_bar.json").
 std::filesystem::path source_path(const std::string& relative);
+
+// The message of the InputError `f` throws, or "" when it throws none.
+std::string input_error_of(const std::function<void()>& f);
 
 }  // namespace shapectl::test

@@ -17,25 +17,6 @@ long line_at(std::string_view text, std::size_t at) {
   return 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
 }
 
-// Byte offset where nesting first exceeds `max_depth`, or npos: one pass, no recursion.
-std::size_t too_deep_at(std::string_view text, int max_depth) {
-  int depth = 0;
-  bool in_string = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      if (c == '\\') ++i;
-      else if (c == '"') in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > max_depth) return i;
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return std::string_view::npos;
-}
 
 // Tracks where the parser is ("object.mesh.box", "grips[1]") and refuses a key an object
 // already has: with nlohmann's default the last one would silently win.
@@ -91,11 +72,30 @@ class DuplicateKeyCheck {
 
 }  // namespace
 
+std::size_t json_too_deep_at(std::string_view text, int max_depth) {
+  int depth = 0;
+  bool in_string = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (in_string) {
+      if (c == '\\') ++i;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > max_depth) return i;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return std::string_view::npos;
+}
+
 nlohmann::json parse_json_text(std::string_view text, const std::string& source,
                                const JsonLimits& limits) {
   if (text.size() > limits.max_bytes)
     throw InputError(source, "", "longer than the " + std::to_string(limits.max_bytes) + " byte limit for JSON");
-  if (const std::size_t at = too_deep_at(text, limits.max_depth); at != std::string_view::npos)
+  if (const std::size_t at = json_too_deep_at(text, limits.max_depth); at != std::string_view::npos)
     throw InputError(source + ":" + std::to_string(line_at(text, at)), "",
                      "JSON nested deeper than " + std::to_string(limits.max_depth) + " levels");
   try {

@@ -20,6 +20,10 @@ struct JsonLimits {
   int max_depth = 64;  // nested arrays and objects; scenes use 5
 };
 
+// Byte offset where arrays/objects first nest deeper than `max_depth`, or npos: one pass over
+// the text, no recursion (strings and their escapes skipped), so safe before any parser.
+std::size_t json_too_deep_at(std::string_view text, int max_depth);
+
 // Parses JSON text strictly: size and nesting within `limits`, no key twice in an object.
 // Throws InputError naming `source` (and the line or the key's path): "scene.json:12: invalid
 // JSON (...)", "scene.json:3: JSON nested deeper than 64 levels", "scene.json: object.mesh:

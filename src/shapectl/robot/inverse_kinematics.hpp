@@ -21,7 +21,7 @@ struct IkGoal {
   Vec3 point_link = Vec3::Zero();      // tool point in the link frame, metres
   Vec3 position_world = Vec3::Zero();  // where the tool point should be, metres
   // Wanted orientation of the link frame (world), or none for a position-only goal.
-  std::optional<Eigen::Matrix3d> rotation_world;
+  std::optional<Eigen::Matrix3d> rotation_world = std::nullopt;
   double orientation_weight = 0.1;     // metres per unit of |R − R*|_F: trades rotation for position
 };
 

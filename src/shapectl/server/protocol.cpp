@@ -15,30 +15,11 @@ namespace {
 
 const char* const source = "message";
 
-// Deep nesting is refused before parsing: no valid command nests deeper than 4.
-bool nesting_within(std::string_view text, int max_depth) {
-  int depth = 0;
-  bool in_string = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      if (c == '\\') ++i;
-      else if (c == '"') in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > max_depth) return false;
-    } else if (c == ']' || c == '}') {
-      --depth;
-    }
-  }
-  return true;
-}
-
+// Size and nesting are checked before any parser runs (no valid command nests deeper than 4).
 nlohmann::json parse_json(std::string_view text) {
   if (text.size() > max_message_bytes)
     throw InputError(source, "", "longer than " + std::to_string(max_message_bytes) + " bytes");
-  if (!nesting_within(text, max_json_depth))
+  if (json_too_deep_at(text, max_json_depth) != std::string_view::npos)
     throw InputError(source, "", "JSON nested deeper than " + std::to_string(max_json_depth));
   if (!nlohmann::json::accept(text.begin(), text.end()))
     throw InputError(source, "", "not valid JSON");
@@ -107,7 +88,8 @@ const std::vector<std::pair<std::string, Command::Type>>& type_names() {
 }  // namespace
 
 nlohmann::json message_id(std::string_view text) {
-  if (text.size() > max_message_bytes || !nesting_within(text, max_json_depth)) return nullptr;
+  if (text.size() > max_message_bytes || json_too_deep_at(text, max_json_depth) != std::string_view::npos)
+    return nullptr;
   const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
   if (!j.is_object()) return nullptr;
   const auto it = j.find("id");
