@@ -3,6 +3,8 @@
 // geometry, grip regions at the nodes nearest the tools, the object pose, and reference joints
 // by inverse kinematics that put the tools at the grip regions. Writes the scene, its sphere
 // file and a report; refuses (exit 1) what it cannot make plausible.
+#include <unistd.h>
+
 #include <charconv>
 #include <cmath>
 #include <iostream>
@@ -13,6 +15,7 @@
 #include <set>
 #include <sstream>
 
+#include <shapectl/io/atomic_file.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/input_file.hpp>
 #include <shapectl/io/json_output.hpp>
@@ -178,8 +181,7 @@ std::vector<CollisionSphere> cover_meshes(const AuthorOptions& o, const RobotMod
   for (const auto& m : read_mesh_collisions(model, o.urdf)) {
     const std::string& link = model.links()[static_cast<std::size_t>(m.link)].name;
     const auto file = resolve_mesh_file(m.filename, fs::path(o.urdf).parent_path(), package_paths);
-    const std::string ext = file ? file->extension().string() : "";
-    if (!file || (ext != ".obj" && ext != ".stl" && ext != ".off" && ext != ".OBJ" && ext != ".STL" && ext != ".OFF")) {
+    if (!file || !is_surface_file(*file)) {
       warnings.push_back(o.urdf + ": link '" + link + "': collision mesh '" + bounded_preview(m.filename) +
                          (file ? "' is not OBJ, STL or OFF" : "' not found (give --package-path)") +
                          ": skipped, the link has no spheres for it");
@@ -434,10 +436,6 @@ void run(const AuthorOptions& o) {
   if (!violations.empty() || !(clearance > 0))
     throw SolverFailure("inverse kinematics returned joints outside their limits or in collision");
 
-  // Names from the URDF or mesh may be invalid UTF-8: written with U+FFFD, never thrown on.
-  const auto text = [](const Json& j) { return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n"; };
-  // Write the sphere file, then the scene, then check the scene loads as written.
-  write_text_file_atomically(spheres_out, text(spheres_json(model, spheres, o.sphere_margin, o.urdf)));
   Json reference_joints = Json::object();
   const auto names = model.active_joint_names();
   for (std::size_t i = 0; i < names.size(); ++i) reference_joints[names[i]] = ik.joints[static_cast<Eigen::Index>(i)];
@@ -448,22 +446,42 @@ void run(const AuthorOptions& o) {
   Json grip_list = Json::array();
   for (std::size_t e = 0; e < ees.size(); ++e) grip_list.push_back({{"end_effector", ees[e].name}, {"nodes", grips[e].nodes}});
   const Vec3 rpy = T_world_object.linear().eulerAngles(2, 1, 0).reverse();
-  Json scene = {
-      {"object",
-       {{"mesh", object.json},
-        {"material", {{"youngs_modulus", o.youngs_modulus}, {"poisson_ratio", o.poisson_ratio}, {"density", o.density}}},
-        {"pose", {{"position", vec_json(T_world_object.translation())}, {"rpy", vec_json(rpy)}}}}},
-      {"gravity", {0, 0, -9.81}},
-      {"robot",
-       {{"urdf", relative_to(o.urdf, scene_dir).generic_string()},
-        {"collision_spheres", relative_to(spheres_out, scene_dir).generic_string()},
-        {"reference_joints", reference_joints},
-        {"end_effectors", end_effectors},
-        {"joint_limit_margin", joint_limit_margin}}},
-      {"grips", grip_list},
-      {"grip_stiffness", 1e4}};
-  write_text_file_atomically(out, text(scene));
-  const Scene loaded = load_scene(out);
+  const auto scene_text = [&](const fs::path& spheres_file) {
+    const Json scene = {
+        {"object",
+         {{"mesh", object.json},
+          {"material", {{"youngs_modulus", o.youngs_modulus}, {"poisson_ratio", o.poisson_ratio}, {"density", o.density}}},
+          {"pose", {{"position", vec_json(T_world_object.translation())}, {"rpy", vec_json(rpy)}}}}},
+        {"gravity", {0, 0, -9.81}},
+        {"robot",
+         {{"urdf", relative_to(o.urdf, scene_dir).generic_string()},
+          {"collision_spheres", relative_to(spheres_file, scene_dir).generic_string()},
+          {"reference_joints", reference_joints},
+          {"end_effectors", end_effectors},
+          {"joint_limit_margin", joint_limit_margin}}},
+        {"grips", grip_list},
+        {"grip_stiffness", 1e4}};
+    return to_pretty_json(scene);  // names that are not valid UTF-8 written with U+FFFD
+  };
+  const std::string spheres_text = to_pretty_json(spheres_json(model, spheres, o.sphere_margin, o.urdf));
+
+  // The scene is loaded (and so checked) as it will be written before anything is replaced: a
+  // scene every command would refuse never overwrites a good one. It and its spheres go to
+  // temporary names beside the results first.
+  const std::string check_prefix = ".author-check-" + std::to_string(::getpid()) + "-";
+  const fs::path check_spheres = spheres_out.parent_path() / (check_prefix + spheres_out.filename().string());
+  const fs::path check_scene = out.parent_path() / (check_prefix + out.filename().string());
+  const Scene loaded = [&] {
+    struct Remove {
+      std::vector<fs::path> files;
+      ~Remove() {
+        std::error_code ignored;
+        for (const auto& f : files) fs::remove(f, ignored);
+      }
+    } remove{{check_spheres, check_scene}};
+    write_files_atomically({{check_spheres, spheres_text}, {check_scene, scene_text(check_spheres)}});
+    return load_scene(check_scene);
+  }();
   for (const auto& w : loaded.warnings) {
     std::cerr << "warning: " << w << "\n";
     warnings.push_back(w);
@@ -483,7 +501,10 @@ void run(const AuthorOptions& o) {
                               {"ignored_adjacent", spheres.adjacent.size()}, {"ignored_always_overlapping", spheres.always.size()}}},
                  {"object", {{"node_count", loaded.object_mesh->node_count()}, {"tet_count", loaded.object_mesh->tet_count()}}},
                  {"warnings", warnings}};
-  if (!o.report.empty()) write_text_file_atomically(o.report, text(report));
+  // Every file or none.
+  std::vector<FileContent> files = {{spheres_out, spheres_text}, {out, scene_text(spheres_out)}};
+  if (!o.report.empty()) files.push_back({o.report, to_pretty_json(report)});
+  write_files_atomically(files);
 
   std::cout << "wrote " << out.string() << " and " << spheres_out.string() << " (" << spheres.spheres.size()
             << " spheres)\n";

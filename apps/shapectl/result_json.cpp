@@ -3,7 +3,6 @@
 #include <iostream>
 
 #include <shapectl/io/json_output.hpp>
-#include <shapectl/robot/joints_file.hpp>
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/sim/scene_checks.hpp>
 
@@ -46,11 +45,6 @@ void require_finite(const nlohmann::json& result, const std::string& what, const
 void require_finite(const nlohmann::ordered_json& result, const std::string& what,
                     const std::string& context) {
   require_finite_numbers(result, what, context);
-}
-
-Eigen::VectorXd read_joints_file(const std::string& file, const RobotModel& robot,
-                                 const Eigen::VectorXd& defaults) {
-  return load_joints_file(file, robot, defaults);
 }
 
 }  // namespace shapectl::cli

@@ -19,8 +19,5 @@ void require_finite(const nlohmann::ordered_json& result, const std::string& wha
 // The scene's warnings ("warning: <file>: <field>: ...") and the nodes each grip caught, one line
 // each, on stderr: the traps a user must see before trusting a result.
 void print_scene_notes(const Scene& scene);
-// θ from JOINTS.json {"joints": {name: rad}}; joints not named keep `defaults`.
-Eigen::VectorXd read_joints_file(const std::string& file, const RobotModel& robot,
-                                 const Eigen::VectorXd& defaults);
 
 }  // namespace shapectl::cli

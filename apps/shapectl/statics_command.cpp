@@ -6,6 +6,7 @@
 #include <shapectl/io/atomic_file.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/io/vtu_writer.hpp>
+#include <shapectl/robot/joints_file.hpp>
 #include <shapectl/sim/gripped_object.hpp>
 
 #include "commands.hpp"
@@ -61,7 +62,7 @@ void run_statics(const StaticsArgs& args) {
   }
   GrippedObject object(scene);
   Eigen::VectorXd joints = object.reference_joints();
-  if (!args.joints.empty()) joints = read_joints_file(args.joints, object.robot(), joints);
+  if (!args.joints.empty()) joints = load_joints_file(args.joints, object.robot(), joints);
   const StaticsResult r = object.solve(joints, x);
   write_outputs(args, r, object.mesh(), rest, x, robot_json(scene, joints));
 }

@@ -22,7 +22,7 @@ Vec3 uniform_in_box(const Vec3& size, std::mt19937& rng) {
 
 TEST(SphereCover, BoxCoverContainsSampledPointsAndEveryCorner) {
   std::mt19937 rng(7);
-  for (const Vec3 size : {Vec3(0.1, 0.1, 0.1), Vec3(0.3, 0.03, 0.05), Vec3(0.5, 0.4, 0.01), Vec3(2.0, 0.02, 0.02)}) {
+  for (const Vec3& size : {Vec3(0.1, 0.1, 0.1), Vec3(0.3, 0.03, 0.05), Vec3(0.5, 0.4, 0.01), Vec3(2.0, 0.02, 0.02)}) {
     const auto spheres = cover_box(size);
     ASSERT_FALSE(spheres.empty());
     EXPECT_LE(spheres.size(), 64u) << size.transpose();
@@ -44,7 +44,7 @@ TEST(SphereCover, BoxCoverIsTightForAThinBar) {
 TEST(SphereCover, CylinderCoverContainsSampledPointsOfItsRimAndVolume) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0, 1);
-  for (const auto [radius, length] : {std::pair{0.03, 0.3}, std::pair{0.1, 0.02}, std::pair{0.05, 0.05}}) {
+  for (const auto& [radius, length] : {std::pair{0.03, 0.3}, std::pair{0.1, 0.02}, std::pair{0.05, 0.05}}) {
     const auto spheres = cover_cylinder(radius, length);
     EXPECT_LE(spheres.size(), static_cast<std::size_t>(max_cover_cells_per_axis));
     for (int k = 0; k < 2000; ++k) {

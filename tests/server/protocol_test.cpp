@@ -29,7 +29,7 @@ std::string error_of(const std::string& text) {
 
 TEST(Protocol, DegenerateCentrelineIsRefusedWithItsLength) {
   EXPECT_NE(error_of(R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,1e-13,0.3],[0.4,2e-13,0.3]]})")
-                .find("points: expected a centre-line at least 1 mm long"),
+                .find("points: expected a centre-line at least 1 mm long (its arc length is 2e-13 m)"),
             std::string::npos);
   EXPECT_EQ(error_of(R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,0.001,0.3]]})"), "");
 }

@@ -7,10 +7,6 @@
 
 namespace shapectl {
 
-void write_text_file_atomically(const std::filesystem::path& file, const std::string& text) {
-  write_file_atomically(file, text);
-}
-
 namespace {
 
 template <class Json>

@@ -10,8 +10,6 @@
 
 namespace shapectl {
 
-// Throws InputError naming the path if it cannot be written (e.g. missing directory).
-void write_text_file_atomically(const std::filesystem::path& file, const std::string& text);
 // Indented like dump(1), but arrays of numbers stay on one line ([x, y, z]). Strings that are
 // not valid UTF-8 are repaired (U+FFFD), not refused: names in results come from input files.
 std::string to_pretty_json(const nlohmann::json& value);

@@ -168,7 +168,7 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
   if (log_ && log_foreign)
     log_->write("foreign_sender", {{"channel", supervisor_.channels()[c].name},
                                    {"address", address_text(from)},
-                                   {"note", "ignored; at most 20 such lines are logged"}});
+                                   {"note", "ignored; at most " + std::to_string(max_logged_rejections) + " such lines are logged"}});
   if (verdict != FeedbackVerdict::accepted || !step.send) return;
   const std::string_view bytes = codec_.encode_sensor(command);
   const bool sent = !bytes.empty() && sockets_[c].send_to(bytes, from);

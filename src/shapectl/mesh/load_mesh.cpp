@@ -14,8 +14,7 @@ TetMesh load_mesh(const std::filesystem::path& file, const SurfaceMeshOptions& s
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (extension == ".msh") return read_msh(file);
   if (extension == ".node" || extension == ".ele") return read_tetgen(file);
-  if (extension == ".obj" || extension == ".stl" || extension == ".off")
-    return mesh_surface(file, surface_options);
+  if (is_surface_file(file)) return mesh_surface(file, surface_options);
   throw InputError(file.string(), "",
                    "unknown mesh format '" + extension +
                        "' (supported: .msh, .node/.ele, and surfaces .obj, .stl, .off)");

@@ -382,10 +382,15 @@ TetgenResult tetrahedralize_isolated(tetgenbehavior& behavior, tetgenio& in,
 
 }  // namespace
 
+bool is_surface_file(const std::filesystem::path& file) {
+  const std::string extension = lowercase(file.extension().string());
+  return extension == ".obj" || extension == ".stl" || extension == ".off";
+}
+
 TriangleSurface read_surface(const std::filesystem::path& file) {
   const std::string extension = lowercase(file.extension().string());
   const std::string name = file.string();
-  if (extension != ".obj" && extension != ".stl" && extension != ".off")
+  if (!is_surface_file(file))
     throw InputError(name, "", "unknown surface format '" + extension + "' (supported: .obj, .stl, .off)");
   const std::string text = read_text_file(file);
   if (extension == ".obj") return read_obj(name, text);

@@ -28,6 +28,9 @@ struct TriangleSurface {
   std::vector<std::array<int, 3>> triangles;  // indices into vertices
 };
 
+// True for the surface formats read_surface reads (.obj, .stl, .off, in any letter case).
+bool is_surface_file(const std::filesystem::path& file);
+
 // Reads a triangle surface by extension: .obj (v/f lines; polygons fan-triangulated; f 1/2/3,
 // f 1//3 and negative indices), .stl (ASCII or binary) or .off. Vertices with identical
 // coordinates are merged into the first; vertices no face uses are dropped; the rest keep the

@@ -4,7 +4,9 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <iomanip>
 #include <set>
+#include <sstream>
 
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_input.hpp>
@@ -21,10 +23,13 @@ nlohmann::json parse_json(std::string_view text) {
     throw InputError(source, "", "longer than " + std::to_string(max_message_bytes) + " bytes");
   if (json_too_deep_at(text, max_json_depth) != std::string_view::npos)
     throw InputError(source, "", "JSON nested deeper than " + std::to_string(max_json_depth));
-  if (!nlohmann::json::accept(text.begin(), text.end()))
-    throw InputError(source, "", "not valid JSON");
   // Strictly: a key given twice is an error naming it, never silently the last one.
-  return parse_json_text(text, source, {.max_bytes = max_message_bytes, .max_depth = max_json_depth});
+  try {
+    return parse_json_text(text, source, {.max_bytes = max_message_bytes, .max_depth = max_json_depth});
+  } catch (const InputError&) {
+    if (!nlohmann::json::accept(text.begin(), text.end())) throw InputError(source, "", "not valid JSON");
+    throw;  // valid JSON with a key given twice
+  }
 }
 
 bool valid_id(const nlohmann::json& id) {
@@ -157,9 +162,11 @@ Command parse_command(std::string_view text, const ProtocolContext& context) {
         c.points.push_back(read_point(list.at(k)));
         if (k > 0) length += (c.points[k] - c.points[k - 1]).norm();
       }
-      if (!(length >= min_centerline_length))
-        list.fail("a centre-line at least 1 mm long (the points are all within " +
-                  std::to_string(length) + " m of each other)");
+      if (!(length >= min_centerline_length)) {
+        std::ostringstream arc;
+        arc << std::setprecision(3) << length;
+        list.fail("a centre-line at least 1 mm long (its arc length is " + arc.str() + " m)");
+      }
       break;
     }
     case T::SetPaused:

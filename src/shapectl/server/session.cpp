@@ -256,8 +256,8 @@ void Session::apply(const Command& c) {
 }
 
 namespace {
-// Everything a state or positions frame carries, finite and within float range: a snapshot
-// that is not is never sent (the last good one stays).
+// Everything a state or positions frame carries, finite and within float range: the numbers
+// of a snapshot that is not are never sent (the last good ones stay; see tick()).
 bool publishable(const ControllerSnapshot& s) {
   auto ok = [](const auto& m) { return (m.array().abs() <= 1e30).all(); };
   for (const auto& T : s.T_world_link)
@@ -271,7 +271,20 @@ bool publishable(const ControllerSnapshot& s) {
 }  // namespace
 
 void Session::tick() {
-  if (auto next = controller_->snapshot(); publishable(*next)) snapshot_ = std::move(next);
+  auto next = controller_->snapshot();
+  if (publishable(*next)) {
+    snapshot_ = std::move(next);
+  } else if (next->sequence != snapshot_->sequence) {
+    // Geometry and numbers from the last good state; what the controller says from this one,
+    // so pages see that something failed instead of a frozen state.
+    auto shown = std::make_shared<ControllerSnapshot>(*snapshot_);
+    shown->sequence = next->sequence;
+    shown->status = next->status;
+    shown->paused = next->paused;
+    shown->last_error = "a state with non-finite numbers was not shown" +
+                        (next->last_error.empty() ? std::string() : ": " + next->last_error);
+    snapshot_ = std::move(shown);
+  }
   const double t = now();
   history_.push_back({t, snapshot_->error.mean, t - last_edit_time_ < editing_window});
   while (history_.size() > history_capacity) history_.pop_front();

@@ -15,6 +15,8 @@ class HessianAssembler {
   // Returns the assembled matrix; `pattern_changed()` tells if the sparsity pattern is new.
   const SparseMatrix& assemble(const Triplets& triplets);
   bool pattern_changed() const { return pattern_changed_; }
+  // The matrix the last assemble() returned.
+  const SparseMatrix& matrix() const { return matrix_; }
   const std::vector<char>& fixed_dof() const { return fixed_dof_; }
 
  private:

@@ -1,6 +1,5 @@
 #include <shapectl/sim/scene.hpp>
 
-#include <cctype>
 #include <sstream>
 
 #include <shapectl/mesh/box_mesh.hpp>
@@ -129,12 +128,6 @@ double read_mesh_scale(const JsonInput& j) {
   if (units == "cm") return 1e-2;
   if (units == "mm") return 1e-3;
   j.at("units").fail("\"m\", \"cm\" or \"mm\" (or give \"scale\": factor to metres)");
-}
-
-bool is_surface_file(const std::filesystem::path& file) {
-  std::string extension = file.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return extension == ".obj" || extension == ".stl" || extension == ".off";
 }
 
 // A mesh file, its coordinates scaled to metres: a surface before TetGen sees it (so

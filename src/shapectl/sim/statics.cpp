@@ -112,12 +112,11 @@ StaticsResult StaticsSolver::solve(Positions& x, int max_iterations) {
   return result;
 }
 
-std::string StaticsSolver::singular_reason(const Positions& x) {
-  // Structural checks (every part held) belong to the caller; here the matrix itself is
-  // judged: the spread of its diagonal over free dofs measures how ill-conditioned it is.
-  triplets_.clear();
-  for (const auto* t : terms_) t->add_hessian(x, triplets_, true);
-  const SparseMatrix& H = assembler_.assemble(triplets_);
+std::string StaticsSolver::singular_reason() const {
+  // Structural checks (every part held) belong to the caller; here the matrix itself, the
+  // projected Hessian that just failed to factor, is judged: the spread of its diagonal over
+  // free dofs measures how ill-conditioned it is.
+  const SparseMatrix& H = assembler_.matrix();
   const auto& fixed = assembler_.fixed_dof();
   double lo = std::numeric_limits<double>::infinity(), hi = 0;
   for (int d = 0; d < H.rows(); ++d)
@@ -216,7 +215,7 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
       log.projected = true;
       if (!factor_at(x, true)) {
         result.status = StaticsStatus::Singular;
-        result.reason = singular_reason(x);
+        result.reason = singular_reason();
         return result;
       }
       dx = -cholesky_.solve(g);

@@ -104,8 +104,9 @@ class StaticsSolver {
   double max_force(const Eigen::VectorXd& gradient) const;
   // Assembles and factors at x; projected = use PSD-projected element Hessians.
   bool factor_at(const Positions& x, bool projected);
-  // Why the projected Hessian at x could not be factored, with its conditioning.
-  std::string singular_reason(const Positions& x);
+  // Why the projected Hessian factor_at just assembled could not be factored, with its
+  // conditioning.
+  std::string singular_reason() const;
 
   int node_count_;
   std::vector<const EnergyTerm*> terms_;
