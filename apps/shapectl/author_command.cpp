@@ -480,7 +480,12 @@ void run(const AuthorOptions& o) {
       }
     } remove{{check_spheres, check_scene}};
     write_files_atomically({{check_spheres, spheres_text}, {check_scene, scene_text(check_spheres)}});
-    return load_scene(check_scene);
+    try {
+      return load_scene(check_scene);
+    } catch (const InputError& e) {
+      throw InputError("the proposed scene would be refused, so nothing was written (" +
+                       std::string(e.what()) + "); change the option that sets that field");
+    }
   }();
   for (const auto& w : loaded.warnings) {
     std::cerr << "warning: " << w << "\n";

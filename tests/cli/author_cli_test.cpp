@@ -283,6 +283,8 @@ TEST(AuthorCli, BadInputIsExitOneNamingTheFieldAndLeavesAnExistingSceneAlone) {
     EXPECT_EQ(run.exit_code, 1) << c.change[0] << " " << run.err;
     EXPECT_NE(run.err.find(c.expected), std::string::npos) << run.err;
     EXPECT_EQ(test::read_text(a.scene), before);
+    for (const auto& f : std::filesystem::directory_iterator(a.scene.parent_path()))
+      EXPECT_EQ(f.path().filename().string().find(".author-check-"), std::string::npos) << f.path();
   }
   // The unreachable grip says why.
   auto args = author_args(a);
