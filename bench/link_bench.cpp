@@ -29,6 +29,7 @@ RobotModel yumi_arms() {
 EgmFeedback sample_feedback(std::uint32_t seqno) {
   EgmFeedback f;
   f.seqno = seqno;
+  f.tm = seqno * 4;  // the controller's clock, ms: one 4 ms cycle per datagram
   f.joints << 0.1, -1.2, 0.8, 0.5, -0.3, 0.4, 0.2;
   f.motors_on = f.egm_running = f.rapid_running = true;
   return f;

@@ -51,7 +51,7 @@ struct Controller {
   std::string datagram(int c, std::uint32_t seqno) {
     EgmFeedback f;
     f.seqno = seqno;
-    f.tm = seqno * 4;
+    f.tm = seqno * cycle_ms;
     f.joints = pose[c];
     f.motors_on = f.egm_running = f.rapid_running = true;
     return std::string(codec.encode_robot(f));
@@ -87,6 +87,7 @@ struct Controller {
   ArmJoints pose[2];
   EgmCodec codec;
   std::uint32_t seqno = 0;
+  std::uint32_t cycle_ms = 4;  // the controller's \SampleRate
 };
 
 struct Fixture {
@@ -132,9 +133,10 @@ TEST(EgmAdversarial, ABurstAfterAStallAdvancesNoFasterThanTheClock) {
   const std::vector<ArmJoints> replies = f.ctl.replies(0, 20, 1.0);
   const auto burst_answered = Clock::now();
   ASSERT_EQ(replies.size(), 20u);
-  // Within the burst: n advances need n·T ≤ 2J + its duration (motion_pacing.hpp).
+  // The burst's replies land on one controller tick (or two, should the burst straddle one):
+  // one governor step each, not one per datagram (motion_pacing.hpp).
   const double duration = seconds(burst_sent, burst_answered);
-  const double bound = v_max * (duration + 2 * pacing_jitter(T)) + 1e-9;
+  const double bound = v_max * (duration + T) + 1e-9;
   for (const ArmJoints& q : replies)
     EXPECT_LE((q - replies.front()).cwiseAbs().maxCoeff(), bound) << "burst took " << duration << " s";
   // The first one restarts from rest after the stall: at most a·T² from the held pose.
@@ -184,6 +186,19 @@ TEST(EgmAdversarial, DuplicatesGetNoReplyAndReorderingIsStaleNotLost) {
   f.ctl.send(0, f.ctl.datagram(0, s + 4));
   EXPECT_EQ(f.ctl.replies(0, 1, 0.2).size(), 1u);
   EXPECT_EQ(f.link.status().lost_datagrams, 1u);
+}
+
+TEST(EgmAdversarial, AControllerCyclingAtAnotherRateThanConfiguredCannotBeArmed) {
+  Fixture f;
+  f.ctl.cycle_ms = 8;  // \SampleRate 8 ms against egm_period 4 ms: steps would be half speed
+  for (int k = 0; k < 5; ++k) f.ctl.cycle();
+  std::string why;
+  EXPECT_FALSE(f.link.arm(&why));
+  EXPECT_NE(why.find("sample period is 8 ms"), std::string::npos) << why;
+  EXPECT_NE(why.find("egm_period is 4 ms"), std::string::npos) << why;
+  f.ctl.cycle_ms = 4;  // fixed on the controller: arming works
+  for (int k = 0; k < 5; ++k) f.ctl.cycle();
+  EXPECT_TRUE(f.link.arm(&why)) << why;
 }
 
 }  // namespace

@@ -25,7 +25,7 @@ struct Fixture {
     t += dt;
     if (with_feedback)
       for (int c = 0; c < 2; ++c) {
-        s.on_feedback(c, robot.segment(c, 1), "", t);
+        s.on_feedback(c, robot.segment(c, 1), "", t, t);
         robot[c] = s.command(c)[0];
       }
     s.check_watchdog(t);
@@ -56,7 +56,7 @@ TEST(LinkSupervisor, ArmingNeedsFeedbackOnEveryChannel) {
   std::string why;
   EXPECT_FALSE(f.s.arm(0, &why));
   EXPECT_EQ(why, "a: no feedback");
-  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.0), "", 0.001);
+  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.0), "", 0.001, 0.001);
   EXPECT_FALSE(f.s.arm(0.001, &why));
   EXPECT_EQ(why, "b: no feedback");
 }
@@ -131,7 +131,7 @@ TEST(LinkSupervisor, RobotFaultDisarmsAndBlocksArming) {
   Fixture f;
   f.tick();
   ASSERT_TRUE(f.s.arm(f.t, nullptr));
-  f.s.on_feedback(1, Eigen::VectorXd::Constant(1, -0.2), "motors off", f.t + dt);
+  f.s.on_feedback(1, Eigen::VectorXd::Constant(1, -0.2), "motors off", f.t + dt, f.t + dt);
   EXPECT_EQ(f.s.status(f.t).reason, "b: motors off");
   std::string why;
   EXPECT_FALSE(f.s.arm(f.t, &why));
@@ -142,7 +142,7 @@ TEST(LinkSupervisor, TrackingErrorDisarms) {
   Fixture f;
   f.tick();
   ASSERT_TRUE(f.s.arm(f.t, nullptr));
-  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.6), "", f.t + dt);
+  f.s.on_feedback(0, Eigen::VectorXd::Constant(1, 0.6), "", f.t + dt, f.t + dt);
   EXPECT_FALSE(f.s.status(f.t).armed);
   EXPECT_EQ(f.s.status(f.t).reason, "a: tracking error 0.3 rad above 0.2 rad");
 }
@@ -178,8 +178,8 @@ TEST(LinkSupervisor, MeasuredBeyondTheHardLimitsGetsNoCommandAndCannotBeArmed) {
   f.robot = Eigen::Vector2d(0.3, -2.05);  // joint 1 reported beyond its limit (-2)
   for (int k = 0; k < 10; ++k) {
     f.t += dt;
-    EXPECT_TRUE(f.s.on_feedback(0, f.robot.segment(0, 1), "", f.t).send);
-    EXPECT_FALSE(f.s.on_feedback(1, f.robot.segment(1, 1), "", f.t).send);
+    EXPECT_TRUE(f.s.on_feedback(0, f.robot.segment(0, 1), "", f.t, f.t).send);
+    EXPECT_FALSE(f.s.on_feedback(1, f.robot.segment(1, 1), "", f.t, f.t).send);
   }
   std::string why;
   EXPECT_FALSE(f.s.arm(f.t, &why));
@@ -190,7 +190,7 @@ TEST(LinkSupervisor, MeasuredBeyondTheHardLimitsGetsNoCommandAndCannotBeArmed) {
   ASSERT_TRUE(f.s.arm(f.t, &why)) << why;
   for (int k = 0; k < 50; ++k) f.tick();
   f.t += dt;
-  EXPECT_FALSE(f.s.on_feedback(1, Eigen::VectorXd::Constant(1, 2.3), "", f.t).send);
+  EXPECT_FALSE(f.s.on_feedback(1, Eigen::VectorXd::Constant(1, 2.3), "", f.t, f.t).send);
   EXPECT_FALSE(f.s.status(f.t).armed);
   EXPECT_NE(f.s.status(f.t).reason.find("outside its limits"), std::string::npos);
 }
@@ -219,11 +219,31 @@ TEST(LinkSupervisor, FeedbackFasterThanTheClockHoldsInsteadOfStepping) {
   ASSERT_TRUE(f.s.arm(f.t, nullptr));
   for (int k = 0; k < 100; ++k) f.tick();  // moving at full speed now
   const double before = f.s.command(0)[0];
-  // 40 datagrams within 2 ms (a burst, a flood): at most one step.
+  // 40 datagrams within 2 ms (a burst, a flood), honestly stamped: at most one step.
   int advanced = 0;
-  for (int k = 0; k < 40; ++k) advanced += f.s.on_feedback(0, f.s.command(0), "", f.t + 5e-5 * k).advanced;
+  for (int k = 0; k < 40; ++k) {
+    const double t = f.t + 5e-5 * k;
+    advanced += f.s.on_feedback(0, f.s.command(0), "", t, t).advanced;
+  }
   EXPECT_LE(advanced, 1);
   EXPECT_LE(std::abs(f.s.command(0)[0] - before), 0.5 * dt + 1e-12);
+}
+
+TEST(LinkSupervisor, StampsRunningAheadOfTheClockCannotOutrunIt) {
+  Fixture f;
+  f.target(Eigen::Vector2d(1, 1));
+  f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  for (int k = 0; k < 100; ++k) f.tick();
+  const double before = f.s.command(0)[0];
+  // 40 datagrams within 2 ms, each stamped a cycle later than the one before: the real-time
+  // credit (2 cycles, spent down to −1) allows at most three steps.
+  int advanced = 0;
+  for (int k = 0; k < 40; ++k)
+    advanced += f.s.on_feedback(0, f.s.command(0), "", f.t + 5e-5 * k, f.t + dt * (k + 1)).advanced;
+  EXPECT_GE(advanced, 1);
+  EXPECT_LE(advanced, 3);
+  EXPECT_LE(std::abs(f.s.command(0)[0] - before), 3 * 0.5 * dt + 1e-12);
 }
 
 }  // namespace

@@ -2,9 +2,11 @@
 
 #include <arpa/inet.h>
 #include <poll.h>
+#include <time.h>
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <regex>
 
 #include <shapectl/io/input_error.hpp>
@@ -88,6 +90,7 @@ EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
   }
   next_seqno_.assign(sockets_.size(), 1);
   filters_.resize(sockets_.size());
+  pending_.resize(sockets_.size());
   latency_us_.reserve(latency_capacity);
   if (log_)
     log_link_started(*log_, "egm", robot.active_joint_names(), supervisor_.channels(),
@@ -99,10 +102,15 @@ EgmLink::~EgmLink() { stop(); }
 void EgmLink::run(std::stop_token stop) {
   std::vector<pollfd> fds;
   for (const auto& s : sockets_) fds.push_back({s.fd(), POLLIN, 0});
-  // Wake at least every millisecond for the watchdog and for stop requests.
-  constexpr int poll_timeout_ms = 1;
+  // Wake at least every millisecond for the watchdog and for stop requests, and when a
+  // held-back reply is due.
+  constexpr double poll_interval = 1e-3;
   while (!stop.stop_requested()) {
-    ::poll(fds.data(), fds.size(), poll_timeout_ms);
+    double wait = poll_interval;
+    for (const auto& queue : pending_)
+      if (!queue.empty()) wait = std::min(wait, std::max(queue.front().due - now(), 0.0));
+    const timespec timeout{0, static_cast<long>(wait * 1e9)};
+    ::ppoll(fds.data(), fds.size(), &timeout, nullptr);
     for (std::size_t c = 0; c < sockets_.size(); ++c) {
       if (!(fds[c].revents & POLLIN)) continue;
       sockaddr_in from{};
@@ -113,6 +121,7 @@ void EgmLink::run(std::stop_token stop) {
                                                              std::min<long>(n, static_cast<long>(buffer_.size())))),
                         from, std::chrono::steady_clock::now());
     }
+    send_due_replies();
     std::lock_guard lock(mutex_);
     supervisor_.check_watchdog(now());
   }
@@ -138,9 +147,11 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
     return;
   }
   EgmCommand command;
-  Eigen::VectorXd measured = to_vector(feedback.joints);
+  Reply reply;
+  reply.to = from;
+  reply.arrived = arrived;
+  reply.measured = to_vector(feedback.joints);
   FeedbackVerdict verdict;
-  FeedbackStep step;
   bool log_foreign = false;
   std::string bound_to;
   {
@@ -156,11 +167,20 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
       log_foreign = true;
     }
     if (verdict == FeedbackVerdict::accepted) {
-      step = supervisor_.on_feedback(channel, measured, feedback.fault(), now());
+      // Steps are paced by the controller's ticks: its cycle must be the one configured.
+      std::string fault(feedback.fault());
+      const auto period_ms = std::llround(period_ * 1000);
+      if (fault.empty() && filter.cycle_ms() != 0 && filter.cycle_ms() != period_ms)
+        fault = "the controller's sample period is " + std::to_string(filter.cycle_ms()) +
+                " ms (feedback time stamps), egm_period is " + std::to_string(period_ms) +
+                " ms: set \\SampleRate or egm_period to match";
+      reply.step = supervisor_.on_feedback(channel, reply.measured, fault, now(),
+                                           filter.controller_time());
       command.joints = supervisor_.command(channel);
-      command.velocity = step.advanced ? supervisor_.command_velocity(channel) : ArmJoints::Zero();
-      if (step.send) command.seqno = next_seqno_[c]++;
-      command.tm = static_cast<std::uint32_t>(now() * 1000);
+      command.velocity =
+          reply.step.advanced ? supervisor_.command_velocity(channel) : ArmJoints::Zero();
+      if (reply.step.send) command.seqno = next_seqno_[c]++;
+      command.tm = static_cast<std::uint32_t>(reply.step.send_at * 1000);
     }
   }
   if (log_ && !bound_to.empty())
@@ -169,23 +189,44 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
     log_->write("foreign_sender", {{"channel", supervisor_.channels()[c].name},
                                    {"address", address_text(from)},
                                    {"note", "ignored; at most " + std::to_string(max_logged_rejections) + " such lines are logged"}});
-  if (verdict != FeedbackVerdict::accepted || !step.send) return;
-  const std::string_view bytes = codec_.encode_sensor(command);
-  const bool sent = !bytes.empty() && sockets_[c].send_to(bytes, from);
+  if (verdict != FeedbackVerdict::accepted || !reply.step.send) return;
+  reply.bytes = codec_.encode_sensor(command);
+  reply.joints = command.joints;
+  reply.seqno = command.seqno;
+  reply.due = reply.step.send_at;
+  // Replies leave in order; one held back until it surely lands after a tick waits here.
+  auto& queue = pending_[c];
+  if (queue.empty() && reply.due <= now()) {
+    send_reply(channel, reply);
+  } else if (queue.size() < max_pending_replies) {
+    queue.push_back(std::move(reply));
+  }
+}
+
+void EgmLink::send_due_replies() {
+  for (std::size_t c = 0; c < pending_.size(); ++c)
+    while (!pending_[c].empty() && pending_[c].front().due <= now()) {
+      send_reply(static_cast<int>(c), pending_[c].front());
+      pending_[c].pop_front();
+    }
+}
+
+void EgmLink::send_reply(int channel, const Reply& reply) {
+  const auto c = static_cast<std::size_t>(channel);
+  const bool sent = !reply.bytes.empty() && sockets_[c].send_to(reply.bytes, reply.to);
   const auto done = std::chrono::steady_clock::now();
-  const float us = std::chrono::duration<float, std::micro>(done - arrived).count();
-  std::uint64_t seq;
+  const float us = std::chrono::duration<float, std::micro>(done - reply.arrived).count();
   {
     std::lock_guard lock(mutex_);
     if (latency_us_.size() < latency_capacity) latency_us_.push_back(us);
     else latency_us_[latency_next_] = us;
     latency_next_ = (latency_next_ + 1) % latency_capacity;
-    if (bytes.empty()) supervisor_.disarm("internal: non-finite command not sent");
+    if (reply.bytes.empty()) supervisor_.disarm("internal: non-finite command not sent");
     if (sent) ++commands_sent_;
-    seq = command.seqno;
   }
   if (log_ && sent)
-    log_command(*log_, supervisor_.channels()[c].name, seq, command.joints, measured, step);
+    log_command(*log_, supervisor_.channels()[c].name, reply.seqno, reply.joints, reply.measured,
+                reply.step);
 }
 
 LinkStatus EgmLink::status() const {

@@ -1,10 +1,14 @@
 #pragma once
 // The real robot link: ABB EGM joint streaming to a YuMi, one UDP endpoint per arm. The
-// controller sends an EgmRobot every sample; each one is answered at once with an EgmSensor
-// carrying the governor's next command for that arm (one governor step of `egm_period` per
-// message). Nothing is sent unasked: without feedback the robot gets nothing, and EGM's own
-// \CommTimeout stops it. Datagrams that are not valid EgmRobot messages are counted and ignored.
+// controller sends an EgmRobot every sample; each one is answered with an EgmSensor carrying
+// the governor's command for the controller tick the reply lands on (one governor step of
+// `egm_period` per tick, MotionPacer). A reply leaves at once, or up to a latency allowance
+// later when it could otherwise land on either side of a tick. Nothing is sent unasked:
+// without feedback the robot gets nothing, and EGM's own \CommTimeout stops it. Datagrams
+// that are not valid EgmRobot messages are counted and ignored.
 #include <chrono>
+#include <deque>
+#include <string>
 #include <memory>
 #include <vector>
 
@@ -44,12 +48,29 @@ class EgmLink : public SupervisedLink {
 
  private:
   void run(std::stop_token stop) override;
+  // A reply ready to leave at `due` (s, the link's clock).
+  struct Reply {
+    sockaddr_in to{};
+    std::chrono::steady_clock::time_point arrived;  // its feedback's arrival
+    Eigen::VectorXd measured;
+    FeedbackStep step;
+    std::string bytes;  // empty: the command was not finite
+    ArmJoints joints = ArmJoints::Zero();
+    std::uint32_t seqno = 0;
+    double due = 0;
+  };
+  // Bursts (one reply per datagram) fit; more means the link thread stalled: drop the newest.
+  static constexpr std::size_t max_pending_replies = 64;
+
   void handle_datagram(int channel, std::string_view datagram, const sockaddr_in& from,
                        std::chrono::steady_clock::time_point arrived);
+  void send_due_replies();
+  void send_reply(int channel, const Reply& reply);
 
   std::vector<UdpSocket> sockets_;  // one per channel
   EgmCodec codec_;                  // link thread only
   std::vector<char> buffer_;        // link thread only
+  std::vector<std::deque<Reply>> pending_;  // per channel, link thread only
 
   // Guarded by mutex_:
   std::vector<std::uint32_t> next_seqno_;  // per channel, ours

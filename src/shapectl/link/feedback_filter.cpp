@@ -18,6 +18,8 @@ FeedbackVerdict FeedbackFilter::accept(std::uint64_t sender, std::uint32_t seqno
   if (!has_sequence_) {
     has_sequence_ = true;
     newest_ = seqno, newest_tm_ = tm, seen_ = 1;
+    newest_time_ms_ = tm;
+    cycle_ms_ = 0;
     return FeedbackVerdict::accepted;
   }
   const std::int64_t d = ahead(newest_, seqno);
@@ -33,6 +35,8 @@ FeedbackVerdict FeedbackFilter::accept(std::uint64_t sender, std::uint32_t seqno
   if (ahead(newest_tm_, tm) < 0) return ++counts_.stale, FeedbackVerdict::stale;
   if (d < 1000) counts_.lost += static_cast<std::uint64_t>(d - 1);
   seen_ = d >= window ? 1 : (seen_ << d | 1);
+  cycle_ms_ = d == 1 ? ahead(newest_tm_, tm) : 0;
+  newest_time_ms_ += ahead(newest_tm_, tm);
   newest_ = seqno, newest_tm_ = tm;
   return FeedbackVerdict::accepted;
 }

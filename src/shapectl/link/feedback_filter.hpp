@@ -28,6 +28,12 @@ class FeedbackFilter {
 
   const FeedbackCounts& counts() const { return counts_; }
   bool bound() const { return bound_; }
+  // The newest accepted datagram's time stamp, unwrapped, in seconds of the controller's clock
+  // (counted from the first datagram of the current sequence).
+  double controller_time() const { return static_cast<double>(newest_time_ms_) * 1e-3; }
+  // The controller's cycle seen in the newest datagram: its stamp minus the previous one's
+  // when their sequence numbers are consecutive, ms; 0 when not known.
+  std::int64_t cycle_ms() const { return cycle_ms_; }
   std::uint64_t sender() const { return sender_; }
 
  private:
@@ -36,6 +42,8 @@ class FeedbackFilter {
   std::uint64_t sender_ = 0;
   bool has_sequence_ = false;
   std::uint32_t newest_ = 0, newest_tm_ = 0;
+  std::int64_t newest_time_ms_ = 0;  // newest_tm_ unwrapped
+  std::int64_t cycle_ms_ = 0;
   std::uint64_t seen_ = 0;  // bit d: newest − d was accepted or seen late
   FeedbackCounts counts_;
 };

@@ -142,7 +142,8 @@ std::string LinkSupervisor::outside_limits(const Channel& c, const Eigen::Vector
 }
 
 FeedbackStep LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& measured,
-                                         std::string_view fault, double now) {
+                                         std::string_view fault, double now,
+                                         double controller_time) {
   Channel& c = state_[static_cast<std::size_t>(channel)];
   assert(measured.size() == c.governor.limits().size() && measured.allFinite());
   const bool resumed = !c.connected || !c.outside.empty();
@@ -170,8 +171,8 @@ FeedbackStep LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& mea
       disarm(c.spec.name + ": tracking error " + format(error) + " rad above " +
              format(settings_.max_tracking_error) + " rad");
   }
-  const PaceStep pace = c.pacer.on_send(now);
-  FeedbackStep step{.send = true, .advanced = pace.advance, .from_rest = false};
+  const PaceStep pace = c.pacer.on_feedback(now, controller_time);
+  FeedbackStep step{.send = true, .advanced = pace.advance, .from_rest = false, .send_at = pace.send_at};
   if (!pace.advance) return step;
   if (pace.from_rest && !c.governor.at_rest()) {
     c.governor.halt();

@@ -12,8 +12,9 @@
 //   failing the pose check), feedback missing longer than the watchdog time, a robot fault,
 //   a tracking error above the limit, a commanded pose failing the pose check (then it stops
 //   at the last good pose at once).
-// - Real time: a channel's governor advances one step of `period` only as fast as the clock
-//   allows (MotionPacer), whatever the arrival pattern of the feedback; the rest are holds.
+// - Real time: a channel's governor advances one step of `period` per controller tick that its
+//   replies land on (MotionPacer), whatever the arrival pattern of the feedback; other replies
+//   repeat the command.
 // - Hard limits: while a channel's measured joints are outside the robot's joint limits it gets
 //   no command at all (none may lie outside them, and jumping inside is no option), it is
 //   disarmed and arming is refused; once measured inside again it restarts from there. From
@@ -54,6 +55,7 @@ struct FeedbackStep {
   bool send = false;       // reply with command(); false: send nothing
   bool advanced = false;   // the governor took a step (else the command is the previous one)
   bool from_rest = false;  // ... after zeroing its velocity (the pose was held over a gap)
+  double send_at = 0;      // when the reply should leave (s, `now`'s clock): now or a little later
 };
 
 // Full-θ check of a pose (e.g. self-collision): true when fine, else false and `why` set.
@@ -80,11 +82,13 @@ class LinkSupervisor {
   bool arm(double now, std::string* why_not);
   void disarm(const std::string& reason);
 
-  // One feedback sample of `channel` (its joints, rad, channel order) arrived at `now`;
-  // `fault` is non-empty when the robot says it cannot follow. Advances that channel's
-  // governor as far as real time allows; command() is then the command to send.
+  // One feedback sample of `channel` (its joints, rad, channel order), stamped
+  // `controller_time` by the controller (s, its clock), arrived at `now`; `fault` is non-empty
+  // when the robot says it cannot follow. Advances that channel's governor by at most one step
+  // for the controller tick the reply lands on; command() is then the command to send at
+  // the returned send_at.
   FeedbackStep on_feedback(int channel, const Eigen::VectorXd& measured, std::string_view fault,
-                           double now);
+                           double now, double controller_time);
   bool connected(int channel) const { return state_[static_cast<std::size_t>(channel)].connected; }
   const Eigen::VectorXd& command(int channel) const;
   const Eigen::VectorXd& command_velocity(int channel) const;

@@ -64,7 +64,9 @@ void SimLink::run(std::stop_token stop) {
       std::lock_guard lock(mutex_);
       robot_.step(period_);
       measured = robot_.position();
-      step = supervisor_.on_feedback(0, measured, {}, now());
+      // The simulated robot is its own controller: stamped now, the reply lands at its next tick.
+      const double t = now();
+      step = supervisor_.on_feedback(0, measured, {}, t, t);
       if (step.send) {
         command = supervisor_.command(0);
         robot_.command(command);
