@@ -5,6 +5,7 @@ import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import net from 'node:net';
 import { startServer, RawWebSocket, waitFor } from './support.mjs';
+import { Command, Message } from '../../web/js/protocol.js';
 
 // Seeded PRNG (mulberry32), so a failure can be replayed.
 function rng(seed) {
@@ -16,8 +17,10 @@ function rng(seed) {
   };
 }
 
-const TYPES = ['ping', 'set_target', 'remove_target', 'set_targets', 'clear_targets', 'set_centerline',
-  'set_paused', 'set_joint', 'set_joints', 'reset', 'load_scene', 'arm', 'disarm'];
+const TYPES = Object.values(Command);
+// Commands without fields, and a valid ping as text to break in various ways.
+const NO_FIELD_TYPES = [Command.Ping, Command.Reset, Command.ClearTargets, Command.Arm, Command.Disarm];
+const PING = JSON.stringify({ type: Command.Ping });
 
 // Messages that are invalid by construction, in many different ways.
 function badMessages(count, nodeCount, jointCount, random) {
@@ -33,30 +36,30 @@ function badMessages(count, nodeCount, jointCount, random) {
   };
   const generators = [
     // Not JSON, or JSON that is not a command object.
-    () => pick(['', ' ', '{', '}', '[', 'null', '42', '"ping"', '{"type":', '{"type":"ping"', 'ping', '\u0000', '{"type":"ping"}}']),
-    () => JSON.stringify(randomJson(0)).replace(/"type":"(ping|reset|clear_targets|arm|disarm)"/, '"type":"x"'),
+    () => pick(['', ' ', '{', '}', '[', 'null', '42', JSON.stringify(Command.Ping), '{"type":', PING.slice(0, -1), Command.Ping, '\u0000', `${PING}}`]),
+    () => JSON.stringify(randomJson(0)).replace(new RegExp(`"type":"(${NO_FIELD_TYPES.join('|')})"`), '"type":"x"'),
     () => Array.from({ length: 1 + int(200) }, () => String.fromCharCode(32 + int(95))).join(''),
     () => '['.repeat(17 + int(5000)) + ']'.repeat(int(3)),
     // Unknown or mistyped "type", unknown keys, bad ids.
-    () => JSON.stringify({ type: pick(['launch', 'PING', '', 'set-target', 1, null, ['ping']]) }),
+    () => JSON.stringify({ type: pick(['launch', 'PING', '', 'set-target', 1, null, [Command.Ping]]) }),
     () => JSON.stringify({ type: pick(TYPES), [`extra${int(9)}`]: 1, node: 0, position: [0, 0, 0] }),
-    () => JSON.stringify({ type: 'ping', id: pick([1.5, [], {}, true, 'x'.repeat(65)]) }),
+    () => JSON.stringify({ type: Command.Ping, id: pick([1.5, [], {}, true, 'x'.repeat(65)]) }),
     // Out-of-range or wrongly typed fields.
-    () => JSON.stringify({ type: 'set_target', id: int(1e6), node: pick(badNumbers), position: [0.4, 0, 0.3] }),
-    () => JSON.stringify({ type: 'set_target', node: int(nodeCount), position: pick(badPoints) }),
-    () => `{"type":"set_target","node":${int(nodeCount)},"position":[1e400,0,0]}`,
-    () => JSON.stringify({ type: 'set_target', node: int(nodeCount) }),
-    () => JSON.stringify({ type: 'remove_target', node: pick(badNumbers) }),
-    () => JSON.stringify({ type: 'set_targets', targets: pick([null, {}, 'all', [{ node: 0 }], [{ node: 0, position: [0, 0, 0] }, { node: 0, position: [0, 0, 0] }]]) }),
-    () => JSON.stringify({ type: 'set_targets', targets: Array.from({ length: nodeCount + 1 }, (_, k) => ({ node: k, position: [0, 0, 0] })) }),
-    () => JSON.stringify({ type: 'set_centerline', points: pick([[], [[0, 0, 0]], 'line', [[0, 0, 0], [0, 0]], [[0, 0, 0], [20, 0, 0]]]) }),
-    () => JSON.stringify({ type: 'set_centerline', points: Array.from({ length: 2001 + int(100) }, (_, k) => [0.4, k * 1e-4, 0.3]) }),
-    () => JSON.stringify({ type: 'set_paused', paused: pick([1, 0, 'true', null, [], undefined]) }),
-    () => JSON.stringify({ type: 'set_joint', joint: pick([jointCount, -1, 'no_such_joint', 0.5, null]), value: 0 }),
-    () => JSON.stringify({ type: 'set_joint', joint: int(jointCount), value: pick([100, -100, 1e400, 'x', null]) }),
-    () => JSON.stringify({ type: 'set_joints', joints: pick([[], Array(jointCount + 1).fill(0), Array(jointCount).fill('x'), Array(jointCount).fill(50)]) }),
-    () => JSON.stringify({ type: 'load_scene', scene: pick(['../../etc/passwd', '/etc/passwd', '', 'nope.json', 'yumi_bar.json/..', 7]) }),
-    () => JSON.stringify({ type: pick(['arm', 'disarm']) }),  // no robot link in this session
+    () => JSON.stringify({ type: Command.SetTarget, id: int(1e6), node: pick(badNumbers), position: [0.4, 0, 0.3] }),
+    () => JSON.stringify({ type: Command.SetTarget, node: int(nodeCount), position: pick(badPoints) }),
+    () => `{"type":"${Command.SetTarget}","node":${int(nodeCount)},"position":[1e400,0,0]}`,
+    () => JSON.stringify({ type: Command.SetTarget, node: int(nodeCount) }),
+    () => JSON.stringify({ type: Command.RemoveTarget, node: pick(badNumbers) }),
+    () => JSON.stringify({ type: Command.SetTargets, targets: pick([null, {}, 'all', [{ node: 0 }], [{ node: 0, position: [0, 0, 0] }, { node: 0, position: [0, 0, 0] }]]) }),
+    () => JSON.stringify({ type: Command.SetTargets, targets: Array.from({ length: nodeCount + 1 }, (_, k) => ({ node: k, position: [0, 0, 0] })) }),
+    () => JSON.stringify({ type: Command.SetCenterline, points: pick([[], [[0, 0, 0]], 'line', [[0, 0, 0], [0, 0]], [[0, 0, 0], [20, 0, 0]]]) }),
+    () => JSON.stringify({ type: Command.SetCenterline, points: Array.from({ length: 2001 + int(100) }, (_, k) => [0.4, k * 1e-4, 0.3]) }),
+    () => JSON.stringify({ type: Command.SetPaused, paused: pick([1, 0, 'true', null, [], undefined]) }),
+    () => JSON.stringify({ type: Command.SetJoint, joint: pick([jointCount, -1, 'no_such_joint', 0.5, null]), value: 0 }),
+    () => JSON.stringify({ type: Command.SetJoint, joint: int(jointCount), value: pick([100, -100, 1e400, 'x', null]) }),
+    () => JSON.stringify({ type: Command.SetJoints, joints: pick([[], Array(jointCount + 1).fill(0), Array(jointCount).fill('x'), Array(jointCount).fill(50)]) }),
+    () => JSON.stringify({ type: Command.LoadScene, scene: pick(['../../etc/passwd', '/etc/passwd', '', 'nope.json', 'yumi_bar.json/..', 7]) }),
+    () => JSON.stringify({ type: pick([Command.Arm, Command.Disarm]) }),  // no robot link in this session
   ];
   return Array.from({ length: count }, () => pick(generators)());
 }
@@ -67,7 +70,7 @@ describe('WebSocket fuzz', () => {
   before(async () => {
     server = await startServer([]);
     watcher = await RawWebSocket.connect(server.port);
-    scene = JSON.parse((await watcher.next((m) => m.text?.includes('"type":"scene"'))).text);
+    scene = JSON.parse((await watcher.next((m) => m.text?.includes(`"type":"${Message.Scene}"`))).text);
   });
 
   after(async () => {
@@ -77,16 +80,16 @@ describe('WebSocket fuzz', () => {
 
   it('answers every bad message with one error and changes nothing', async () => {
     // A session with a target being worked on.
-    watcher.sendJson({ type: 'set_target', id: 'setup', node: 10, position: [0.4, 0.05, 0.3] });
+    watcher.sendJson({ type: Command.SetTarget, id: 'setup', node: 10, position: [0.4, 0.05, 0.3] });
     await watcher.next((m) => m.text?.includes('"id":"setup"'));
-    const latest = () => watcher.json((m) => m.type === 'state').pop();
+    const latest = () => watcher.json((m) => m.type === Message.State).pop();
     await waitFor(() => latest()?.targets.length === 1, 'the target in the state');
     const reference = latest();
 
     const fuzzer = await RawWebSocket.connect(server.port);
     const messages = badMessages(3000, scene.node_count, scene.robot.joint_names.length, rng(20260517));
     let sent = 0;
-    const replies = () => fuzzer.json((m) => m.type === 'ok' || m.type === 'error');
+    const replies = () => fuzzer.json((m) => m.type === Message.Ok || m.type === Message.Error);
     for (let batch = 0; batch < messages.length; batch += 100) {
       for (const text of messages.slice(batch, batch + 100)) { fuzzer.sendText(text); sent++; }
       if (batch % 500 === 0) { fuzzer.sendFrame(2, Buffer.from([1, 2, 3])); sent++; }  // binary
@@ -95,13 +98,13 @@ describe('WebSocket fuzz', () => {
     }
     const all = replies();
     assert.equal(all.length, sent, 'exactly one reply per message');
-    const accepted = all.filter((r) => r.type === 'ok');
+    const accepted = all.filter((r) => r.type === Message.Ok);
     assert.deepEqual(accepted, [], 'no fuzz message was accepted');
     assert.ok(all.every((r) => typeof r.message === 'string' && r.message.startsWith('message')), 'every error says what was wrong');
 
     // The session is as it was: same scene, same target, not paused; states still stream.
     const count = watcher.messages.length;
-    await watcher.next((m) => m.text?.includes('"type":"state"'), 5000, count);
+    await watcher.next((m) => m.text?.includes(`"type":"${Message.State}"`), 5000, count);
     const after = latest();
     assert.equal(after.scene, reference.scene);
     assert.equal(after.paused, false);
@@ -117,9 +120,9 @@ describe('WebSocket fuzz', () => {
     const abuses = [
       (ws) => ws.sendText('x'.repeat(1024 * 1024 + 10)),                      // over the size limit
       (ws) => ws.sendFrame(1, Buffer.from([0xff, 0xfe, 0x80])),               // invalid UTF-8
-      (ws) => ws.sendFrame(1, '{"type":"ping"}', { mask: false }),            // unmasked
+      (ws) => ws.sendFrame(1, PING, { mask: false }),                          // unmasked
       (ws) => ws.sendFrame(3, 'x'),                                            // reserved opcode
-      (ws) => ws.sendFrame(1, '{"type":"ping"}', { rsv: 4 }),                 // reserved bits
+      (ws) => ws.sendFrame(1, PING, { rsv: 4 }),                               // reserved bits
       (ws) => ws.sendFrame(0, 'x'),                                            // continuation of nothing
       (ws) => ws.socket.write(Buffer.from([0x81, 0xff, 0x7f, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 1, 2, 3, 4])),  // absurd length
       (ws) => ws.socket.write('GET / HTTP/1.1\r\n\r\n'),                     // HTTP inside the WebSocket
@@ -147,11 +150,11 @@ describe('WebSocket fuzz', () => {
 
     // Everyone else is unaffected: the watcher still gets states and can still command.
     const count = watcher.messages.length;
-    await watcher.next((m) => m.text?.includes('"type":"state"'), 5000, count);
-    watcher.sendJson({ type: 'ping', id: 'still-there' });
-    await watcher.next((m) => m.text?.includes('"id":"still-there"') && m.text.includes('"ok"'));
+    await watcher.next((m) => m.text?.includes(`"type":"${Message.State}"`), 5000, count);
+    watcher.sendJson({ type: Command.Ping, id: 'still-there' });
+    await watcher.next((m) => m.text?.includes('"id":"still-there"') && m.text.includes(`"${Message.Ok}"`));
     const fresh = await RawWebSocket.connect(server.port);
-    await fresh.next((m) => m.text?.includes('"type":"scene"'));
+    await fresh.next((m) => m.text?.includes(`"type":"${Message.Scene}"`));
     fresh.close();
     assert.ok(server.alive());
   });

@@ -3,21 +3,26 @@
 import { Connection } from './connection.js';
 import { View3D } from './view3d.js';
 import { ConvergencePlot } from './plot.js';
+import { Command, ControllerStatus } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
+// Badge style per controller status; the others are plain.
+const STATUS_BADGE = {
+  [ControllerStatus.Converged]: 'ok', [ControllerStatus.Optimizing]: 'busy', [ControllerStatus.Stuck]: 'bad',
+};
 
 const page = {
   scene: null,       // the last "scene" message
   state: null,       // the last "state" message
-  positionsSeq: -1,  // sequence of the last positions frame
+  sliders: [],       // per joint: {slider, row, value, mark, lo, hi}
   stats: { states: 0, positions: 0, errors: [], editingStates: 0, stateTimes: [] },
 };
 
 const view = new View3D($('view'), {
-  addTarget: (node, position) => command('set_target', { node, position }),
-  moveTarget: (node, position) => command('set_target', { node, position }),
-  sketch: (points) => command('set_centerline', { points }).then(() => setSketchMode(false)),
+  addTarget: (node, position) => command(Command.SetTarget, { node, position }),
+  moveTarget: (node, position) => command(Command.SetTarget, { node, position }),
+  sketch: (points) => command(Command.SetCenterline, { points }).then(() => setSketchMode(false)),
   select: (node) => { $('delete').disabled = node === null; },
 });
 const plot = new ConvergencePlot($('plot'));
@@ -28,7 +33,6 @@ const connection = new Connection(`ws://${location.host}/ws`, {
   scene: onScene,
   state: onState,
   positions: (frame) => {
-    page.positionsSeq = frame.sequence;
     page.stats.positions++;
     if (page.scene && frame.positions.length === 3 * page.scene.node_count) view.setPositions(frame.positions);
   },
@@ -87,7 +91,7 @@ function buildJointSliders(robot) {
     slider.addEventListener('blur', () => { slider.dragging = false; });
     slider.addEventListener('input', () => {
       slider.editedAt = performance.now();
-      command('set_joint', { joint: k, value: Number(slider.value) });
+      command(Command.SetJoint, { joint: k, value: Number(slider.value) });
     });
     box.appendChild(row);
     page.sliders.push({ slider, row, value: row.querySelector('.value'), mark: row.querySelector('.limit i'), lo, hi });
@@ -105,8 +109,7 @@ function onState(state) {
   plot.add(state.time, state.error.mean, state.editing);
   drawPlot();
 
-  const kind = { converged: 'ok', optimizing: 'busy', stuck: 'bad', paused: '', idle: '' }[state.status];
-  setBadge('status', state.status, kind);
+  setBadge('status', state.status, STATUS_BADGE[state.status]);
   const mm = (v) => (v === null ? '–' : (1000 * v).toFixed(2));
   $('error-mean').textContent = state.targets.length ? mm(state.error.mean) : '–';
   $('error-max').textContent = state.targets.length ? mm(state.error.max) : '–';
@@ -118,7 +121,7 @@ function onState(state) {
   $('pause').classList.toggle('active', state.paused);
   $('jog-hint').textContent = state.paused ? '(drag to jog)' : '(pause to jog)';
 
-  (page.sliders ?? []).forEach((s, k) => {
+  page.sliders.forEach((s, k) => {
     const v = state.joints[k];
     s.slider.disabled = !state.paused;
     // Don't fight the user's hand: a slider being moved keeps its own value.
@@ -152,22 +155,22 @@ function setSketchMode(on) {
 
 function deleteSelected() {
   if (view.selected === null) return;
-  command('remove_target', { node: view.selected });
+  command(Command.RemoveTarget, { node: view.selected });
   view.select(null);
 }
 
-$('pause').onclick = () => command('set_paused', { paused: !page.state?.paused });
-$('reset').onclick = () => command('reset');
-$('clear').onclick = () => { command('clear_targets'); view.select(null); };
+$('pause').onclick = () => command(Command.SetPaused, { paused: !page.state?.paused });
+$('reset').onclick = () => command(Command.Reset);
+$('clear').onclick = () => { command(Command.ClearTargets); view.select(null); };
 $('delete').onclick = deleteSelected;
 $('sketch').onclick = () => setSketchMode(!view.sketchMode);
 $('face-bar').onclick = () => { if (page.scene?.bar) view.faceBar(page.scene.bar.direction); };
 $('show-wireframe').onchange = (e) => view.setWireframe(e.target.checked);
 $('show-spheres').onchange = (e) => view.setSpheresVisible(e.target.checked);
 $('show-robot').onchange = (e) => view.setRobotVisible(e.target.checked);
-$('scene-select').onchange = (e) => command('load_scene', { scene: e.target.value });
-$('arm').onclick = () => command('arm');
-$('disarm').onclick = () => command('disarm');
+$('scene-select').onchange = (e) => command(Command.LoadScene, { scene: e.target.value });
+$('arm').onclick = () => command(Command.Arm);
+$('disarm').onclick = () => command(Command.Disarm);
 window.addEventListener('keydown', (e) => {
   if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
   if (e.key === 'Delete' || e.key === 'Backspace') deleteSelected();
@@ -182,7 +185,7 @@ window.shapectl = {
   get state() { return page.state; },
   get stats() { return page.stats; },
   get ready() { return !!(page.scene && page.state && view.positions && view.frames > 2); },
-  get arrowCount() { return view.arrowCount ?? 0; },
+  get arrowCount() { return view.arrowCount; },
   get selected() { return view.selected; },
   nodePosition: (node) => view.nodePosition(node).toArray(),
   positions: () => Array.from(view.positions ?? []),
@@ -190,5 +193,5 @@ window.shapectl = {
   nodeToPage: (node) => view.worldToPage(view.nodePosition(node).toArray()),
   setLayers: ({ robot = true, object = true } = {}) => { view.setRobotVisible(robot); view.setObjectVisible(object); view.render(); },
   objectCentroid: () => view.objectCentroid().toArray(),
-  cameraDirection: () => { const d = view.camera.getWorldDirection(new (view.camera.position.constructor)()); return d.toArray(); },
+  cameraDirection: () => view.cameraDirection(),
 };

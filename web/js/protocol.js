@@ -1,0 +1,53 @@
+// Every name that goes over the WebSocket to `shapectl serve` (docs/gui.md), in one place for
+// the page and its tests: compare against these, never against a string literal. They must
+// match the server's names (src/shapectl/server/, control/controller.cpp, link/).
+
+// Commands, client → server (the order of the server's list; the fuzz test picks by index).
+export const Command = Object.freeze({
+  Ping: 'ping',
+  SetTarget: 'set_target',
+  RemoveTarget: 'remove_target',
+  SetTargets: 'set_targets',
+  ClearTargets: 'clear_targets',
+  SetCenterline: 'set_centerline',
+  SetPaused: 'set_paused',
+  SetJoint: 'set_joint',
+  SetJoints: 'set_joints',
+  Reset: 'reset',
+  LoadScene: 'load_scene',
+  Arm: 'arm',
+  Disarm: 'disarm',
+});
+
+// Text messages, server → client: a reply to a command (to its sender) or a broadcast.
+export const Message = Object.freeze({
+  Ok: 'ok',
+  Error: 'error',
+  Scene: 'scene',
+  State: 'state',
+});
+
+// A state's "status": what the optimizer is doing.
+export const ControllerStatus = Object.freeze({
+  Idle: 'idle',  // no targets
+  Optimizing: 'optimizing',
+  Converged: 'converged',
+  Stuck: 'stuck',
+  Paused: 'paused',
+});
+
+// A state's "link.kind", and the `serve --robot` value that chooses it.
+export const LinkKind = Object.freeze({
+  Sim: 'sim',
+  Egm: 'egm',
+});
+
+// A robot visual's "kind" in the scene message.
+export const ShapeKind = Object.freeze({
+  Sphere: 'sphere',
+  Box: 'box',
+  Cylinder: 'cylinder',
+});
+
+// The first four bytes of a binary positions frame.
+export const POSITIONS_MAGIC = 'POS1';
