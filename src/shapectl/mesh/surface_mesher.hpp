@@ -1,12 +1,11 @@
 #pragma once
-// Tetrahedralizes a closed triangle surface (OBJ, STL or OFF) with TetGen.
-#include <array>
+// Tetrahedralizes a closed triangle surface (OBJ, STL or OFF) with TetGen: checks the surface
+// and the options, runs TetGen (tetgen_runner.hpp), checks what it made.
 #include <filesystem>
 #include <string>
-#include <vector>
 
+#include <shapectl/mesh/surface_reader.hpp>  // read_surface, is_surface_file, TriangleSurface
 #include <shapectl/mesh/tet_mesh.hpp>
-#include <shapectl/types.hpp>
 
 namespace shapectl {
 
@@ -22,20 +21,6 @@ struct SurfaceMeshOptions {
   std::string origin_file = "";
   std::string origin_path = "";
 };
-
-struct TriangleSurface {
-  std::vector<Vec3> vertices;                 // metres
-  std::vector<std::array<int, 3>> triangles;  // indices into vertices
-};
-
-// True for the surface formats read_surface reads (.obj, .stl, .off, in any letter case).
-bool is_surface_file(const std::filesystem::path& file);
-
-// Reads a triangle surface by extension: .obj (v/f lines; polygons fan-triangulated; f 1/2/3,
-// f 1//3 and negative indices), .stl (ASCII or binary) or .off. Vertices with identical
-// coordinates are merged into the first; vertices no face uses are dropped; the rest keep the
-// file's order. Throws InputError naming the file and line.
-TriangleSurface read_surface(const std::filesystem::path& file);
 
 // Tetrahedralizes a closed surface. Node order: the surface vertices first, in order, then the
 // points TetGen added. Throws InputError naming `source` if the surface is not closed (every edge
