@@ -54,11 +54,12 @@ BENCHMARK(BM_StaticsFullSolve)->Unit(benchmark::kMillisecond);
 void BM_StaticsSolveFromRest(benchmark::State& state) {
   Scene scene = clamped_bar({16, 4, 4});
   ObjectStatics statics(scene);
-  statics.solver().set_chord_steps(false);
+  StaticsWorkspace ws = statics.make_workspace();
   int iterations = 0;
   for (auto _ : state) {
     Positions x = scene.world_rest_positions();
-    const StaticsResult r = statics.solve(x);
+    ws.forget_factor();  // the analysis stays
+    const StaticsResult r = statics.solve(ws, x);
     if (!r.converged()) state.SkipWithError(r.reason.c_str());
     iterations = r.iterations;
   }
@@ -69,8 +70,9 @@ BENCHMARK(BM_StaticsSolveFromRest)->Unit(benchmark::kMillisecond);
 void BM_StaticsWarmResolve(benchmark::State& state) {
   const Scene scene = clamped_bar({16, 4, 4});
   ObjectStatics statics(scene);
+  StaticsWorkspace ws = statics.make_workspace();
   Positions x = scene.world_rest_positions();
-  if (!statics.solve(x).converged()) state.SkipWithError("initial solve failed");
+  if (!statics.solve(ws, x).converged()) state.SkipWithError("initial solve failed");
   // Nodes of the +x clamp: move them 1 mm along x and back, alternately.
   std::vector<int> clamp;
   for (int i = 0; i < statics.mesh().node_count(); ++i)
@@ -80,7 +82,7 @@ void BM_StaticsWarmResolve(benchmark::State& state) {
   for (auto _ : state) {
     for (int i : clamp) x[3 * i] += direction * 1e-3;
     direction = -direction;
-    const StaticsResult r = statics.solve(x);
+    const StaticsResult r = statics.solve(ws, x, nullptr, 0, &ws);  // chord steps with the last factor
     if (!r.converged()) state.SkipWithError(r.reason.c_str());
     iterations = r.iterations;
   }
@@ -117,7 +119,7 @@ void factorize(benchmark::State& state, SparseCholesky::Backend backend, int rhs
   ObjectStatics statics(scene);
   Positions x = scene.world_rest_positions();
   if (!statics.solve(x).converged()) state.SkipWithError("statics failed");
-  const SparseMatrix H = statics.solver().hessian(x);
+  const SparseMatrix H = statics.hessian(x);
   SparseCholesky cholesky(backend);
   cholesky.analyze(H);
   if (!cholesky.factorize(H)) state.SkipWithError("not positive definite");

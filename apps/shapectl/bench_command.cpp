@@ -34,7 +34,7 @@ struct BenchArgs {
 };
 
 // A safe, reachable goal: random joints near the reference, its equilibrium, some of its nodes.
-bool random_goal(ReducedObjective& objective, const Evaluation& reference, std::mt19937& rng,
+bool random_goal(const ReducedObjective& objective, const Evaluation& reference, std::mt19937& rng,
                  ShapeTargets& targets) {
   std::uniform_real_distribution<double> u(-0.15, 0.15);
   Eigen::VectorXd theta = reference.joints;
@@ -76,7 +76,6 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
   for (int trial = 0; trial < args.trials; ++trial) {
     ShapeTargets targets;
     if (!random_goal(objective, reference, rng, targets)) continue;
-    objective.set_targets(targets);
     std::uniform_real_distribution<double> u(-0.1, 0.1);
     Eigen::VectorXd theta = reference.joints;
     for (int j = 0; j < theta.size(); ++j) theta[j] += u(rng);
@@ -88,16 +87,15 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
           std::tuple{GradientMethod::Adjoint, &t_adj_factored, Factor::Counted},
           std::tuple{GradientMethod::FiniteDifference, &t_fd_chord, Factor::ChordResolves},
           std::tuple{GradientMethod::FiniteDifference, &t_fd_newton, Factor::NewtonResolves}}) {
-      Evaluation fresh = objective.evaluate(theta, reference.positions);
-      if (factor == Factor::Reused && !objective.confirm_stable(fresh)) break;
-      objective.stale_factor_step = factor == Factor::Counted ? 0.0 : 1e-6;
-      object.statics().solver().set_chord_steps(factor != Factor::NewtonResolves);
+      const ReducedObjective variant(object, targets,
+                                     {.stale_factor_step = factor == Factor::Counted ? 0.0 : 1e-6,
+                                      .chord_steps = factor != Factor::NewtonResolves});
+      Evaluation fresh = variant.evaluate(theta, reference.positions);
+      if (factor == Factor::Reused && !variant.confirm_stable(fresh)) break;
       const auto t0 = Clock::now();
-      objective.gradient(fresh, method);
+      variant.gradient(fresh, method);
       times->push_back(seconds(t0, Clock::now()));
     }
-    objective.stale_factor_step = 1e-6;
-    object.statics().solver().set_chord_steps(true);
   }
   const double fd = percentile(t_fd_newton, 0.5);
   auto row = [&](const char* name, const std::vector<double>& t) {
@@ -120,14 +118,14 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
     for (int trial = 0; trial < args.trials; ++trial) {
       ShapeTargets targets;
       if (!random_goal(objective, reference, goals, targets)) continue;
-      objective.set_targets(targets);
+      const ReducedObjective goal = objective.with_targets(targets);
       Evaluation current = reference;
-      objective.rescore(current);
+      goal.rescore(current);
       auto optimizer = make_optimizer(kind, GradientMethod::Sensitivity);
       const auto t0 = Clock::now();
       int it = 0;
       while (current.error.mean >= 1e-3 && it < 200 && seconds(t0, Clock::now()) < 10) {
-        if (optimizer->step(objective, current) != StepOutcome::Improved) break;
+        if (optimizer->step(goal, current) != StepOutcome::Improved) break;
         ++it;
       }
       if (current.error.mean < 1e-3) {
@@ -156,12 +154,12 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
       squeeze.nodes.push_back(i);
       squeeze.positions.push_back(x0.segment<3>(3 * i) + (e == 0 ? inward : Vec3(-inward)));
     }
-  objective.set_targets(squeeze);
+  const ReducedObjective buckle = objective.with_targets(squeeze);
   Evaluation current = reference;
-  objective.rescore(current);
+  buckle.rescore(current);
   GaussNewton optimizer;
   const auto t0 = Clock::now();
-  const OptimizeResult r = optimize(objective, optimizer, current, {.max_iterations = 100, .max_seconds = 20});
+  const OptimizeResult r = optimize(buckle, optimizer, current, {.max_iterations = 100, .max_seconds = 20});
   double to_1mm = NAN;
   for (const auto& h : r.history)
     if (h.error_mean < 1e-3) {

@@ -49,8 +49,7 @@ void run_solve(const SolveArgs& args) {
   if (!scene.robot) throw InputError(args.scene, "robot", "a robot to optimize (missing key)");
   GrippedObject object(scene);
   const TargetsInput input = load_targets(args.targets, object.node_count());
-  ReducedObjective objective(object);
-  objective.set_targets(resolve_targets(input, args.targets, object));
+  const ReducedObjective objective(object, resolve_targets(input, args.targets, object));
 
   const OptimizerKind kind = args.optimizer == "lbfgs" ? OptimizerKind::Lbfgs : OptimizerKind::GaussNewton;
   const GradientMethod gradient = args.gradient == "adjoint"             ? GradientMethod::Adjoint
@@ -89,7 +88,7 @@ void run_solve(const SolveArgs& args) {
   for (const auto& h : result.history)
     out["history"].push_back({{"iteration", h.iteration}, {"time", h.time}, {"error_mean", h.error_mean},
                               {"objective", h.objective}});
-  const ObjectiveTiming& t = objective.timing();
+  const ObjectiveTiming t = objective.timing();
   out["timing"] = {{"statics_solves", t.statics_solves}, {"statics_seconds", t.statics_seconds},
                    {"gradient_evaluations", t.gradient_evaluations}, {"gradient_seconds", t.gradient_seconds}};
   require_finite(out, "solve", result.reason);

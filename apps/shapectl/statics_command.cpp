@@ -63,8 +63,8 @@ void run_statics(const StaticsArgs& args) {
   GrippedObject object(scene);
   Eigen::VectorXd joints = object.reference_joints();
   if (!args.joints.empty()) joints = load_joints_file(args.joints, object.robot(), joints);
-  const StaticsResult r = object.solve(joints, x);
-  write_outputs(args, r, object.mesh(), rest, x, robot_json(scene, joints));
+  const ObjectState state = object.solve_from(joints, x);
+  write_outputs(args, state.statics(), object.mesh(), rest, state.positions(), robot_json(scene, joints));
 }
 
 }  // namespace

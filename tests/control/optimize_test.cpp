@@ -52,7 +52,7 @@ TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
     for (int j = 0; j < goal.size(); ++j) goal[j] += u(rng);
     const Evaluation at_goal = objective.evaluate(goal, object.reference_positions());
     ASSERT_TRUE(at_goal.statics.converged());
-    objective.set_targets(targets_from_shape(at_goal.positions, 10 + seed * 5, rng));
+    objective = objective.with_targets(targets_from_shape(at_goal.positions, 10 + seed * 5, rng));
 
     const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
     ASSERT_GT(start.error.mean, 3e-3) << "the targets should be a real change";
@@ -69,7 +69,7 @@ TEST_P(OptimizeTest, TargetsThroughEachOtherEndSafe) {
   GrippedObject object(scene);
   ReducedObjective objective(object);
   const Positions x0 = object.reference_positions();
-  objective.set_targets(grips_swapped(scene, x0, 0.4));
+  objective = objective.with_targets(grips_swapped(scene, x0, 0.4));
   const Evaluation start = objective.evaluate(object.reference_joints(), x0);
   ASSERT_TRUE(start.safe());
   auto optimizer = make_optimizer(GetParam(), GradientMethod::Adjoint);
@@ -88,7 +88,7 @@ TEST_P(OptimizeTest, UnreachableTargetsGiveAnHonestBestEffort) {
   ShapeTargets t;
   t.nodes = {0, 10, 20};
   t.positions = {Vec3(5, 5, 5), Vec3(5, 5, 6), Vec3(-5, 5, 5)};
-  objective.set_targets(t);
+  objective = objective.with_targets(t);
   const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
   auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
   const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 60});
@@ -111,7 +111,7 @@ TEST_P(OptimizeTest, NonFiniteObjectiveNeitherCrashesNorConverges) {
     ShapeTargets t;
     t.nodes = {0, 10, 20};
     t.positions = {Vec3(1000, 0, 0), Vec3(0, -1000, 0), Vec3(0, 0, 1000)};
-    objective.set_targets(t);
+    objective = objective.with_targets(t);
     const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
     ASSERT_TRUE(start.statics.converged());
     ASSERT_FALSE(std::isfinite(start.objective)) << "the test needs a non-finite objective";
@@ -140,13 +140,13 @@ TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
   goal << 0.2, -0.5, 1.2, -0.2, -0.1, 0.7;
   const Evaluation at_goal = objective.evaluate(goal, object.reference_positions());
   ASSERT_TRUE(at_goal.statics.converged());
-  objective.set_targets(targets_from_shape(at_goal.positions, 12, rng));
+  objective = objective.with_targets(targets_from_shape(at_goal.positions, 12, rng));
   const ShapeTargets targets = objective.targets();
   // Each run from scratch, so every run takes the same path until its budget runs out.
   auto run = [&](double max_seconds, double* work_done) {
     GrippedObject fresh_object(scene);
     ReducedObjective fresh(fresh_object);
-    fresh.set_targets(targets);
+    fresh = fresh.with_targets(targets);
     const Evaluation start = fresh.evaluate(fresh_object.reference_joints(), fresh_object.reference_positions());
     const ObjectiveTiming before = fresh.timing();
     auto work = [&] {
@@ -205,7 +205,7 @@ TEST_F(YumiBar, ReachableTargetsAreReachedOverSeveralSeeds) {
     const Evaluation at_goal = objective.evaluate(goal, reference.positions);
     if (!at_goal.safe()) continue;  // only collision-free, in-limit goals are reachable
     ++tried;
-    objective.set_targets(targets_from_shape(at_goal.positions, 10 + 7 * tried, rng));
+    objective = objective.with_targets(targets_from_shape(at_goal.positions, 10 + 7 * tried, rng));
     Evaluation start = reference;
     objective.rescore(start);
     GaussNewton optimizer;
@@ -219,7 +219,7 @@ TEST_F(YumiBar, TargetsPullingTheGrippersThroughEachOtherEndCollisionFree) {
   GrippedObject object(scene);
   ReducedObjective objective(object);
   const Positions x0 = object.reference_positions();
-  objective.set_targets(grips_swapped(scene, x0, 0.45));
+  objective = objective.with_targets(grips_swapped(scene, x0, 0.45));
   const Evaluation start = objective.evaluate(object.reference_joints(), x0);
   ASSERT_TRUE(start.safe());
   GaussNewton optimizer;

@@ -28,11 +28,10 @@ TEST(ReducedObjective, GradientAgreesAllThreeWaysWithCentralDifferences) {
   Scene scene = test::two_arm_scene();
   scene.statics.relative_tolerance = 1e-11;
   GrippedObject object(scene);
-  ReducedObjective objective(object);
-  objective.stale_factor_step = 0;  // exact sensitivities for this comparison
-  objective.finite_difference_step = 1e-6;
   std::mt19937 rng(11);
-  objective.set_targets(some_targets(object, rng));
+  // Exact sensitivities for this comparison.
+  const ReducedObjective objective(object, some_targets(object, rng),
+                                   {.finite_difference_step = 1e-6, .stale_factor_step = 0});
   std::uniform_real_distribution<double> u(-0.2, 0.2);
   for (int trial = 0; trial < 3; ++trial) {
     Eigen::VectorXd theta = object.reference_joints();
@@ -64,10 +63,8 @@ TEST(ReducedObjective, LeastSquaresFormMatchesObjectiveAndGradient) {
   Scene scene = test::two_arm_scene();
   scene.statics.relative_tolerance = 1e-11;
   GrippedObject object(scene);
-  ReducedObjective objective(object);
-  objective.stale_factor_step = 0;
   std::mt19937 rng(12);
-  objective.set_targets(some_targets(object, rng));
+  const ReducedObjective objective(object, some_targets(object, rng), {.stale_factor_step = 0});
   Eigen::VectorXd theta = object.reference_joints();
   theta[4] = -1.97;  // near the lower limit
   const Evaluation at = objective.evaluate(theta, object.reference_positions());
@@ -108,6 +105,7 @@ TEST(ReducedObjective, ConfirmStableRejectsAStateWhoseHessianIsIndefinite) {
     const Vec3 p = squeezed.positions.segment<3>(3 * i);
     squeezed.positions.segment<3>(3 * i) = p - 0.1 * axis.dot(p - centre) * axis;
   }
+  squeezed.state = std::make_shared<ObjectState>(object.make_state(held.joints, squeezed.positions));
   EXPECT_FALSE(objective.confirm_stable(squeezed));
   EXPECT_EQ(squeezed.statics.status, StaticsStatus::Unstable);
   EXPECT_FALSE(std::isfinite(squeezed.objective));
@@ -120,7 +118,7 @@ TEST(ReducedObjective, AbsurdTargetsAreRefusedNamingTheTargetAndChangeNothing) {
   ShapeTargets good;
   good.nodes = {0, 5};
   good.positions = {Vec3(0.1, 0, 0.2), Vec3(0.2, 0, 0.2)};
-  objective.set_targets(good);
+  objective = objective.with_targets(good);
   const std::vector<std::pair<ShapeTargets, std::string>> bad = {
       {{{0, 5}, {Vec3(0, 0, 0), Vec3(1e155, 0, 0)}},
        "targets: targets[1].position: expected a finite point within 1000 m of the origin, got [1e+155, 0, 0]"},
@@ -132,7 +130,7 @@ TEST(ReducedObjective, AbsurdTargetsAreRefusedNamingTheTargetAndChangeNothing) {
       {{{0, 1}, {Vec3(0, 0, 0)}}, "targets: expected as many positions as nodes"}};
   for (const auto& [targets, message] : bad) {
     try {
-      objective.set_targets(targets);
+      objective = objective.with_targets(targets);
       ADD_FAILURE() << "accepted: " << message;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
@@ -140,7 +138,7 @@ TEST(ReducedObjective, AbsurdTargetsAreRefusedNamingTheTargetAndChangeNothing) {
     EXPECT_EQ(objective.targets().nodes, good.nodes);
   }
   // The bound itself is a valid target.
-  objective.set_targets({{0}, {Vec3(-1000, 1000, 0)}});
+  objective = objective.with_targets({{0}, {Vec3(-1000, 1000, 0)}});
   EXPECT_EQ(objective.targets().size(), 1);
 }
 

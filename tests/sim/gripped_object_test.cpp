@@ -21,9 +21,9 @@ TEST(GripSprings, DerivativesMatchCentralDifferences) {
   const Scene scene = test::two_arm_scene();
   GrippedObject object(scene);
   std::mt19937 rng(1);
-  Positions x = object.reference_positions();
-  object.solve(random_joints(object, 0.2, rng), x);
-  test::expect_derivatives_match(object.grips(), test::perturbed(x, 0.002, rng), 1e-6);
+  const ObjectState state = object.solve_from(random_joints(object, 0.2, rng), object.reference_positions());
+  const GripEnergy grip(object.grips(), state.kinematics());
+  test::expect_derivatives_match(grip, test::perturbed(state.positions(), 0.002, rng), 1e-6);
 }
 
 TEST(GripSprings, ForceJacobianMatchesCentralDifferencesInJoints) {
@@ -33,17 +33,15 @@ TEST(GripSprings, ForceJacobianMatchesCentralDifferencesInJoints) {
   for (int trial = 0; trial < 3; ++trial) {
     const Eigen::VectorXd theta = random_joints(object, 0.3, rng);
     const Positions x = test::perturbed(object.reference_positions(), 0.003, rng);
-    Positions unused = x;
-    object.solve(theta, unused);  // sets the robot state for θ
-    const Eigen::MatrixXd dF = object.grips().force_jacobian(object.node_count());
+    const KinematicsState kinematics = forward_kinematics(object.robot(), theta);
+    const Eigen::MatrixXd dF = object.grips().force_jacobian(kinematics, object.node_count());
     Eigen::MatrixXd dF_fd(dF.rows(), dF.cols());
     const double h = 1e-6;
     for (int j = 0; j < theta.size(); ++j) {
       auto force = [&](double dt) {
         Eigen::VectorXd t = theta;
         t[j] += dt;
-        GripSprings springs = object.grips();
-        springs.set_robot_state(forward_kinematics(object.robot(), t));
+        const GripEnergy springs(object.grips(), forward_kinematics(object.robot(), t));
         Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
         springs.add_gradient(x, g);
         return Eigen::VectorXd(-g);
@@ -53,7 +51,7 @@ TEST(GripSprings, ForceJacobianMatchesCentralDifferencesInJoints) {
     EXPECT_LT(test::relative_error(dF, dF_fd), 1e-6);
     // The adjoint product agrees with the explicit matrix.
     const Eigen::VectorXd lambda = test::perturbed(Eigen::VectorXd::Zero(x.size()), 1.0, rng);
-    EXPECT_LT(test::relative_error(object.grips().force_jacobian_transpose_times(lambda),
+    EXPECT_LT(test::relative_error(object.grips().force_jacobian_transpose_times(kinematics, lambda),
                                    dF.transpose() * lambda), 1e-12);
   }
 }
@@ -62,28 +60,27 @@ TEST(GrippedObject, ReferenceJointsHoldTheObjectAtItsPlacedShape) {
   Scene scene = test::two_arm_scene();
   scene.gravity = Vec3::Zero();
   GrippedObject object(scene);
-  Positions x = object.reference_positions();
-  const StaticsResult r = object.solve(object.reference_joints(), x);
-  ASSERT_TRUE(r.converged()) << r.reason;
-  EXPECT_LT((x - object.reference_positions()).cwiseAbs().maxCoeff(), 1e-9);
+  const ObjectState state = object.solve_from(object.reference_joints(), object.reference_positions());
+  ASSERT_TRUE(state.statics().converged()) << state.statics().reason;
+  EXPECT_LT((state.positions() - object.reference_positions()).cwiseAbs().maxCoeff(), 1e-9);
 }
 
 TEST(GrippedObject, CarriedGrippedNodesKeepTheirSpringLengths) {
   const Scene scene = test::two_arm_scene();
   GrippedObject object(scene);
   const Eigen::VectorXd from = object.reference_joints();
-  Positions x = object.reference_positions();
-  ASSERT_TRUE(object.solve(from, x).converged());
-  const double springs_before = object.grips().value(x);
+  const ObjectState state = object.solve_from(from, object.reference_positions());
+  ASSERT_TRUE(state.statics().converged());
+  const Positions& x = state.positions();
+  const double springs_before = GripEnergy(object.grips(), state.kinematics()).value(x);
   ASSERT_GT(springs_before, 0);  // gravity stretches them: a non-trivial check
   Eigen::VectorXd to = from;
   to << 0.3, -0.1, 0.7, -0.25, -0.45, 1.1;
   Positions carried = x;
   object.carry_gripped_nodes(from, to, x, carried);
   // A rigid motion of nodes and anchors together: every spring keeps its length.
-  Positions probe = carried;
-  object.solve(to, probe, 1);  // moves the anchors to `to` (one Newton step, result unused)
-  EXPECT_NEAR(object.grips().value(carried), springs_before, 1e-9 * springs_before);
+  const GripEnergy moved(object.grips(), forward_kinematics(object.robot(), to));
+  EXPECT_NEAR(moved.value(carried), springs_before, 1e-9 * springs_before);
   // Nodes nobody grips stay where they were.
   std::vector<char> gripped(object.node_count(), 0);
   for (const auto& g : scene.grips)
@@ -101,24 +98,24 @@ TEST(GrippedObject, SensitivityMatchesCentralDifferencesOfStatics) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 3; ++trial) {
     const Eigen::VectorXd theta = random_joints(object, 0.25, rng);
-    Positions x = object.reference_positions();
-    ASSERT_TRUE(object.solve(theta, x).converged());
-    const Eigen::MatrixXd dx = object.sensitivity(x);
+    ObjectState state = object.solve_from(theta, object.reference_positions());
+    ASSERT_TRUE(state.statics().converged());
+    const Positions x = state.positions();
+    const Eigen::MatrixXd dx = object.sensitivity(state);
     Eigen::MatrixXd dx_fd(dx.rows(), dx.cols());
     const double h = 1e-5;
     for (int j = 0; j < theta.size(); ++j) {
       Eigen::VectorXd tp = theta, tm = theta;
       tp[j] += h;
       tm[j] -= h;
-      Positions xp = x, xm = x;
-      ASSERT_TRUE(object.solve(tp, xp).converged());
-      ASSERT_TRUE(object.solve(tm, xm).converged());
-      dx_fd.col(j) = (xp - xm) / (2 * h);
+      const ObjectState sp = object.solve_from(tp, x), sm = object.solve_from(tm, x);
+      ASSERT_TRUE(sp.statics().converged());
+      ASSERT_TRUE(sm.statics().converged());
+      dx_fd.col(j) = (sp.positions() - sm.positions()) / (2 * h);
     }
     EXPECT_LT(test::relative_error(dx, dx_fd), 1e-5) << "trial " << trial;
-    ASSERT_TRUE(object.solve(theta, x).converged());
     const Eigen::VectorXd v = test::perturbed(Eigen::VectorXd::Zero(x.size()), 1.0, rng);
-    EXPECT_LT(test::relative_error(object.adjoint(x, v), dx.transpose() * v), 1e-9);
+    EXPECT_LT(test::relative_error(object.adjoint(state, v), dx.transpose() * v), 1e-9);
   }
 }
 

@@ -61,8 +61,9 @@ GrippedObject held_bar(double youngs) {
 TEST(StaticsHonesty, ExtremeMaterialOfAHeldObjectIsNotCalledUnheld) {
   // 1 mPa foam in 1e4 N/m grips: stiffnesses 16 orders apart, beyond what doubles resolve.
   GrippedObject object = held_bar(1e-3);
-  Positions x = object.reference_positions();
-  const StaticsResult r = object.solve(object.reference_joints(), x);
+  const ObjectState state = object.solve_from(object.reference_joints(), object.reference_positions());
+  const StaticsResult& r = state.statics();
+  const Positions& x = state.positions();
   ASSERT_EQ(r.status, StaticsStatus::Singular) << r.reason;
   EXPECT_EQ(r.reason.find("held"), std::string::npos) << r.reason;
   EXPECT_NE(r.reason.find("ill-conditioned"), std::string::npos) << r.reason;
@@ -74,8 +75,9 @@ TEST(StaticsHonesty, HeldObjectWithoutGripsStillSaysNothingHoldsIt) {
   Scene scene = test::two_arm_scene({12, 2, 2});
   scene.grips.clear();
   GrippedObject object(scene);
-  Positions x = object.reference_positions();
-  const StaticsResult r = object.solve(object.reference_joints(), x);
+  const ObjectState state = object.solve_from(object.reference_joints(), object.reference_positions());
+  const StaticsResult& r = state.statics();
+  const Positions& x = state.positions();
   EXPECT_EQ(r.status, StaticsStatus::Singular);
   EXPECT_NE(r.reason.find("nothing holds"), std::string::npos) << r.reason;
 }

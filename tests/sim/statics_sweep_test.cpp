@@ -121,8 +121,9 @@ TEST(StaticsSweep, HeldBarConvergesForEveryMaterial) {
       Scene scene = test::two_arm_scene({12, 2, 2});
       scene.material = material_from_youngs(E, 0.3, rho);
       GrippedObject object(scene);
-      Positions x = object.reference_positions();
-      const StaticsResult r = object.solve(object.reference_joints(), x);
+      const ObjectState state = object.solve_from(object.reference_joints(), object.reference_positions());
+      const StaticsResult& r = state.statics();
+      const Positions& x = state.positions();
       const std::string what = "held, E " + std::to_string(E) + " Pa, density " + std::to_string(rho);
       EXPECT_TRUE(r.converged()) << what << ": " << r.reason;
       EXPECT_TRUE(x.allFinite()) << what;

@@ -28,9 +28,8 @@ TEST(Statics, ClampedBarConvergesSuperlinearly) {
   // A soft foam bar clamped at both ends sags visibly under its own weight.
   const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
   ObjectStatics statics(scene);
-  statics.solver().set_chord_steps(false);  // Newton proper: a new factorization every step
   Positions x = scene.world_rest_positions();
-  const StaticsResult r = statics.solve(x);
+  const StaticsResult r = statics.solve(x);  // from scratch: Newton proper, a factorization every step
   ASSERT_TRUE(r.converged()) << r.reason;
   EXPECT_LE(r.iterations, 12);
   ASSERT_GE(r.log.size(), 3u);
@@ -55,23 +54,24 @@ TEST(Statics, ClampedBarConvergesSuperlinearly) {
 TEST(Statics, ChordStepsSaveFactorizationsAndReachTheSameEquilibrium) {
   const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
   Positions newton_x = scene.world_rest_positions(), chord_x = newton_x;
-  ObjectStatics newton(scene), chord(scene);
-  newton.solver().set_chord_steps(false);
-  ASSERT_TRUE(newton.solve(newton_x).converged());
-  ASSERT_TRUE(chord.solve(chord_x).converged());
+  const ObjectStatics statics(scene);
+  const ObjectStatics& chord = statics;
+  StaticsWorkspace newton_ws = statics.make_workspace(), chord_ws = statics.make_workspace();
+  ASSERT_TRUE(statics.solve(newton_ws, newton_x).converged());
+  ASSERT_TRUE(statics.solve(chord_ws, chord_x).converged());
   // Warm re-solves after the +x clamp moves 2 mm sideways: the case chord steps are for.
   for (int i = 0; i < chord.mesh().node_count(); ++i)
     if (chord.fixed_node()[i] && chord.mesh().rest_positions()[i].x() > 0) {
       newton_x[3 * i + 1] += 2e-3;
       chord_x[3 * i + 1] += 2e-3;
     }
-  const int newton_before = newton.solver().factorizations(), chord_before = chord.solver().factorizations();
-  const StaticsResult rn = newton.solve(newton_x), rc = chord.solve(chord_x);
+  // Newton proper forgets the earlier factorization; chord steps start with it.
+  newton_ws.forget_factor();
+  const StaticsResult rn = statics.solve(newton_ws, newton_x);
+  const StaticsResult rc = statics.solve(chord_ws, chord_x, nullptr, 0, &chord_ws);
   ASSERT_TRUE(rn.converged()) << rn.reason;
   ASSERT_TRUE(rc.converged()) << rc.reason;
-  const int newton_factorizations = newton.solver().factorizations() - newton_before;
-  const int chord_factorizations = chord.solver().factorizations() - chord_before;
-  EXPECT_LT(chord_factorizations, newton_factorizations);
+  EXPECT_LT(rc.factorizations, rn.factorizations);
   int chord_steps = 0;
   for (const auto& it : rc.log) chord_steps += it.chord;
   EXPECT_GT(chord_steps, 0);
@@ -87,16 +87,18 @@ TEST(Statics, CompressedSlenderBarIsNotPositiveDefinite) {
   // strain (4π² I / A L² ≈ 3 %), so bending modes have negative stiffness there.
   Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e5, 0.3, 40), 0.001, true);
   scene.gravity = Vec3::Zero();
-  ObjectStatics statics(scene);
+  const ObjectStatics statics(scene);
+  const StaticsSolver& solver = statics.solver();
+  StaticsWorkspace ws = statics.make_workspace();
   Positions x = scene.world_rest_positions();
-  EXPECT_TRUE(statics.solver().hessian_positive_definite(x));
+  EXPECT_TRUE(solver.factor(statics.terms(), ws, x));
   for (int i = 0; i < statics.mesh().node_count(); ++i) x[3 * i] *= 0.9;
-  EXPECT_FALSE(statics.solver().hessian_positive_definite(x));
-  EXPECT_THROW(statics.solver().solve_hessian(x, Eigen::MatrixXd::Ones(x.size(), 1)), std::runtime_error);
+  EXPECT_FALSE(solver.factor(statics.terms(), ws, x));
+  EXPECT_THROW(solver.solve_with_factor(ws, Eigen::MatrixXd::Ones(x.size(), 1)), std::runtime_error);
   // Shortened 0.1 %: far from buckling, still positive definite.
   x = scene.world_rest_positions();
   for (int i = 0; i < statics.mesh().node_count(); ++i) x[3 * i] *= 0.999;
-  EXPECT_TRUE(statics.solver().hessian_positive_definite(x));
+  EXPECT_TRUE(solver.factor(statics.terms(), ws, x));
 }
 
 TEST(Statics, WarmStartAtEquilibriumNeedsNoIteration) {

@@ -73,28 +73,29 @@ void Controller::State::validate(const ShapeTargets& t) const {
 void Controller::State::apply(Inbox in) {
   if (in.reset) {
     current = objective->evaluate(object->reference_joints(), object->reference_positions());
-    objective->set_targets({});
+    objective = std::make_unique<ReducedObjective>(objective->with_targets({}));
     centerline.clear();
     objective->rescore(current);
     optimizer->reset();
     last_error.clear();
   }
   if (in.clear) {
-    objective->set_targets({});
+    objective = std::make_unique<ReducedObjective>(objective->with_targets({}));
     centerline.clear();
   }
   if (in.targets) {
-    objective->set_targets(*in.targets);
+    objective = std::make_unique<ReducedObjective>(objective->with_targets(*in.targets));
     centerline.clear();
   }
   if (in.centerline) {
     // Checked when posted; a target the mapping still puts out of bounds (a sketch at the edge
     // of the world, the bar's offset beyond it) is refused here, not thrown out of the thread.
     try {
-      objective->set_targets(centerline_targets(object->mesh(), *bar_axis, *in.centerline, current.positions));
+      objective = std::make_unique<ReducedObjective>(objective->with_targets(
+          centerline_targets(object->mesh(), *bar_axis, *in.centerline, current.positions)));
       centerline = *in.centerline;
     } catch (const InputError& e) {
-      objective->set_targets({});
+      objective = std::make_unique<ReducedObjective>(objective->with_targets({}));
       centerline.clear();
       last_error = std::string("centre-line refused: ") + e.what();
     }
@@ -103,7 +104,7 @@ void Controller::State::apply(Inbox in) {
   if (in.jog && paused) {
     const Eigen::VectorXd theta = in.jog->cwiseMax(object->robot().lower_limits())
                                       .cwiseMin(object->robot().upper_limits());
-    Evaluation e = objective->evaluate(theta, current.positions);
+    Evaluation e = objective->evaluate(theta, current.positions, 0, &current);
     if (objective->confirm_stable(e)) {
       current = std::move(e);
       last_error.clear();

@@ -5,7 +5,7 @@
 
 namespace shapectl {
 
-OptimizeResult optimize(ReducedObjective& objective, Optimizer& optimizer, Evaluation start,
+OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer, Evaluation start,
                         const OptimizeOptions& options) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();

@@ -31,7 +31,7 @@ struct OptimizeResult {
   std::vector<HistoryEntry> history;  // entry 0 is the start
 };
 
-OptimizeResult optimize(ReducedObjective& objective, Optimizer& optimizer, Evaluation start,
+OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer, Evaluation start,
                         const OptimizeOptions& options);
 
 }  // namespace shapectl

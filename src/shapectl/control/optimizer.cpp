@@ -31,20 +31,20 @@ bool negligible(double before, double after) {
 }
 }  // namespace
 
-Evaluation evaluate_predicted(ReducedObjective& objective, const Eigen::VectorXd& joints,
-                              const Positions& warm, const Positions& predicted,
+Evaluation evaluate_predicted(const ReducedObjective& objective, const Eigen::VectorXd& joints,
+                              const Evaluation& from, const Positions& predicted,
                               const std::function<bool()>& out_of_time) {
   // A trial whose statics need many Newton steps is far outside the linear model: better
   // rejected (and the step shortened) than solved at length.
   constexpr int kTrialNewtonLimit = 25;
-  Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit);
+  Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit, &from);
   if (e.statics.status == StaticsStatus::Inverted && e.statics.iterations == 0 &&
       !(out_of_time && out_of_time()))
-    e = objective.evaluate(joints, warm, kTrialNewtonLimit);  // the prediction itself inverted
+    e = objective.evaluate(joints, from.positions, kTrialNewtonLimit, &from);  // the prediction itself inverted
   return e;
 }
 
-StepOutcome GaussNewton::step(ReducedObjective& objective, Evaluation& current) {
+StepOutcome GaussNewton::step(const ReducedObjective& objective, Evaluation& current) {
   // At an equilibrium whose objective overflowed (or is NaN) no trial can be "better" and the
   // derivatives are meaningless. (An unconverged state scores +inf by design: steps may leave it.)
   if (current.statics.converged() && !std::isfinite(current.objective)) return StepOutcome::Stuck;
@@ -74,8 +74,7 @@ StepOutcome GaussNewton::step(ReducedObjective& objective, Evaluation& current) 
     // First-order prediction of the new equilibrium, the gripped nodes carried exactly.
     Positions predicted_x = current.positions + dx * delta;
     objective.object().carry_gripped_nodes(current.joints, theta, current.positions, predicted_x);
-    Evaluation trial =
-        evaluate_predicted(objective, theta, current.positions, predicted_x, out_of_time);
+    Evaluation trial = evaluate_predicted(objective, theta, current, predicted_x, out_of_time);
     const double predicted = current.objective - 0.5 * (r + J * delta).squaredNorm();
     if (acceptable(trial, current, current.objective) && objective.confirm_stable(trial)) {
       // Gain ratio: how well the linear model predicted the decrease.
@@ -97,7 +96,7 @@ void Lbfgs::reset() {
   gradient_.resize(0);
 }
 
-StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
+StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) {
   if (current.statics.converged() && !std::isfinite(current.objective)) return StepOutcome::Stuck;  // as in GaussNewton
   if (gradient_.size() == 0 || gradient_at_ != current.joints) {
     if (budget_spent()) return StepOutcome::OutOfTime;
@@ -138,7 +137,7 @@ StepOutcome Lbfgs::step(ReducedObjective& objective, Evaluation& current) {
     const Eigen::VectorXd theta = current.joints + t * d;
     // Warm start from the current shape: carrying the gripped nodes alone (without dx̂/dθ·Δθ
     // for the rest) measured no faster for these short steps.
-    Evaluation trial = objective.evaluate(theta, current.positions, 25);
+    Evaluation trial = objective.evaluate(theta, current.positions, 25, &current);
     if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
     if (!objective.confirm_stable(trial)) continue;
     const bool tiny = negligible(current.objective, trial.objective);

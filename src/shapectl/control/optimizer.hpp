@@ -20,11 +20,13 @@ enum class StepOutcome {
 };
 const char* to_string(StepOutcome outcome);
 
+// An optimizer object is the explicit state of one run (curvature pairs, damping): step()
+// continues from the previous step of the same object, reset() forgets it.
 class Optimizer {
  public:
   virtual ~Optimizer() = default;
   virtual std::string name() const = 0;
-  virtual StepOutcome step(ReducedObjective& objective, Evaluation& current) = 0;
+  virtual StepOutcome step(const ReducedObjective& objective, Evaluation& current) = 0;
   // Forget accumulated curvature/damping, e.g. after the targets changed.
   virtual void reset() = 0;
   // Asked before every statics trial and every gradient; true ends the step there, so a budget
@@ -42,7 +44,7 @@ enum class OptimizerKind { GaussNewton, Lbfgs };
 class GaussNewton : public Optimizer {
  public:
   std::string name() const override { return "gauss-newton"; }
-  StepOutcome step(ReducedObjective& objective, Evaluation& current) override;
+  StepOutcome step(const ReducedObjective& objective, Evaluation& current) override;
   void reset() override { damping_ = kInitialDamping; }
   double max_step = 0.3;  // rad, largest joint change per trial
 
@@ -60,7 +62,7 @@ class Lbfgs : public Optimizer {
  public:
   explicit Lbfgs(GradientMethod method) : method_(method) {}
   std::string name() const override { return "lbfgs"; }
-  StepOutcome step(ReducedObjective& objective, Evaluation& current) override;
+  StepOutcome step(const ReducedObjective& objective, Evaluation& current) override;
   void reset() override;
   int memory = 8;
   double max_step = 0.2;  // rad, largest joint change of a first (unscaled) step
@@ -74,11 +76,12 @@ class Lbfgs : public Optimizer {
 
 std::unique_ptr<Optimizer> make_optimizer(OptimizerKind kind, GradientMethod gradient);
 
-// Solves statics at `joints` from `x`, trying the prediction first and falling back to the
-// plain warm start if the predicted state is inverted. The fallback is skipped (the inverted
+// Solves statics at `joints`, trying the prediction first and falling back to the plain warm
+// start (`from`'s positions) if the predicted state is inverted. The fallback is skipped (the inverted
 // evaluation returned) if `out_of_time` says the budget is spent.
-Evaluation evaluate_predicted(ReducedObjective& objective, const Eigen::VectorXd& joints,
-                              const Positions& warm, const Positions& predicted,
+// Chord steps use `from`'s factorization (the state both starts came from).
+Evaluation evaluate_predicted(const ReducedObjective& objective, const Eigen::VectorXd& joints,
+                              const Evaluation& from, const Positions& predicted,
                               const std::function<bool()>& out_of_time = {});
 
 }  // namespace shapectl

@@ -11,17 +11,41 @@ double seconds_since(Clock::time_point t0) {
 }
 }  // namespace
 
-ReducedObjective::ReducedObjective(GrippedObject& object)
-    : object_(object),
+ReducedObjective::ReducedObjective(const GrippedObject& object, ShapeTargets targets,
+                                   ObjectiveOptions options)
+    : object_(&object),
+      targets_(std::move(targets)),
+      options_(options),
       limits_(object.robot(), object.scene().robot->joint_limit_margin,
               object.scene().robot->joint_limit_stiffness),
-      weights_(object.scene().weights) {
+      weights_(object.scene().weights),
+      counters_(std::make_shared<TimingCounters>()) {
+  check_targets(targets_, object.node_count(), "targets");
   if (object.scene().robot->collisions) collisions_ = *object.scene().robot->collisions;
 }
 
-void ReducedObjective::set_targets(ShapeTargets targets) {
-  check_targets(targets, object_.node_count(), "targets");
-  targets_ = std::move(targets);
+ReducedObjective ReducedObjective::with_targets(ShapeTargets targets) const {
+  check_targets(targets, object_->node_count(), "targets");
+  ReducedObjective copy = *this;
+  copy.targets_ = std::move(targets);
+  return copy;
+}
+
+ObjectiveTiming ReducedObjective::timing() const {
+  std::lock_guard lock(counters_->mutex);
+  return counters_->timing;
+}
+
+void ReducedObjective::count_statics(double seconds) const {
+  std::lock_guard lock(counters_->mutex);
+  ++counters_->timing.statics_solves;
+  counters_->timing.statics_seconds += seconds;
+}
+
+void ReducedObjective::count_gradient(double seconds) const {
+  std::lock_guard lock(counters_->mutex);
+  ++counters_->timing.gradient_evaluations;
+  counters_->timing.gradient_seconds += seconds;
 }
 
 void ReducedObjective::score(Evaluation& e) const {
@@ -36,46 +60,39 @@ void ReducedObjective::score(Evaluation& e) const {
 
 void ReducedObjective::rescore(Evaluation& e) const { score(e); }
 
-Evaluation ReducedObjective::evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton) {
+Evaluation ReducedObjective::describe(ObjectState state) const {
   Evaluation e;
-  e.joints = joints;
-  e.positions = x;
-  const auto t0 = Clock::now();
-  e.statics = object_.solve(joints, e.positions, max_newton);
-  timing_.statics_seconds += seconds_since(t0);
-  ++timing_.statics_solves;
-  current_joints_ = joints;
-  current_positions_ = e.positions;
-
-  const KinematicsState& state = object_.kinematics();
+  e.state = std::make_shared<ObjectState>(std::move(state));
+  e.joints = e.state->joints();
+  e.positions = e.state->positions();
+  e.statics = e.state->statics();
+  const KinematicsState& kinematics = e.state->kinematics();
   if (collisions_) {
-    e.min_clearance = collisions_->min_clearance(state);
-    e.collision = weights_.collision * collisions_->value(object_.robot(), state);
+    e.min_clearance = collisions_->min_clearance(kinematics);
+    e.collision = weights_.collision * collisions_->value(object_->robot(), kinematics);
   }
-  e.joint_limits = weights_.joint_limits * limits_.value(joints);
-  e.within_limits = limit_violations(object_.robot(), state.joints).empty();
+  e.joint_limits = weights_.joint_limits * limits_.value(e.joints);
+  e.within_limits = limit_violations(object_->robot(), kinematics.joints).empty();
   score(e);
   return e;
 }
 
-bool ReducedObjective::confirm_stable(Evaluation& e) {
+Evaluation ReducedObjective::evaluate(const Eigen::VectorXd& joints, const Positions& x,
+                                      int max_newton, const Evaluation* from) const {
+  const auto t0 = Clock::now();
+  const ObjectState* chord = from && options_.chord_steps ? from->state.get() : nullptr;
+  ObjectState state = object_->solve_from(joints, x, max_newton, chord);
+  count_statics(seconds_since(t0));
+  return describe(std::move(state));
+}
+
+bool ReducedObjective::confirm_stable(Evaluation& e) const {
   if (!e.statics.converged()) return false;
-  make_current(e);
-  if (object_.statics().solver().hessian_positive_definite(e.positions, stale_factor_step)) return true;
+  if (object_->stable(*e.state, options_.stale_factor_step)) return true;
   e.statics.status = StaticsStatus::Unstable;
   e.statics.reason = "unstable equilibrium: the Hessian there is not positive definite";
   score(e);
   return false;
-}
-
-void ReducedObjective::make_current(const Evaluation& at) {
-  if (current_joints_.size() == at.joints.size() && current_joints_ == at.joints &&
-      current_positions_ == at.positions)
-    return;
-  Positions x = at.positions;
-  object_.solve(at.joints, x);  // already at equilibrium: no Newton step, same x
-  current_joints_ = at.joints;
-  current_positions_ = x;
 }
 
 Eigen::VectorXd ReducedObjective::shape_gradient_x(const Evaluation& at) const {
@@ -87,58 +104,50 @@ Eigen::VectorXd ReducedObjective::shape_gradient_x(const Evaluation& at) const {
   return g;
 }
 
-Eigen::MatrixXd ReducedObjective::sensitivity(const Evaluation& at, bool allow_stale) {
-  make_current(at);
-  return object_.statics().solver().solve_hessian(
-      at.positions, object_.grips().force_jacobian(object_.node_count()),
-      allow_stale ? stale_factor_step : 0.0);
+Eigen::MatrixXd ReducedObjective::sensitivity(const Evaluation& at, bool allow_stale) const {
+  return object_->sensitivity(*at.state, allow_stale ? options_.stale_factor_step : 0.0);
 }
 
-Eigen::VectorXd ReducedObjective::gradient(const Evaluation& at, GradientMethod method) {
+Eigen::VectorXd ReducedObjective::gradient(const Evaluation& at, GradientMethod method) const {
   const auto t0 = Clock::now();
   Eigen::VectorXd g(joint_count());
   if (method == GradientMethod::FiniteDifference) {
-    // Forward differences of the full reduced objective, each a warm-started statics solve.
+    // Forward differences of the full reduced objective, each a warm-started statics solve
+    // (counted as gradient work, not statics).
+    const double h = options_.finite_difference_step;
     for (int j = 0; j < joint_count(); ++j) {
       Eigen::VectorXd theta = at.joints;
-      theta[j] += finite_difference_step;
-      const Evaluation e = evaluate(theta, at.positions);
-      g[j] = (e.objective - at.objective) / finite_difference_step;
+      theta[j] += h;
+      const ObjectState* chord = options_.chord_steps ? at.state.get() : nullptr;
+      const Evaluation e = describe(object_->solve_from(theta, at.positions, 0, chord));
+      g[j] = (e.objective - at.objective) / h;
     }
-    timing_.statics_solves -= joint_count();  // counted as gradient work, not statics
   } else {
-    make_current(at);
     const Eigen::VectorXd dO_dx = shape_gradient_x(at);
-    if (method == GradientMethod::Adjoint) {
-      const Eigen::VectorXd lambda = object_.statics().solver().solve_hessian(
-          at.positions, dO_dx, stale_factor_step);
-      g = object_.grips().force_jacobian_transpose_times(lambda);
-    } else {
-      g = sensitivity(at, true).transpose() * dO_dx;
-    }
-    const KinematicsState& state = object_.kinematics();
+    if (method == GradientMethod::Adjoint) g = object_->adjoint(*at.state, dO_dx, options_.stale_factor_step);
+    else g = sensitivity(at, true).transpose() * dO_dx;
+    const KinematicsState& state = at.state->kinematics();
     Eigen::VectorXd barrier(joint_count());
     if (collisions_) {
-      collisions_->value(object_.robot(), state, &barrier);
+      collisions_->value(object_->robot(), state, &barrier);
       g += weights_.collision * barrier;
     }
     limits_.value(at.joints, &barrier);
     g += weights_.joint_limits * barrier;
   }
-  timing_.gradient_seconds += seconds_since(t0);
-  ++timing_.gradient_evaluations;
+  count_gradient(seconds_since(t0));
   return g;
 }
 
 void ReducedObjective::least_squares(const Evaluation& at, Eigen::VectorXd& r, Eigen::MatrixXd& J,
-                                     Eigen::MatrixXd* dx_dtheta) {
+                                     Eigen::MatrixXd* dx_dtheta) const {
   const auto t0 = Clock::now();
   const Eigen::MatrixXd dx = sensitivity(at, true);
-  const KinematicsState& state = object_.kinematics();
+  const KinematicsState& state = at.state->kinematics();
   const int m = joint_count();
   Eigen::VectorXd r_collision, r_limits;
   Eigen::MatrixXd J_collision, J_limits;
-  if (collisions_) collisions_->residuals(object_.robot(), state, r_collision, &J_collision);
+  if (collisions_) collisions_->residuals(object_->robot(), state, r_collision, &J_collision);
   limits_.residuals(at.joints, r_limits, &J_limits);
   const int n_shape = 3 * targets_.size();
   r.resize(n_shape + r_collision.size() + r_limits.size());
@@ -157,8 +166,7 @@ void ReducedObjective::least_squares(const Evaluation& at, Eigen::VectorXd& r, E
   r.tail(r_limits.size()) = wl * r_limits;
   J.bottomRows(r_limits.size()) = wl * J_limits;
   if (dx_dtheta) *dx_dtheta = dx;
-  timing_.gradient_seconds += seconds_since(t0);
-  ++timing_.gradient_evaluations;
+  count_gradient(seconds_since(t0));
 }
 
 }  // namespace shapectl

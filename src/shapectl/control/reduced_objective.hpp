@@ -4,6 +4,8 @@
 // its gradient by direct sensitivities, by the adjoint method or by finite differences, and
 // its least-squares form (residuals and Jacobian) for Gauss–Newton.
 #include <chrono>
+#include <memory>
+#include <mutex>
 #include <limits>
 #include <optional>
 
@@ -15,7 +17,8 @@ namespace shapectl {
 
 enum class GradientMethod { Sensitivity, Adjoint, FiniteDifference };
 
-// Everything known about one θ.
+// Everything known about one θ. Copies share one ObjectState (the equilibrium and its
+// factorization), which the derivatives at this θ use.
 struct Evaluation {
   Eigen::VectorXd joints;
   Positions positions;  // x̂(θ)
@@ -27,6 +30,7 @@ struct Evaluation {
   ShapeError error;
   double min_clearance = std::numeric_limits<double>::infinity();  // m, margin not subtracted
   bool within_limits = true;  // hard limits, no margin
+  std::shared_ptr<ObjectState> state;
   // A configuration we may hand to a robot.
   bool safe() const { return statics.converged() && min_clearance >= 0 && within_limits; }
 };
@@ -38,55 +42,73 @@ struct ObjectiveTiming {
   double gradient_seconds = 0;  // reduced gradients / Jacobians only
 };
 
+struct ObjectiveOptions {
+  double finite_difference_step = 1e-6;  // rad, forward differences (the paper's baseline)
+  // Allowed staleness of the factorization reused for sensitivities, metres of the last
+  // Newton step (0 = always exact; see GrippedObject::sensitivity).
+  double stale_factor_step = 1e-6;
+  // Statics from a nearby state first try steps with that state's factorization (see
+  // StaticsSolver::solve); off: every solve factors anew (the paper's baseline).
+  bool chord_steps = true;
+};
+
+// Immutable once made (the targets too: with_targets makes a new one); every call is const and
+// takes what it works on explicitly, so threads may share one. Only the timing counters change.
 class ReducedObjective {
  public:
-  explicit ReducedObjective(GrippedObject& object);
+  // The object must outlive this. Throws InputError ("targets: targets[k]...", see
+  // check_targets) for a node out of range or a position not finite or beyond
+  // max_target_distance.
+  explicit ReducedObjective(const GrippedObject& object, ShapeTargets targets = {},
+                            ObjectiveOptions options = {});
+  // The same objective with other targets (checked as above); shares the timing counters.
+  ReducedObjective with_targets(ShapeTargets targets) const;
 
-  // Throws InputError ("targets: targets[k]...", see check_targets) for a node out of range or
-  // a position not finite or beyond max_target_distance; the targets are then unchanged.
-  void set_targets(ShapeTargets targets);
   const ShapeTargets& targets() const { return targets_; }
-  GrippedObject& object() { return object_; }
-  int joint_count() const { return object_.joint_count(); }
+  const GrippedObject& object() const { return *object_; }
+  const ObjectiveOptions& options() const { return options_; }
+  int joint_count() const { return object_->joint_count(); }
 
-  // Solves statics at θ from the warm start `x` and scores it. The object's state is then
-  // this θ's (what gradient() and least_squares() need).
-  // max_newton > 0 caps the Newton iterations (a trial that needs more is not worth it).
-  Evaluation evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton = 0);
+  // Solves statics at θ from the warm start `x` (chord steps with `from`'s factorization if
+  // given, e.g. the state x came from) and scores it. max_newton > 0 caps the Newton
+  // iterations (a trial that needs more is not worth it).
+  Evaluation evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton = 0,
+                      const Evaluation* from = nullptr) const;
   // True if `e` is a stable equilibrium (the Hessian there positive definite); otherwise
   // marks it Unstable, objective +inf. Optimizers ask before accepting a state: an unstable
   // equilibrium is no shape a robot can hold. The factorization it needs is the one the next
   // gradient reuses, so accepted states cost nothing extra.
-  bool confirm_stable(Evaluation& e);
-  // Re-scores an evaluation after a target change, without re-solving.
+  bool confirm_stable(Evaluation& e) const;
+  // Scores an evaluation (e.g. made under other targets) against this objective's targets.
   void rescore(Evaluation& e) const;
-  // dÔ/dθ at `at` (re-solved first if the object has since moved elsewhere).
-  Eigen::VectorXd gradient(const Evaluation& at, GradientMethod method);
+  // dÔ/dθ at `at`.
+  Eigen::VectorXd gradient(const Evaluation& at, GradientMethod method) const;
   // Residuals r (½|r|² = Ô) and Jacobian dr/dθ at `at`; `dx_dtheta` receives dx̂/dθ if given.
   void least_squares(const Evaluation& at, Eigen::VectorXd& r, Eigen::MatrixXd& J,
-                     Eigen::MatrixXd* dx_dtheta = nullptr);
-  // dx̂/dθ at `at` (exact unless `allow_stale`; see StaticsSolver::solve_hessian).
-  Eigen::MatrixXd sensitivity(const Evaluation& at, bool allow_stale);
+                     Eigen::MatrixXd* dx_dtheta = nullptr) const;
+  // dx̂/dθ at `at` (exact unless `allow_stale`).
+  Eigen::MatrixXd sensitivity(const Evaluation& at, bool allow_stale) const;
 
-  ObjectiveTiming& timing() { return timing_; }
-  double finite_difference_step = 1e-6;  // rad, forward differences (the paper's baseline)
-  // Allowed staleness of the factorization reused for sensitivities, metres of the last
-  // Newton step (0 = always exact).
-  double stale_factor_step = 1e-6;
+  ObjectiveTiming timing() const;
 
  private:
-  void make_current(const Evaluation& at);
+  struct TimingCounters {
+    std::mutex mutex;
+    ObjectiveTiming timing;
+  };
   void score(Evaluation& e) const;
+  Evaluation describe(ObjectState state) const;  // scores a solved state
   Eigen::VectorXd shape_gradient_x(const Evaluation& at) const;  // ∂O_shape/∂x, weighted
+  void count_statics(double seconds) const;
+  void count_gradient(double seconds) const;
 
-  GrippedObject& object_;
+  const GrippedObject* object_;
   ShapeTargets targets_;
+  ObjectiveOptions options_;
   std::optional<CollisionModel> collisions_;
   JointLimits limits_;
   ObjectiveWeights weights_;
-  Eigen::VectorXd current_joints_;  // θ of the object's last solve
-  Positions current_positions_;
-  ObjectiveTiming timing_;
+  std::shared_ptr<TimingCounters> counters_;
 };
 
 }  // namespace shapectl

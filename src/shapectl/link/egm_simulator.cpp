@@ -2,6 +2,8 @@
 
 #include <array>
 #include <chrono>
+#include <deque>
+#include <string>
 
 namespace shapectl {
 
@@ -13,6 +15,8 @@ struct EgmSimulator::Arm {
   std::uint32_t seqno = 0;
   std::vector<ArmJoints> recent;  // up to two previous commands, for the checks
   bool resumed = false;
+  // Replies received after the tick being processed (the thread woke late): the next tick's.
+  std::deque<std::pair<double, std::string>> later;
 };
 
 GovernorLimits yumi_arm_limits(double acceleration) {
@@ -35,10 +39,11 @@ EgmSimulator::EgmSimulator(EgmSimulatorConfig config) : config_(std::move(config
   for (int a = 0; a < 2; ++a) {
     auto arm = std::make_unique<Arm>(Arm{std::nullopt, {},
                                          SimRobot(yumi_arm_limits(config_.acceleration), initial[a]),
-                                         {}, 0, {}, false});
+                                         {}, 0, {}, false, {}});
     if (ports[a] > 0) {
       arm->sensor = ipv4_address(config_.sensor_address, ports[a], "egm-sim sensor address");
       arm->socket.emplace("0.0.0.0", 0, "egm-sim");
+      arm->socket->record_arrival_times();
       arm->stats.present = true;
     }
     arm->stats.position = initial[a];
@@ -74,30 +79,41 @@ void EgmSimulator::run(std::stop_token stop) {
   while (!stop.stop_requested()) {
     next += period;
     std::this_thread::sleep_until(next);
-    // A late tick (this machine is busy; a real controller's cycle is exact) is not checked.
-    const bool late = std::chrono::steady_clock::now() - next > period / 2;
+    // A real controller's cycle is exact; this thread may wake late on a busy machine. The
+    // tick still uses only the replies that arrived before its exact time (kernel receive
+    // times), so commands land on the ticks they would on a controller. A very late tick is
+    // not checked.
+    const auto woke = std::chrono::steady_clock::now();
+    const bool late = woke - next > period / 2;
+    const double tick_time = std::chrono::duration<double>(
+        std::chrono::system_clock::now().time_since_epoch() - (woke - next)).count();
     const bool paused = paused_;
     for (auto& arm : arms_) {
       if (!arm->socket) continue;
       if (was_paused && !paused) arm->resumed = true;
-      tick(*arm, paused, late);
+      tick(*arm, paused, late, tick_time);
     }
     was_paused = paused;
   }
 }
 
-void EgmSimulator::tick(Arm& arm, bool paused, bool late) {
+void EgmSimulator::tick(Arm& arm, bool paused, bool late, double tick_time) {
   const GovernorLimits limits = yumi_arm_limits(config_.acceleration);
   std::array<char, EgmCodec::max_datagram + 1> buffer;
   // Replies to earlier feedback: the newest valid one is the arm's command, as on a real
   // controller, which uses the latest correction each cycle.
   std::optional<ArmJoints> newest;
   long n;
-  while ((n = arm.socket->receive(buffer, nullptr)) >= 0) {
-    EgmCommand command;
+  double arrived = 0;
+  while ((n = arm.socket->receive(buffer, nullptr, &arrived)) >= 0) {
     const auto size = static_cast<std::size_t>(std::min<long>(n, static_cast<long>(buffer.size())));
+    arm.later.emplace_back(arrived, std::string(buffer.data(), size));
+  }
+  for (; !arm.later.empty() && arm.later.front().first <= tick_time; arm.later.pop_front()) {
+    const std::string& bytes = arm.later.front().second;
+    EgmCommand command;
     std::lock_guard lock(mutex_);
-    if (!codec_.decode_sensor({buffer.data(), size}, command, nullptr)) {
+    if (!codec_.decode_sensor(bytes, command, nullptr)) {
       ++arm.stats.rejected;
       continue;
     }

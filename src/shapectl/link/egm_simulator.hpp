@@ -59,7 +59,8 @@ class EgmSimulator {
  private:
   struct Arm;
   void run(std::stop_token stop);
-  void tick(Arm& arm, bool paused, bool late);
+  // `tick_time`: the tick's exact time (s, CLOCK_REALTIME, as kernel receive times).
+  void tick(Arm& arm, bool paused, bool late, double tick_time);
 
   EgmSimulatorConfig config_;
   std::vector<std::unique_ptr<Arm>> arms_;  // [left, right]

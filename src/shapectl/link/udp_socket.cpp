@@ -56,6 +56,35 @@ long UdpSocket::receive(std::span<char> buffer, sockaddr_in* from) {
   return static_cast<long>(n);
 }
 
+long UdpSocket::receive(std::span<char> buffer, sockaddr_in* from, double* arrived) {
+  sockaddr_in sender{};
+  iovec io{buffer.data(), buffer.size()};
+  alignas(cmsghdr) char control[CMSG_SPACE(sizeof(timespec))];
+  msghdr message{};
+  message.msg_name = &sender;
+  message.msg_namelen = sizeof sender;
+  message.msg_iov = &io;
+  message.msg_iovlen = 1;
+  message.msg_control = control;
+  message.msg_controllen = sizeof control;
+  const ssize_t n = ::recvmsg(fd_, &message, MSG_TRUNC);
+  if (n < 0) return -1;
+  if (from) *from = sender;
+  *arrived = 0;
+  for (cmsghdr* c = CMSG_FIRSTHDR(&message); c; c = CMSG_NXTHDR(&message, c))
+    if (c->cmsg_level == SOL_SOCKET && c->cmsg_type == SCM_TIMESTAMPNS) {
+      timespec t;
+      std::memcpy(&t, CMSG_DATA(c), sizeof t);
+      *arrived = static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+    }
+  return static_cast<long>(n);
+}
+
+void UdpSocket::record_arrival_times() {
+  const int on = 1;
+  ::setsockopt(fd_, SOL_SOCKET, SO_TIMESTAMPNS, &on, sizeof on);
+}
+
 bool UdpSocket::send_to(std::string_view bytes, const sockaddr_in& to) {
   return ::sendto(fd_, bytes.data(), bytes.size(), 0, reinterpret_cast<const sockaddr*>(&to),
                   sizeof to) == static_cast<ssize_t>(bytes.size());

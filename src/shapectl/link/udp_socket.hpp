@@ -27,6 +27,10 @@ class UdpSocket {
   // The next waiting datagram into `buffer`: its full size (larger than the buffer when it was
   // cut short), or -1 when none is waiting.
   long receive(std::span<char> buffer, sockaddr_in* from);
+  // The same, also telling when the kernel received it (s, CLOCK_REALTIME), after
+  // record_arrival_times(); 0 when the kernel gave no time.
+  long receive(std::span<char> buffer, sockaddr_in* from, double* arrived);
+  void record_arrival_times();
   bool send_to(std::string_view bytes, const sockaddr_in& to);
 
  private:

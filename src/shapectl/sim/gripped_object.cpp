@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include <shapectl/sim/workspace_pool.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -19,15 +21,36 @@ GrippedObject::GrippedObject(const Scene& scene) : scene_(scene) {
   const KinematicsState reference = forward_kinematics(robot(), scene_.robot->reference_joints);
   grips_ = std::make_unique<GripSprings>(
       robot(), GripSprings::attach(reference, scene_.world_rest_positions(), pairs), scene_.grip_stiffness);
-  grips_->set_robot_state(reference);
   std::vector<int> held;
   for (const auto& p : pairs) held.push_back(p.first);
-  statics_ = std::make_unique<ObjectStatics>(scene_, std::vector<const EnergyTerm*>{grips_.get()}, held);
+  statics_ = std::make_unique<ObjectStatics>(scene_, held);
+  pool_ = WorkspacePool::create([statics = statics_.get()] { return statics->make_workspace(); });
 }
 
-StaticsResult GrippedObject::solve(const Eigen::VectorXd& joints, Positions& x, int max_iterations) {
-  grips_->set_robot_state(forward_kinematics(robot(), joints));
-  return statics_->solve(x, max_iterations);
+ObjectState GrippedObject::make_state(const Eigen::VectorXd& joints, const Positions& x) const {
+  ObjectState s;
+  s.joints_ = joints;
+  s.kinematics_ = forward_kinematics(robot(), joints);
+  s.positions_ = x;
+  s.workspace_ = pool_->acquire();
+  return s;
+}
+
+const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::VectorXd& joints,
+                                          int max_iterations, const ObjectState* chord) const {
+  state.joints_ = joints;
+  state.kinematics_ = forward_kinematics(robot(), joints);
+  const GripEnergy grip(*grips_, state.kinematics_);
+  const StaticsWorkspace* chord_ws = chord ? chord->workspace_.get() : nullptr;
+  state.statics_ = statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations, chord_ws);
+  return state.statics_;
+}
+
+ObjectState GrippedObject::solve_from(const Eigen::VectorXd& joints, const Positions& x,
+                                      int max_iterations, const ObjectState* chord) const {
+  ObjectState s = make_state(joints, x);
+  solve(s, joints, max_iterations, chord);
+  return s;
 }
 
 void GrippedObject::carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
@@ -40,13 +63,28 @@ void GrippedObject::carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen
   }
 }
 
-Eigen::MatrixXd GrippedObject::sensitivity(const Positions& x) {
-  return statics_->solver().solve_hessian(x, grips_->force_jacobian(node_count()));
+bool GrippedObject::factored(ObjectState& state, double stale_step) const {
+  const StaticsSolver& solver = statics_->solver();
+  StaticsWorkspace& ws = *state.workspace_;
+  if (solver.factor_distance(ws, state.positions_) <= stale_step) return true;
+  const GripEnergy grip(*grips_, state.kinematics_);
+  return solver.factor(statics_->terms(&grip), ws, state.positions_);
 }
 
-Eigen::VectorXd GrippedObject::adjoint(const Positions& x, const Eigen::VectorXd& v) {
-  const Eigen::VectorXd lambda = statics_->solver().solve_hessian(x, v);
-  return grips_->force_jacobian_transpose_times(lambda);
+bool GrippedObject::stable(ObjectState& state, double stale_step) const {
+  return factored(state, stale_step);
+}
+
+Eigen::MatrixXd GrippedObject::sensitivity(ObjectState& state, double stale_step) const {
+  factored(state, stale_step);
+  return statics_->solver().solve_with_factor(*state.workspace_,
+                                              grips_->force_jacobian(state.kinematics_, node_count()));
+}
+
+Eigen::VectorXd GrippedObject::adjoint(ObjectState& state, const Eigen::VectorXd& v, double stale_step) const {
+  factored(state, stale_step);
+  const Eigen::VectorXd lambda = statics_->solver().solve_with_factor(*state.workspace_, v);
+  return grips_->force_jacobian_transpose_times(state.kinematics_, lambda);
 }
 
 }  // namespace shapectl

@@ -1,20 +1,30 @@
 #pragma once
 // The object held by the robot: joint angles θ → quasi-static shape x̂(θ) (paper Section II)
 // and its sensitivity dx̂/dθ = H⁻¹ ∂F/∂θ (eq. 9), H the true Hessian at the equilibrium.
+//
+// Model and data, as in Pinocchio: GrippedObject is the fixed description (scene, robot, grip
+// springs, energies, fixed nodes, solver options), immutable and shareable across threads;
+// ObjectState is everything that changes. Every algorithm is a const member taking the state:
+// two threads may work on one GrippedObject with states of their own.
 #include <memory>
 
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/sim/grip_springs.hpp>
+#include <shapectl/sim/object_state.hpp>
 #include <shapectl/sim/object_statics.hpp>
 #include <shapectl/sim/scene.hpp>
 
 namespace shapectl {
+
+class WorkspacePool;
 
 class GrippedObject {
  public:
   // The scene must have a robot and grips; the object's reference shape x⁰ is its placed
   // rest shape, gripped at the reference joints θ⁰.
   explicit GrippedObject(const Scene& scene);
+  GrippedObject(const GrippedObject&) = delete;
+  GrippedObject& operator=(const GrippedObject&) = delete;
 
   const Scene& scene() const { return scene_; }
   const RobotModel& robot() const { return *scene_.robot->model; }
@@ -23,14 +33,20 @@ class GrippedObject {
   int joint_count() const { return robot().active_count(); }
   const Eigen::VectorXd& reference_joints() const { return scene_.robot->reference_joints; }
   Positions reference_positions() const { return scene_.world_rest_positions(); }
-
-  // Equilibrium at θ = joints, warm-started from x (overwritten with the result).
-  // max_iterations > 0 caps Newton for this call.
-  StaticsResult solve(const Eigen::VectorXd& joints, Positions& x, int max_iterations = 0);
-  // Robot state of the last solve.
-  const KinematicsState& kinematics() const { return grips_->robot_state(); }
   const GripSprings& grips() const { return *grips_; }
-  ObjectStatics& statics() { return *statics_; }
+  const ObjectStatics& statics() const { return *statics_; }
+
+  // A state at θ with positions x (not solved: statics() reports NotConverged, 0 iterations).
+  ObjectState make_state(const Eigen::VectorXd& joints, const Positions& x) const;
+  // Equilibrium at θ = joints, Newton from the state's positions; `state` then describes it.
+  // Newton tries steps with `chord`'s factorization first if it holds one (a nearby state's,
+  // e.g. the one the warm start came from; it may be `state` itself). max_iterations > 0
+  // caps Newton for this call.
+  const StaticsResult& solve(ObjectState& state, const Eigen::VectorXd& joints,
+                             int max_iterations = 0, const ObjectState* chord = nullptr) const;
+  // A new state solved at θ = joints from the warm start x, chord steps from `chord`'s factor.
+  ObjectState solve_from(const Eigen::VectorXd& joints, const Positions& x,
+                         int max_iterations = 0, const ObjectState* chord = nullptr) const;
 
   // A warm start for the equilibrium at `to` from the one at `from`: every gripped node of `x`
   // is set to its position in `at_from` moved rigidly with its end effector from `from` to
@@ -38,15 +54,25 @@ class GrippedObject {
   // newtons through stiff grip springs, and Newton iterations to undo.
   void carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                            const Positions& at_from, Positions& x) const;
-  // dx̂/dθ (3n × m) at the last solve's equilibrium x.
-  Eigen::MatrixXd sensitivity(const Positions& x);
+
+  // The derivatives below need the Hessian at the state's positions factored. The state's own
+  // factorization is used when it is within `stale_step` metres of them (its solve's last
+  // Newton step: an error of that order in H saves a factorization per optimizer iteration);
+  // otherwise the state is factored at its positions first.
+  // Whether the state is a stable equilibrium (the Hessian there positive definite).
+  bool stable(ObjectState& state, double stale_step = 0) const;
+  // dx̂/dθ (3n × m). Throws std::runtime_error at an unstable state.
+  Eigen::MatrixXd sensitivity(ObjectState& state, double stale_step = 0) const;
   // (dx̂/dθ)ᵀ v by the adjoint method, one solve: λ = H⁻¹ v, result = (∂F/∂θ)ᵀ λ.
-  Eigen::VectorXd adjoint(const Positions& x, const Eigen::VectorXd& v);
+  Eigen::VectorXd adjoint(ObjectState& state, const Eigen::VectorXd& v, double stale_step = 0) const;
 
  private:
+  bool factored(ObjectState& state, double stale_step) const;
+
   Scene scene_;
   std::unique_ptr<GripSprings> grips_;
   std::unique_ptr<ObjectStatics> statics_;
+  std::shared_ptr<WorkspacePool> pool_;
 };
 
 }  // namespace shapectl

@@ -67,43 +67,61 @@ std::shared_ptr<const TetMesh> placed_mesh(const Scene& scene) {
 }
 }  // namespace
 
-ObjectStatics::ObjectStatics(const Scene& scene, std::vector<const EnergyTerm*> extra_terms,
-                             const std::vector<int>& held_nodes)
+namespace {
+std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
+  std::vector<char> fixed(placed.node_count(), 0);
+  if (scene.fixed)
+    for (int i : scene.fixed->resolve(*scene.object_mesh)) fixed[i] = 1;
+  // Nodes no element touches carry no stiffness: keep them where they are.
+  for (int i : placed.isolated_nodes()) fixed[i] = 1;
+  return fixed;
+}
+
+StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double weight) {
+  // Converged when every nodal force is a tiny fraction of the weight (or, for a weightless
+  // object, of the force that strains it by 0.1 %) — but never below what round-off leaves.
+  const double size = (placed.bounds_max() - placed.bounds_min()).norm();
+  const double scale = weight > 0 ? weight : 1e-3 * scene.material.mu * size * size;
+  const RoundoffScale roundoff = roundoff_scale(placed, scene.material, weight);
+  return {.force_tolerance = scene.statics.relative_tolerance * scale,
+          .force_roundoff = roundoff.force,
+          .energy_roundoff = roundoff.energy,
+          .max_iterations = scene.statics.max_iterations,
+          .backend = scene.statics.backend};
+}
+}  // namespace
+
+ObjectStatics::ObjectStatics(const Scene& scene, const std::vector<int>& held_nodes)
     : mesh_(placed_mesh(scene)),
       elasticity_(*mesh_, scene.material),
       gravity_(*mesh_, scene.material.density, scene.gravity),
-      fixed_node_(mesh_->node_count(), 0) {
-  if (scene.fixed)
-    for (int i : scene.fixed->resolve(*scene.object_mesh)) fixed_node_[i] = 1;
-  // Nodes no element touches carry no stiffness: keep them where they are.
-  for (int i : mesh_->isolated_nodes()) fixed_node_[i] = 1;
+      fixed_node_(fixed_nodes(scene, *mesh_)),
+      solver_(mesh_->node_count(), fixed_node_, statics_options(scene, *mesh_, gravity_.weight())) {
   std::vector<char> held = fixed_node_;
   for (int i : held_nodes) held[i] = 1;
   unheld_reason_ = find_unheld_part(*mesh_, held);
-
-  std::vector<const EnergyTerm*> terms = {&elasticity_, &gravity_};
-  terms.insert(terms.end(), extra_terms.begin(), extra_terms.end());
-  // Converged when every nodal force is a tiny fraction of the weight (or, for a weightless
-  // object, of the force that strains it by 0.1 %) — but never below what round-off leaves.
-  const double size = (mesh_->bounds_max() - mesh_->bounds_min()).norm();
-  const double scale = gravity_.weight() > 0 ? gravity_.weight() : 1e-3 * scene.material.mu * size * size;
-  const RoundoffScale roundoff = roundoff_scale(*mesh_, scene.material, gravity_.weight());
-  StaticsOptions options{.force_tolerance = scene.statics.relative_tolerance * scale,
-                         .force_roundoff = roundoff.force,
-                         .energy_roundoff = roundoff.energy,
-                         .max_iterations = scene.statics.max_iterations,
-                         .backend = scene.statics.backend};
-  solver_ = std::make_unique<StaticsSolver>(mesh_->node_count(), terms, fixed_node_, options);
 }
 
-StaticsResult ObjectStatics::solve(Positions& x, int max_iterations) {
+EnergyTerms ObjectStatics::terms(const EnergyTerm* extra) const {
+  EnergyTerms t = {&elasticity_, &gravity_};
+  if (extra) t.push_back(extra);
+  return t;
+}
+
+StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra,
+                                   int max_iterations, const StaticsWorkspace* chord) const {
   if (!unheld_reason_.empty()) {
     StaticsResult r;
     r.status = StaticsStatus::Singular;
     r.reason = unheld_reason_;
     return r;
   }
-  return solver_->solve(x, max_iterations);
+  return solver_.solve(terms(extra), ws, x, max_iterations, chord);
+}
+
+StaticsResult ObjectStatics::solve(Positions& x, int max_iterations) const {
+  StaticsWorkspace ws = make_workspace();
+  return solve(ws, x, nullptr, max_iterations);
 }
 
 }  // namespace shapectl

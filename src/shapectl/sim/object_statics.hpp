@@ -11,22 +11,33 @@
 
 namespace shapectl {
 
+// The fixed description (immutable, shareable across threads); the changing part of a solve is
+// the caller's StaticsWorkspace and positions.
 class ObjectStatics {
  public:
-  // extra_terms: not owned, must outlive this. held_nodes: nodes those terms hold in place
-  // (gripped nodes), used only to detect parts of the object that nothing holds.
-  ObjectStatics(const Scene& scene, std::vector<const EnergyTerm*> extra_terms = {},
-                const std::vector<int>& held_nodes = {});
+  // held_nodes: nodes that extra terms (the robot's grip springs) will hold in place, used only
+  // to detect parts of the object that nothing holds.
+  explicit ObjectStatics(const Scene& scene, const std::vector<int>& held_nodes = {});
 
-  // Equilibrium from the warm start x (fixed nodes must be at their prescribed positions).
-  // An object that nothing holds is reported as Singular without iterating.
-  StaticsResult solve(Positions& x, int max_iterations = 0);
-  StaticsSolver& solver() { return *solver_; }
+  // The object's energy terms (elasticity, gravity), plus `extra` if given.
+  EnergyTerms terms(const EnergyTerm* extra = nullptr) const;
+  StaticsWorkspace make_workspace() const { return solver_.make_workspace(); }
+  // Equilibrium from the warm start x (fixed nodes must be at their prescribed positions) with
+  // the energy plus `extra`, in `ws` (see StaticsSolver::solve for `chord`). An object that
+  // nothing holds is reported as Singular without iterating.
+  StaticsResult solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra = nullptr,
+                      int max_iterations = 0, const StaticsWorkspace* chord = nullptr) const;
+  // The same from scratch (a workspace of its own, no earlier factorization).
+  StaticsResult solve(Positions& x, int max_iterations = 0) const;
+  // The true Hessian of the object's own energy at x (for tests and tools).
+  SparseMatrix hessian(const Positions& x) const { return solver_.hessian(terms(), x); }
+
+  const StaticsSolver& solver() const { return solver_; }
   const TetMesh& mesh() const { return *mesh_; }
   const std::vector<char>& fixed_node() const { return fixed_node_; }
   double weight() const { return gravity_.weight(); }
   // The force Newton stops at: the scene's tolerance, or the round-off floor if larger.
-  double force_tolerance() const { return solver_->effective_tolerance(); }
+  double force_tolerance() const { return solver_.effective_tolerance(); }
 
  private:
   std::shared_ptr<const TetMesh> mesh_;
@@ -34,7 +45,7 @@ class ObjectStatics {
   Gravity gravity_;
   std::vector<char> fixed_node_;
   std::string unheld_reason_;
-  std::unique_ptr<StaticsSolver> solver_;
+  StaticsSolver solver_;
 };
 
 // What round-off alone leaves in a nodal force (N) and in the energy (J) of `mesh` (placed in

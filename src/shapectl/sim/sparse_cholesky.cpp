@@ -50,6 +50,8 @@ SparseCholesky::SparseCholesky(std::optional<Backend> backend)
 }
 
 SparseCholesky::~SparseCholesky() = default;
+SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
+SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
 void SparseCholesky::analyze(const SparseMatrix& lower) {
   if (automatic_) {

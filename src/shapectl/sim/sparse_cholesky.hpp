@@ -18,6 +18,8 @@ class SparseCholesky {
   // A fixed backend, or none: then analyze() picks one for the matrix.
   explicit SparseCholesky(std::optional<Backend> backend = std::nullopt);
   ~SparseCholesky();
+  SparseCholesky(SparseCholesky&&) noexcept;
+  SparseCholesky& operator=(SparseCholesky&&) noexcept;
   // The backend in use (decided by the first analyze() when automatic).
   Backend backend() const { return backend_; }
   // Symbolic analysis; call again only when the pattern changes.

@@ -32,26 +32,24 @@ std::string sci(double v) {
 }
 }  // namespace
 
-StaticsSolver::StaticsSolver(int node_count, std::vector<const EnergyTerm*> terms,
-                             std::vector<char> fixed_node, StaticsOptions options)
-    : node_count_(node_count),
-      terms_(std::move(terms)),
-      options_(options),
-      assembler_(3 * node_count, dof_mask(fixed_node)),
-      cholesky_(options.backend) {}
+StaticsSolver::StaticsSolver(int node_count, std::vector<char> fixed_node, StaticsOptions options)
+    : node_count_(node_count), fixed_dof_(dof_mask(fixed_node)), options_(options) {}
 
-double StaticsSolver::energy(const Positions& x) const {
+StaticsWorkspace StaticsSolver::make_workspace() const {
+  return StaticsWorkspace(3 * node_count_, fixed_dof_, options_.backend);
+}
+
+double StaticsSolver::energy(const EnergyTerms& terms, const Positions& x) const {
   double e = 0;
-  for (const auto* t : terms_) e += t->value(x);
+  for (const auto* t : terms) e += t->value(x);
   return std::isnan(e) ? std::numeric_limits<double>::infinity() : e;
 }
 
-Eigen::VectorXd StaticsSolver::gradient(const Positions& x) const {
+Eigen::VectorXd StaticsSolver::gradient(const EnergyTerms& terms, const Positions& x) const {
   Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
-  for (const auto* t : terms_) t->add_gradient(x, g);
-  const auto& fixed = assembler_.fixed_dof();
+  for (const auto* t : terms) t->add_gradient(x, g);
   for (int d = 0; d < g.size(); ++d)
-    if (fixed[d]) g[d] = 0;
+    if (fixed_dof_[d]) g[d] = 0;
   return g;
 }
 
@@ -61,66 +59,56 @@ double StaticsSolver::max_force(const Eigen::VectorXd& g) const {
   return std::isfinite(m) ? m : std::numeric_limits<double>::infinity();
 }
 
-bool StaticsSolver::factor_at(const Positions& x, bool projected) {
-  triplets_.clear();
-  for (const auto* t : terms_) t->add_hessian(x, triplets_, projected);
-  const SparseMatrix& H = assembler_.assemble(triplets_);
-  if (!analyzed_ || assembler_.pattern_changed()) {
-    cholesky_.analyze(H);
-    analyzed_ = true;
+bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
+                              bool projected) const {
+  ws.triplets.clear();
+  for (const auto* t : terms) t->add_hessian(x, ws.triplets, projected);
+  const SparseMatrix& H = ws.assembler.assemble(ws.triplets);
+  if (!ws.analyzed || ws.assembler.pattern_changed()) {
+    ws.cholesky.analyze(H);
+    ws.analyzed = true;
   }
-  ++factorizations_;
-  const bool ok = cholesky_.factorize(H);
-  factor_is_true_ = ok && !projected;
-  if (factor_is_true_) factor_x_ = x;
+  const bool ok = ws.cholesky.factorize(H);
+  ws.has_factor = ok && !projected;
+  if (ws.has_factor) ws.factor_x = x;
   return ok;
 }
 
-SparseMatrix StaticsSolver::hessian(const Positions& x) {
-  triplets_.clear();
-  for (const auto* t : terms_) t->add_hessian(x, triplets_, false);
-  return assembler_.assemble(triplets_);
+bool StaticsSolver::factor(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x) const {
+  return factor_at(terms, ws, x, false);
 }
 
-bool StaticsSolver::hessian_positive_definite(const Positions& x, double stale_step) {
-  const bool exact = factor_is_true_ && factor_x_.size() == x.size() && factor_x_ == x;
-  const bool close = factor_is_true_ && stale_step > 0 && solved_x_.size() == x.size() &&
-                     solved_x_ == x && last_step_from_factor_ <= stale_step;
-  return exact || close || factor_at(x, false);
+SparseMatrix StaticsSolver::hessian(const EnergyTerms& terms, const Positions& x) const {
+  Triplets triplets;
+  for (const auto* t : terms) t->add_hessian(x, triplets, false);
+  HessianAssembler assembler(3 * node_count_, fixed_dof_);
+  return assembler.assemble(triplets);
 }
 
-Eigen::MatrixXd StaticsSolver::solve_hessian(const Positions& x, const Eigen::MatrixXd& rhs,
-                                             double stale_step) {
-  if (!hessian_positive_definite(x, stale_step))
-    throw std::runtime_error("the Hessian at the equilibrium is not positive definite");
+double StaticsSolver::factor_distance(const StaticsWorkspace& ws, const Positions& x) const {
+  if (!ws.has_factor || ws.factor_x.size() != x.size()) return std::numeric_limits<double>::infinity();
+  double d = 0;
+  for (int i = 0; i < node_count_; ++i) d = std::max(d, (x - ws.factor_x).segment<3>(3 * i).norm());
+  return d;
+}
+
+Eigen::MatrixXd StaticsSolver::solve_with_factor(const StaticsWorkspace& ws, const Eigen::MatrixXd& rhs) const {
+  if (!ws.has_factor) throw std::runtime_error("the Hessian at the equilibrium is not positive definite");
   Eigen::MatrixXd masked = rhs;
-  const auto& fixed = assembler_.fixed_dof();
   for (int d = 0; d < masked.rows(); ++d)
-    if (fixed[d]) masked.row(d).setZero();
-  return cholesky_.solve(masked);
+    if (fixed_dof_[d]) masked.row(d).setZero();
+  std::lock_guard lock(*ws.solve_mutex);
+  return ws.cholesky.solve(masked);
 }
 
-StaticsResult StaticsSolver::solve(Positions& x, int max_iterations) {
-  StaticsResult result = newton(x, max_iterations > 0 ? max_iterations : options_.max_iterations);
-  solved_x_ = x;
-  last_step_from_factor_ = std::numeric_limits<double>::infinity();
-  if (factor_is_true_ && factor_x_.size() == x.size()) {
-    last_step_from_factor_ = 0;
-    for (int i = 0; i < node_count_; ++i)
-      last_step_from_factor_ = std::max(last_step_from_factor_, (x - factor_x_).segment<3>(3 * i).norm());
-  }
-  return result;
-}
-
-std::string StaticsSolver::singular_reason() const {
+std::string StaticsSolver::singular_reason(const StaticsWorkspace& ws) const {
   // Structural checks (every part held) belong to the caller; here the matrix itself, the
   // projected Hessian that just failed to factor, is judged: the spread of its diagonal over
   // free dofs measures how ill-conditioned it is.
-  const SparseMatrix& H = assembler_.matrix();
-  const auto& fixed = assembler_.fixed_dof();
+  const SparseMatrix& H = ws.assembler.matrix();
   double lo = std::numeric_limits<double>::infinity(), hi = 0;
   for (int d = 0; d < H.rows(); ++d)
-    if (!fixed[d]) {
+    if (!fixed_dof_[d]) {
       const double v = std::abs(H.coeff(d, d));
       lo = std::min(lo, v);
       hi = std::max(hi, v);
@@ -132,15 +120,17 @@ std::string StaticsSolver::singular_reason() const {
              : "; the held nodes may leave a rigid motion free, e.g. a rotation about one node)");
 }
 
-StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
+StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& ws, Positions& x,
+                                   int max_iterations, const StaticsWorkspace* chord) const {
+  if (max_iterations <= 0) max_iterations = options_.max_iterations;
   StaticsResult result;
-  double e = energy(x);
+  double e = energy(terms, x);
   if (!std::isfinite(e)) {
     result.status = StaticsStatus::Inverted;
     result.reason = "the starting state has an inverted element or a non-finite energy";
     return result;
   }
-  Eigen::VectorXd g = gradient(x);
+  Eigen::VectorXd g = gradient(terms, x);
   double residual = max_force(g);
   const double tolerance = effective_tolerance();
   if (!(tolerance < std::numeric_limits<double>::infinity())) {
@@ -154,7 +144,7 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
   auto energy_noise = [&](double energy) {
     return std::max(options_.energy_roundoff, 1e-12 * std::abs(energy)) + 1e-300;
   };
-  bool may_chord = options_.chord_steps && factor_is_true_;
+  bool may_chord = chord && chord->has_factor && chord->factor_x.size() == x.size();
   for (int it = 0;; ++it) {
     result.iterations = it;
     result.residual = residual;
@@ -183,12 +173,16 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
     // buckling (seconds instead of milliseconds in `shapectl bench`), and Newton's last step
     // leaves a factorization the sensitivities can reuse.
     if (may_chord) {
-      const Eigen::VectorXd dx = -cholesky_.solve(g);
+      Eigen::VectorXd dx;
+      {
+        std::lock_guard lock(*chord->solve_mutex);
+        dx = -chord->cholesky.solve(g);
+      }
       if (g.dot(dx) < 0) {
         Positions trial = x + dx;
-        const double e_trial = energy(trial);
+        const double e_trial = energy(terms, trial);
         if (std::isfinite(e_trial) && e_trial <= e + energy_noise(e)) {
-          Eigen::VectorXd g_trial = gradient(trial);
+          Eigen::VectorXd g_trial = gradient(terms, trial);
           const double r_trial = max_force(g_trial);
           if (r_trial <= 0.25 * residual) {
             log.chord = true;
@@ -207,18 +201,20 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
     may_chord = false;
     // True Hessian at x; it must also give a descent direction.
     Eigen::VectorXd dx;
-    if (factor_at(x, false)) {
-      dx = -cholesky_.solve(g);
+    ++result.factorizations;
+    if (factor_at(terms, ws, x, false)) {
+      dx = -ws.cholesky.solve(g);
       if (!(g.dot(dx) < 0)) dx.resize(0);
     }
     if (dx.size() == 0) {
       log.projected = true;
-      if (!factor_at(x, true)) {
+      ++result.factorizations;
+      if (!factor_at(terms, ws, x, true)) {
         result.status = StaticsStatus::Singular;
-        result.reason = singular_reason();
+        result.reason = singular_reason(ws);
         return result;
       }
-      dx = -cholesky_.solve(g);
+      dx = -ws.cholesky.solve(g);
     }
     // Backtracking line search (see the header). Inverted trial states have E = +inf.
     const double slope = g.dot(dx);
@@ -232,11 +228,11 @@ StaticsResult StaticsSolver::newton(Positions& x, int max_iterations) {
     bool accepted = false;
     for (int k = 0; k < 40 && !accepted; ++k, alpha *= 0.5) {
       trial = x + alpha * dx;
-      e_trial = energy(trial);
+      e_trial = energy(terms, trial);
       if (!std::isfinite(e_trial)) continue;
       const bool armijo = e_trial <= e + 1e-4 * alpha * slope;
       if (!armijo && e_trial > e + noise) continue;
-      g_trial = gradient(trial);
+      g_trial = gradient(terms, trial);
       r_trial = max_force(g_trial);
       if (!std::isfinite(r_trial)) continue;
       // Energy within round-off of the start: the force norm decides.

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,7 +28,7 @@
 namespace shapectl {
 
 // Unstable: an equilibrium where the Hessian is not positive definite (a saddle, e.g. the
-// bar at the tipping point of a buckle); reported only by StaticsSolver::confirm_stable.
+// bar at the tipping point of a buckle); reported by the optimizers' stability check.
 enum class StaticsStatus { Converged, NotConverged, Inverted, Singular, Unstable };
 const char* to_string(StaticsStatus status);
 
@@ -38,8 +39,6 @@ struct StaticsOptions {
   // J: energy differences below this are round-off (at least 1e-12 |E|).
   double energy_roundoff = 0;
   int max_iterations = 100;
-  // Try a step with the last true-Hessian factorization before factoring anew (see newton()).
-  bool chord_steps = true;
   // Which sparse Cholesky; by default chosen by system size (SparseCholesky::choose).
   std::optional<SparseCholesky::Backend> backend;
 };
@@ -58,70 +57,84 @@ struct StaticsResult {
   StaticsStatus status = StaticsStatus::NotConverged;
   std::string reason;  // why it stopped, e.g. "residual 3e-2 N after 50 iterations"
   int iterations = 0;
+  int factorizations = 0;  // numeric factorizations this solve did
   double residual = 0;  // largest nodal force norm at the returned state, N
   double energy = 0;
   std::vector<NewtonIterate> log;
   bool converged() const { return status == StaticsStatus::Converged; }
 };
 
+// The mutable half of statics: the assembled Hessian, its factorization and the point it
+// belongs to (plus the symbolic analysis and buffers, reused from call to call). Made by
+// StaticsSolver::make_workspace. One thread at a time changes it; solving with its factor
+// (solve_with_factor, or as another solve's chord source) is safe from several threads.
+struct StaticsWorkspace {
+  StaticsWorkspace(int dof_count, std::vector<char> fixed_dof, std::optional<SparseCholesky::Backend> backend)
+      : assembler(dof_count, std::move(fixed_dof)), cholesky(backend) {}
+  // Drops the factorization (the buffers and the symbolic analysis stay).
+  void forget_factor() { has_factor = false; }
+
+  HessianAssembler assembler;
+  SparseCholesky cholesky;
+  Triplets triplets;
+  bool analyzed = false;
+  // The factor is of the true Hessian at `factor_x` (else it is unusable).
+  bool has_factor = false;
+  Positions factor_x;
+  // CHOLMOD's solve writes to its common workspace: solves with this factor take turns.
+  std::unique_ptr<std::mutex> solve_mutex = std::make_unique<std::mutex>();
+};
+
+using EnergyTerms = std::vector<const EnergyTerm*>;
+
+// The fixed description of a statics problem (size, fixed dofs, options) and the algorithms on
+// it. Const and shareable across threads; everything that changes lives in the caller's
+// StaticsWorkspace and positions. The energy terms are passed per call (they may depend on the
+// robot's configuration); they must describe the same problem each time (same Hessian
+// triplets).
 class StaticsSolver {
  public:
-  // terms: the energy (not owned; must outlive the solver). fixed_node[i]: node i keeps the
-  // position it has in x (Dirichlet). Sizes: n nodes, 3n unknowns.
-  StaticsSolver(int node_count, std::vector<const EnergyTerm*> terms, std::vector<char> fixed_node,
-                StaticsOptions options = {});
-  // Starts from x (warm start) and overwrites it with the equilibrium or the last iterate.
-  // max_iterations > 0 overrides the options' limit for this call (optimizer trials).
-  StaticsResult solve(Positions& x, int max_iterations = 0);
+  // fixed_node[i]: node i keeps the position it has in x (Dirichlet). Sizes: n nodes, 3n unknowns.
+  StaticsSolver(int node_count, std::vector<char> fixed_node, StaticsOptions options = {});
+  StaticsWorkspace make_workspace() const;
+
+  // Newton from x (warm start), overwritten with the equilibrium or the last iterate; the
+  // workspace is left with the factorization of the last Newton step (or none). When `chord`
+  // holds a true-Hessian factorization (of a nearby state; it may be `ws` itself), Newton tries
+  // steps with it first. max_iterations > 0 overrides the options' limit for this call.
+  StaticsResult solve(const EnergyTerms& terms, StaticsWorkspace& ws, Positions& x,
+                      int max_iterations = 0, const StaticsWorkspace* chord = nullptr) const;
 
   // Total energy and its gradient (fixed dofs zeroed) at x.
-  double energy(const Positions& x) const;
-  Eigen::VectorXd gradient(const Positions& x) const;
-  // Solves H(x) Y = rhs with the true Hessian at x, rows of fixed dofs zero. Reuses the
-  // factorization when it is of the true Hessian at exactly this x, or — when x is the result
-  // of the last solve and `stale_step` > 0 — at a state from which no node of x is more than
-  // `stale_step` metres away (an error of that order in H; it saves a factorization per
-  // optimizer iteration).
-  Eigen::MatrixXd solve_hessian(const Positions& x, const Eigen::MatrixXd& rhs,
-                                double stale_step = 0);
-  // Whether the true Hessian at x is positive definite, i.e. the equilibrium x is stable.
-  // Leaves that factorization for solve_hessian (same reuse rule), so checking an accepted
-  // state costs nothing extra.
-  bool hessian_positive_definite(const Positions& x, double stale_step = 0);
+  double energy(const EnergyTerms& terms, const Positions& x) const;
+  Eigen::VectorXd gradient(const EnergyTerms& terms, const Positions& x) const;
+  // Factors the true Hessian at x into `ws`; false if it is not positive definite (then `ws`
+  // holds no factorization).
+  bool factor(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x) const;
+  // Y = H⁻¹ rhs with the factorization `ws` holds (rows of fixed dofs zero). Throws
+  // std::runtime_error when it holds none.
+  Eigen::MatrixXd solve_with_factor(const StaticsWorkspace& ws, const Eigen::MatrixXd& rhs) const;
+  // Largest distance of a node of x from the point of `ws`'s factorization; +inf without one.
+  double factor_distance(const StaticsWorkspace& ws, const Positions& x) const;
   // The true Hessian at x, lower triangle, fixed dofs eliminated (for tests and tools).
-  SparseMatrix hessian(const Positions& x);
+  SparseMatrix hessian(const EnergyTerms& terms, const Positions& x) const;
 
-  const std::vector<char>& fixed_dof() const { return assembler_.fixed_dof(); }
+  int node_count() const { return node_count_; }
+  const std::vector<char>& fixed_dof() const { return fixed_dof_; }
   const StaticsOptions& options() const { return options_; }
-  void set_force_tolerance(double tolerance) { options_.force_tolerance = tolerance; }
   // The tolerance Newton stops at: the larger of force_tolerance and force_roundoff.
   double effective_tolerance() const { return std::max(options_.force_tolerance, options_.force_roundoff); }
-  void set_chord_steps(bool on) { options_.chord_steps = on; }
-  int factorizations() const { return factorizations_; }
 
  private:
-  StaticsResult newton(Positions& x, int max_iterations);
   double max_force(const Eigen::VectorXd& gradient) const;
-  // Assembles and factors at x; projected = use PSD-projected element Hessians.
-  bool factor_at(const Positions& x, bool projected);
-  // Why the projected Hessian factor_at just assembled could not be factored, with its
-  // conditioning.
-  std::string singular_reason() const;
+  // Assembles and factors at x into ws; projected = use PSD-projected element Hessians.
+  bool factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x, bool projected) const;
+  // Why the projected Hessian factor_at just assembled in ws could not be factored.
+  std::string singular_reason(const StaticsWorkspace& ws) const;
 
   int node_count_;
-  std::vector<const EnergyTerm*> terms_;
+  std::vector<char> fixed_dof_;
   StaticsOptions options_;
-  HessianAssembler assembler_;
-  SparseCholesky cholesky_;
-  Triplets triplets_;
-  bool analyzed_ = false;
-  // What the current factor is of: the true Hessian at factor_x_, or not usable.
-  bool factor_is_true_ = false;
-  Positions factor_x_;
-  int factorizations_ = 0;
-  // The result of the last solve and how far its last Newton step (from factor_x_) moved.
-  Positions solved_x_;
-  double last_step_from_factor_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace shapectl

@@ -1,0 +1,41 @@
+#pragma once
+// The changing half of a gripped object (the fixed half is GrippedObject): joint angles θ, the
+// robot's kinematics at θ, the object's positions (the equilibrium x̂(θ) after a converged
+// solve), the last solve's result, and the factorization with the point it belongs to. Every
+// algorithm on a GrippedObject takes one explicitly; nothing else remembers a past call.
+// Made by GrippedObject::make_state; move-only (it owns its factorization); one thread at a
+// time changes it.
+#include <memory>
+
+#include <shapectl/robot/kinematics.hpp>
+#include <shapectl/sim/statics.hpp>
+
+namespace shapectl {
+
+class ObjectState {
+ public:
+  ObjectState(ObjectState&&) noexcept = default;
+  ObjectState& operator=(ObjectState&&) noexcept = default;
+  ObjectState(const ObjectState&) = delete;
+  ObjectState& operator=(const ObjectState&) = delete;
+
+  const Eigen::VectorXd& joints() const { return joints_; }
+  const KinematicsState& kinematics() const { return kinematics_; }
+  const Positions& positions() const { return positions_; }
+  const StaticsResult& statics() const { return statics_; }
+  // Whether it holds a factorization (of the Hessian at its positions, or at the last Newton
+  // iterate before them).
+  bool has_factor() const { return workspace_ && workspace_->has_factor; }
+
+ private:
+  friend class GrippedObject;
+  ObjectState() = default;
+
+  Eigen::VectorXd joints_;
+  KinematicsState kinematics_;
+  Positions positions_;
+  StaticsResult statics_;
+  std::shared_ptr<StaticsWorkspace> workspace_;  // from the object's pool
+};
+
+}  // namespace shapectl
