@@ -168,7 +168,7 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
     }
   std::printf("  buckling (grips pushed 2 x 4 cm together), gauss-newton: %s after %d iterations, %.0f ms; "
               "< 1 mm after %.0f ms; final mean error %.3f mm\n",
-              r.converged ? "converged" : "stopped", r.iterations, 1e3 * seconds(t0, Clock::now()),
+              to_string(r.termination), r.iterations, 1e3 * seconds(t0, Clock::now()),
               1e3 * to_1mm, 1e3 * r.best.error.mean);
 }
 

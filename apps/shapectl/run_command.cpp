@@ -57,7 +57,7 @@ nlohmann::json link_json(const LinkStatus& s) {
 
 // Why running on cannot settle, or empty.
 std::string cannot_settle(const ControllerSnapshot& s, const LinkStatus& link, bool armed_once) {
-  if (s.status == "stuck") return "optimizer stuck: no acceptable step (error " + std::to_string(s.error.mean) + " m)";
+  if (s.status == ControllerStatus::Stuck) return "optimizer stuck: no acceptable step (error " + std::to_string(s.error.mean) + " m)";
   if (!s.last_error.empty()) return "optimizer: " + s.last_error;
   if (armed_once && !link.armed) return "robot link disarmed: " + link.reason;
   return {};
@@ -65,7 +65,7 @@ std::string cannot_settle(const ControllerSnapshot& s, const LinkStatus& link, b
 
 void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
   log.write("optimizer", {{"sequence", s.sequence},
-                          {"status", s.status},
+                          {"status", to_string(s.status)},
                           {"joints", to_list(s.joints)},
                           {"safe", s.safe},
                           {"error_mean", s.error.mean},
@@ -139,7 +139,7 @@ void run(RunArgs args) {
     }
     const LinkStatus st = link->status();
     // A progress line whenever the state changes.
-    const std::string report = snap->status + "; robot " +
+    const std::string report = std::string(to_string(snap->status)) + "; robot " +
                                (st.connected ? "connected" : "not connected") + ", " +
                                (st.armed ? (st.arrived ? "arrived" : "moving") : "not armed: " + st.reason);
     if (report != last_report) {
@@ -149,7 +149,7 @@ void run(RunArgs args) {
     if (args.until_settled) {
       failure = cannot_settle(*snap, st, armed_once);
       if (!failure.empty()) break;
-      if (snap->status == "converged") {
+      if (snap->status == ControllerStatus::Converged) {
         // Not armed, the robot is never asked to move: it cannot arrive, so say so.
         if (!armed_once) {
           failure = "the optimizer converged, but the robot is not armed (--arm), so it cannot arrive";
@@ -164,7 +164,7 @@ void run(RunArgs args) {
     if (args.timeout > 0 && elapsed() >= args.timeout) {
       if (args.until_settled)
         failure = "not settled after " + std::to_string(args.timeout) + " s: optimizer " +
-                  snap->status + ", robot " + (st.arrived ? "arrived" : "not arrived");
+                  to_string(snap->status) + ", robot " + (st.arrived ? "arrived" : "not arrived");
       break;
     }
   }
@@ -177,7 +177,7 @@ void run(RunArgs args) {
   link->stop();
 
   nlohmann::json result = {{"settled", settled},
-                           {"status", snap->status},
+                           {"status", to_string(snap->status)},
                            {"error_mean", snap->error.mean},
                            {"error_max", snap->error.max},
                            {"iterations", snap->iterations},

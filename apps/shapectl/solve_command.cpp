@@ -51,10 +51,10 @@ void run_solve(const SolveArgs& args) {
   const TargetsInput input = load_targets(args.targets, object.node_count());
   const ReducedObjective objective(object, resolve_targets(input, args.targets, object));
 
-  const OptimizerKind kind = args.optimizer == "lbfgs" ? OptimizerKind::Lbfgs : OptimizerKind::GaussNewton;
-  const GradientMethod gradient = args.gradient == "adjoint"             ? GradientMethod::Adjoint
-                                  : args.gradient == "finite-difference" ? GradientMethod::FiniteDifference
-                                                                         : GradientMethod::Sensitivity;
+  OptimizerKind kind;
+  GradientMethod gradient;
+  if (!parse(args.optimizer, &kind)) throw InputError("--optimizer", "", "one of the optimizer names", args.optimizer);
+  if (!parse(args.gradient, &gradient)) throw InputError("--gradient", "", "one of the gradient names", args.gradient);
   auto optimizer = make_optimizer(kind, gradient);
   const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
   if (!start.statics.converged())
@@ -65,7 +65,8 @@ void run_solve(const SolveArgs& args) {
 
   const Evaluation& best = result.best;
   nlohmann::json out = robot_json(scene, best.joints);
-  out["converged"] = result.converged;
+  out["converged"] = result.converged();
+  out["termination"] = to_string(result.termination);
   out["reason"] = result.reason;
   out["iterations"] = result.iterations;
   out["error_mean"] = best.error.mean;
@@ -115,9 +116,9 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
   cmd->add_option("--vtu", args->vtu, "also write the deformed mesh at the best joints as VTU (ParaView)");
   cmd->add_option("--optimizer", args->optimizer, "gauss-newton (default) or lbfgs")
-      ->check(CLI::IsMember({"gauss-newton", "lbfgs"}));
+      ->check(CLI::IsMember(optimizer_names()));
   cmd->add_option("--gradient", args->gradient, "sensitivity (default), adjoint or finite-difference")
-      ->check(CLI::IsMember({"sensitivity", "adjoint", "finite-difference"}));
+      ->check(CLI::IsMember(gradient_names()));
   cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")->check(CLI::Range(1, 100000));
   cmd->add_option("--max-seconds", args->max_seconds, "time limit")->check(CLI::PositiveNumber);
   cmd->callback([args] { run_solve(*args); });

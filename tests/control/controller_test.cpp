@@ -70,7 +70,7 @@ TEST(Controller, PauseAndJogMoveTheRobotWithoutTheOptimizer) {
   controller.step_once();
   const auto s = controller.snapshot();
   EXPECT_TRUE(s->paused);
-  EXPECT_EQ(s->status, "paused");
+  EXPECT_EQ(s->status, ControllerStatus::Paused);
   EXPECT_NEAR(s->joints[0], jog[0], 1e-12);
   EXPECT_EQ(s->iterations, 0u);
   // The object followed: its gripped left end moved.

@@ -121,7 +121,7 @@ TEST_P(OptimizeTest, NonFiniteObjectiveNeitherCrashesNorConverges) {
       EXPECT_EQ(optimizer->step(objective, current), StepOutcome::Stuck) << weight;
       EXPECT_EQ(current.joints, start.joints);
       const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 5});
-      EXPECT_FALSE(result.converged) << result.reason;
+      EXPECT_FALSE(result.converged()) << result.reason;
       EXPECT_NE(result.reason.find("not finite"), std::string::npos) << result.reason;
       EXPECT_EQ(result.best.joints, start.joints);
     }
@@ -162,13 +162,13 @@ TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
   };
   double unlimited = 0;
   const OptimizeResult full = run(1e9, &unlimited);
-  ASSERT_TRUE(full.converged) << full.reason;
+  ASSERT_TRUE(full.converged()) << full.reason;
   ASSERT_GE(unlimited, 6) << "too little work to cut short";
   for (int budget = 0; budget + 2 < unlimited && budget < 40; ++budget) {
     double work = 0;
     const OptimizeResult result = run(budget + 0.5, &work);
     EXPECT_EQ(result.reason, "time limit reached") << "budget " << budget;
-    EXPECT_FALSE(result.converged);
+    EXPECT_FALSE(result.converged());
     EXPECT_LE(work, budget + 1) << "budget " << budget;
   }
 }

@@ -24,7 +24,35 @@ struct Inbox {
     return !targets && !centerline && !clear && !paused && !jog && !reset;
   }
 };
+
+constexpr std::pair<ControllerStatus, const char*> controller_status_names[] = {
+    {ControllerStatus::Idle, "idle"},           {ControllerStatus::Optimizing, "optimizing"},
+    {ControllerStatus::Converged, "converged"}, {ControllerStatus::Stuck, "stuck"},
+    {ControllerStatus::OutOfTime, "out of time"}, {ControllerStatus::Paused, "paused"}};
+
+// The status once iterations stopped with `outcome`.
+ControllerStatus status_after(StepOutcome outcome) {
+  switch (outcome) {
+    case StepOutcome::Converged: return ControllerStatus::Converged;
+    case StepOutcome::Stuck: return ControllerStatus::Stuck;
+    case StepOutcome::OutOfTime: return ControllerStatus::OutOfTime;
+    case StepOutcome::Improved: break;
+  }
+  return ControllerStatus::Optimizing;
+}
 }  // namespace
+
+const char* to_string(ControllerStatus status) {
+  for (const auto& [s, name] : controller_status_names)
+    if (s == status) return name;
+  return "?";
+}
+
+bool parse(std::string_view name, ControllerStatus* status) {
+  for (const auto& [s, n] : controller_status_names)
+    if (name == n) return *status = s, true;
+  return false;
+}
 
 struct Controller::State {
   Scene scene;
@@ -168,10 +196,10 @@ void Controller::State::publish() {
   s->iterations_per_second = rate;
   s->paused = paused;
   s->last_error = last_error;
-  if (paused) s->status = "paused";
-  else if (objective->targets().empty()) s->status = "idle";
-  else if (!idle) s->status = "optimizing";
-  else s->status = to_string(last_outcome);
+  s->status = paused                       ? ControllerStatus::Paused
+              : objective->targets().empty() ? ControllerStatus::Idle
+              : !idle                        ? ControllerStatus::Optimizing
+                                             : status_after(last_outcome);
   {
     std::lock_guard lock(snapshot_mutex);
     s->sequence = ++sequence;

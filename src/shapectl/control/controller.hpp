@@ -9,6 +9,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -23,6 +24,20 @@ struct ControllerOptions {
   OptimizerKind optimizer = OptimizerKind::GaussNewton;
   GradientMethod gradient = GradientMethod::Sensitivity;
 };
+
+// What the controller is doing, as published.
+enum class ControllerStatus {
+  Idle,        // no targets
+  Optimizing,  // iterating
+  Converged,   // stationary at the targets
+  Stuck,       // no acceptable step
+  OutOfTime,   // an iteration ran out of its budget
+  Paused,
+};
+// "idle", "optimizing", "converged", "stuck", "out of time", "paused" (the GUI's names too:
+// web/js/protocol.js).
+const char* to_string(ControllerStatus status);
+bool parse(std::string_view name, ControllerStatus* status);
 
 // One published state. Everything in the world frame, metres and radians.
 struct ControllerSnapshot {
@@ -43,7 +58,7 @@ struct ControllerSnapshot {
   std::uint64_t iterations = 0;   // optimizer iterations so far
   double iterations_per_second = 0;
   bool paused = false;
-  std::string status;  // "idle" (no targets), "optimizing", "converged", "stuck", "paused"
+  ControllerStatus status = ControllerStatus::Idle;
   std::string last_error;  // e.g. statics failure while jogging; empty when fine
 };
 

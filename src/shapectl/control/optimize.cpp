@@ -5,6 +5,25 @@
 
 namespace shapectl {
 
+namespace {
+constexpr std::pair<Termination, const char*> termination_names[] = {
+    {Termination::Converged, "converged"},   {Termination::IterationLimit, "iteration limit"},
+    {Termination::TimeLimit, "time limit"},  {Termination::Stuck, "stuck"},
+    {Termination::Failed, "failed"}};
+}  // namespace
+
+const char* to_string(Termination termination) {
+  for (const auto& [t, name] : termination_names)
+    if (t == termination) return name;
+  return "?";
+}
+
+bool parse(std::string_view name, Termination* termination) {
+  for (const auto& [t, n] : termination_names)
+    if (name == n) return *termination = t, true;
+  return false;
+}
+
 OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer, Evaluation start,
                         const OptimizeOptions& options) {
   using Clock = std::chrono::steady_clock;
@@ -24,10 +43,12 @@ OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer,
   } clear_budget{optimizer};
   for (int it = 1;; ++it) {
     if (it > options.max_iterations) {
+      result.termination = Termination::IterationLimit;
       result.reason = "iteration limit (" + std::to_string(options.max_iterations) + ") reached";
       break;
     }
     if (optimizer.out_of_time()) {
+      result.termination = Termination::TimeLimit;
       result.reason = "time limit reached";
       break;
     }
@@ -35,17 +56,20 @@ OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer,
     result.iterations = it;
     result.history.push_back({it, elapsed(), result.best.error.mean, result.best.objective});
     if (outcome == StepOutcome::Converged) {
-      result.converged = result.best.statics.converged() && std::isfinite(result.best.objective);
-      result.reason = result.converged ? "stationary after " + std::to_string(it) + " iterations"
+      const bool converged = result.best.statics.converged() && std::isfinite(result.best.objective);
+      result.termination = converged ? Termination::Converged : Termination::Failed;
+      result.reason = converged ? "stationary after " + std::to_string(it) + " iterations"
                                        : "stopped after " + std::to_string(it) +
                                              " iterations at a state that is no converged equilibrium";
       break;
     }
     if (outcome == StepOutcome::OutOfTime) {
+      result.termination = Termination::TimeLimit;
       result.reason = "time limit reached";
       break;
     }
     if (outcome == StepOutcome::Stuck) {
+      result.termination = std::isfinite(result.best.objective) ? Termination::Stuck : Termination::Failed;
       result.reason = std::isfinite(result.best.objective)
                           ? "no acceptable step after " + std::to_string(it) +
                                 " iterations (every trial was worse, unsafe or failed statics)"

@@ -1,6 +1,7 @@
 #pragma once
 // Runs an optimizer to convergence (or an iteration/time budget) from a start state.
 #include <functional>
+#include <string_view>
 #include <vector>
 
 #include <shapectl/control/optimizer.hpp>
@@ -23,10 +24,22 @@ struct HistoryEntry {
   double objective = 0;
 };
 
+// Why a run ended.
+enum class Termination {
+  Converged,       // stationary at a converged equilibrium with a finite objective
+  IterationLimit,  // max_iterations done
+  TimeLimit,       // max_seconds spent
+  Stuck,           // no acceptable step (every trial worse, unsafe or failed statics)
+  Failed,          // no step possible or the state is no converged equilibrium
+};
+const char* to_string(Termination termination);
+bool parse(std::string_view name, Termination* termination);
+
 struct OptimizeResult {
-  Evaluation best;        // the state reached (safe if the start was)
-  bool converged = false;  // stationary at a finite objective, not merely out of budget
-  std::string reason;
+  Evaluation best;  // the state reached (safe if the start was)
+  Termination termination = Termination::Failed;
+  std::string reason;  // the termination in words, with numbers
+  bool converged() const { return termination == Termination::Converged; }
   int iterations = 0;
   std::vector<HistoryEntry> history;  // entry 0 is the start
 };

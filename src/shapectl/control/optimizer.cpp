@@ -16,6 +16,29 @@ const char* to_string(StepOutcome outcome) {
 }
 
 namespace {
+constexpr std::pair<OptimizerKind, const char*> optimizer_kind_names[] = {
+    {OptimizerKind::GaussNewton, "gauss-newton"}, {OptimizerKind::Lbfgs, "lbfgs"}};
+}  // namespace
+
+const char* to_string(OptimizerKind kind) {
+  for (const auto& [k, name] : optimizer_kind_names)
+    if (k == kind) return name;
+  return "?";
+}
+
+bool parse(std::string_view name, OptimizerKind* kind) {
+  for (const auto& [k, n] : optimizer_kind_names)
+    if (name == n) return *kind = k, true;
+  return false;
+}
+
+std::vector<std::string> optimizer_names() {
+  std::vector<std::string> out;
+  for (const auto& entry : optimizer_kind_names) out.push_back(entry.second);
+  return out;
+}
+
+namespace {
 // A trial may replace the current state if it is at least as safe and strictly better (a
 // non-finite objective is neither).
 bool acceptable(const Evaluation& trial, const Evaluation& current, double required_objective) {

@@ -7,6 +7,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include <shapectl/control/reduced_objective.hpp>
 
@@ -38,12 +40,16 @@ class Optimizer {
 };
 
 enum class OptimizerKind { GaussNewton, Lbfgs };
+// "gauss-newton", "lbfgs": the names the CLI, bench and server use.
+const char* to_string(OptimizerKind kind);
+bool parse(std::string_view name, OptimizerKind* kind);
+std::vector<std::string> optimizer_names();
 
 // Levenberg–Marquardt on the residual form; J from direct sensitivities plus the barrier
 // residual Jacobians. The next equilibrium is predicted with dx̂/dθ·Δθ before Newton starts.
 class GaussNewton : public Optimizer {
  public:
-  std::string name() const override { return "gauss-newton"; }
+  std::string name() const override { return to_string(OptimizerKind::GaussNewton); }
   StepOutcome step(const ReducedObjective& objective, Evaluation& current) override;
   void reset() override { damping_ = kInitialDamping; }
   double max_step = 0.3;  // rad, largest joint change per trial
@@ -61,7 +67,7 @@ class GaussNewton : public Optimizer {
 class Lbfgs : public Optimizer {
  public:
   explicit Lbfgs(GradientMethod method) : method_(method) {}
-  std::string name() const override { return "lbfgs"; }
+  std::string name() const override { return to_string(OptimizerKind::Lbfgs); }
   StepOutcome step(const ReducedObjective& objective, Evaluation& current) override;
   void reset() override;
   int memory = 8;

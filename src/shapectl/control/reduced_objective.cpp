@@ -9,7 +9,29 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
+constexpr std::pair<GradientMethod, const char*> gradient_method_names[] = {
+    {GradientMethod::Sensitivity, "sensitivity"},
+    {GradientMethod::Adjoint, "adjoint"},
+    {GradientMethod::FiniteDifference, "finite-difference"}};
 }  // namespace
+
+const char* to_string(GradientMethod method) {
+  for (const auto& [m, name] : gradient_method_names)
+    if (m == method) return name;
+  return "?";
+}
+
+bool parse(std::string_view name, GradientMethod* method) {
+  for (const auto& [m, n] : gradient_method_names)
+    if (name == n) return *method = m, true;
+  return false;
+}
+
+std::vector<std::string> gradient_names() {
+  std::vector<std::string> out;
+  for (const auto& entry : gradient_method_names) out.push_back(entry.second);
+  return out;
+}
 
 ReducedObjective::ReducedObjective(const GrippedObject& object, ShapeTargets targets,
                                    ObjectiveOptions options)

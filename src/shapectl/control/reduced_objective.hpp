@@ -8,6 +8,9 @@
 #include <mutex>
 #include <limits>
 #include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include <shapectl/control/shape_targets.hpp>
 #include <shapectl/robot/joint_limits.hpp>
@@ -16,6 +19,10 @@
 namespace shapectl {
 
 enum class GradientMethod { Sensitivity, Adjoint, FiniteDifference };
+// "sensitivity", "adjoint", "finite-difference".
+const char* to_string(GradientMethod method);
+bool parse(std::string_view name, GradientMethod* method);
+std::vector<std::string> gradient_names();
 
 // Everything known about one θ. Copies share one ObjectState (the equilibrium and its
 // factorization), which the derivatives at this θ use.

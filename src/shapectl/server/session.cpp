@@ -291,7 +291,7 @@ void Session::tick() {
   if (link_) link_->set_target(snapshot_->joints, snapshot_->safe);
 }
 
-bool Session::busy() const { return snapshot_->status == "optimizing"; }
+bool Session::busy() const { return snapshot_->status == ControllerStatus::Optimizing; }
 
 nlohmann::json Session::describe_scene() const {
   const Scene& scene = controller_->scene();
@@ -350,7 +350,7 @@ std::string Session::state_message(int clients) const {
       {"seq", s.sequence},
       {"time", t},
       {"controller_time", s.time},
-      {"status", s.status},
+      {"status", to_string(s.status)},
       {"paused", s.paused},
       {"safe", s.safe},
       {"within_limits", s.within_limits},
