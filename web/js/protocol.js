@@ -28,11 +28,13 @@ export const Message = Object.freeze({
 });
 
 // A state's "status": what the optimizer is doing.
+// The same list as ControllerStatus in src/shapectl/control/controller.hpp (to_string there).
 export const ControllerStatus = Object.freeze({
   Idle: 'idle',  // no targets
   Optimizing: 'optimizing',
   Converged: 'converged',
   Stuck: 'stuck',
+  OutOfTime: 'out of time',  // an iteration ran out of its budget
   Paused: 'paused',
 });
 
