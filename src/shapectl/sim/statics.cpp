@@ -120,140 +120,149 @@ std::string StaticsSolver::singular_reason(const StaticsWorkspace& ws) const {
              : "; the held nodes may leave a rigid motion free, e.g. a rotation about one node)");
 }
 
+double StaticsSolver::largest_node_step(const Eigen::VectorXd& dx) const {
+  double step = 0;
+  for (int i = 0; i < node_count_; ++i) step = std::max(step, dx.segment<3>(3 * i).norm());
+  return step;
+}
+
+double StaticsSolver::energy_noise(double energy) const {
+  return std::max(options_.energy_roundoff, 1e-12 * std::abs(energy)) + 1e-300;
+}
+
+bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord, Positions& x,
+                               Point& at, NewtonIterate& log) const {
+  // The full step with the earlier factorization, kept while it lowers the energy and cuts the
+  // force 4-fold.
+  Eigen::VectorXd dx;
+  {
+    std::lock_guard lock(*chord.solve_mutex);
+    dx = -chord.cholesky.solve(at.gradient);
+  }
+  if (!(at.gradient.dot(dx) < 0)) return false;
+  Positions trial = x + dx;
+  const double e_trial = energy(terms, trial);
+  if (!std::isfinite(e_trial) || e_trial > at.energy + energy_noise(at.energy)) return false;
+  Eigen::VectorXd g_trial = gradient(terms, trial);
+  const double r_trial = max_force(g_trial);
+  if (!(r_trial <= 0.25 * at.residual)) return false;
+  log.chord = true;
+  log.step_length = 1;
+  log.step = largest_node_step(dx);
+  x = std::move(trial);
+  at = {e_trial, std::move(g_trial), r_trial};
+  return true;
+}
+
+Eigen::VectorXd StaticsSolver::newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
+                                                const Positions& x, const Eigen::VectorXd& g,
+                                                NewtonIterate& log, int& factorizations) const {
+  // The true Hessian at x, if it gives a descent direction; else the PSD-projected one.
+  ++factorizations;
+  if (factor_at(terms, ws, x, false)) {
+    Eigen::VectorXd dx = -ws.cholesky.solve(g);
+    if (g.dot(dx) < 0) return dx;
+  }
+  log.projected = true;
+  ++factorizations;
+  if (!factor_at(terms, ws, x, true)) return {};
+  return -ws.cholesky.solve(g);
+}
+
+bool StaticsSolver::line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x,
+                                Point& at, NewtonIterate& log) const {
+  // Backtracking (see the header). Inverted trial states have E = +inf.
+  const double slope = at.gradient.dot(dx);
+  const double noise = energy_noise(at.energy);
+  const double force_norm2 = at.gradient.squaredNorm();
+  double alpha = 1.0;
+  for (int k = 0; k < 40; ++k, alpha *= 0.5) {
+    Positions trial = x + alpha * dx;
+    const double e_trial = energy(terms, trial);
+    if (!std::isfinite(e_trial)) continue;
+    const bool armijo = e_trial <= at.energy + 1e-4 * alpha * slope;
+    if (!armijo && e_trial > at.energy + noise) continue;
+    Eigen::VectorXd g_trial = gradient(terms, trial);
+    const double r_trial = max_force(g_trial);
+    if (!std::isfinite(r_trial)) continue;
+    // Energy within round-off of the start: the force norm decides.
+    if (!armijo && !(g_trial.squaredNorm() <= (1 - 1e-4 * alpha) * force_norm2)) continue;
+    log.step_length = alpha;
+    log.step = largest_node_step(alpha * dx);
+    x = std::move(trial);
+    at = {e_trial, std::move(g_trial), r_trial};
+    return true;
+  }
+  return false;
+}
+
 StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& ws, Positions& x,
                                    int max_iterations, const StaticsWorkspace* chord) const {
   if (max_iterations <= 0) max_iterations = options_.max_iterations;
   StaticsResult result;
-  double e = energy(terms, x);
-  if (!std::isfinite(e)) {
+  Point at;
+  at.energy = energy(terms, x);
+  if (!std::isfinite(at.energy)) {
     result.status = StaticsStatus::Inverted;
     result.reason = "the starting state has an inverted element or a non-finite energy";
     return result;
   }
-  Eigen::VectorXd g = gradient(terms, x);
-  double residual = max_force(g);
+  at.gradient = gradient(terms, x);
+  at.residual = max_force(at.gradient);
   const double tolerance = effective_tolerance();
   if (!(tolerance < std::numeric_limits<double>::infinity())) {
     result.status = StaticsStatus::NotConverged;
-    result.residual = residual;
-    result.energy = e;
+    result.residual = at.residual;
+    result.energy = at.energy;
     result.reason = "not converged: the force tolerance " + sci(tolerance) + " N is non-finite";
     return result;
   }
-  // Energy differences below this are round-off (see the header).
-  auto energy_noise = [&](double energy) {
-    return std::max(options_.energy_roundoff, 1e-12 * std::abs(energy)) + 1e-300;
-  };
+  // Chord steps first: the true Hessian's factor of a nearby state is used while it works.
+  // This saves the factorization, the dominant cost, on warm re-solves. Once the solve factors
+  // anew it stays with Newton: chord steps from a factor of an earlier iterate stalled Newton
+  // near buckling (seconds instead of milliseconds in `shapectl bench`), and Newton's last
+  // step leaves a factorization the sensitivities can reuse.
   bool may_chord = chord && chord->has_factor && chord->factor_x.size() == x.size();
   for (int it = 0;; ++it) {
     result.iterations = it;
-    result.residual = residual;
-    result.energy = e;
-    if (!std::isfinite(residual)) {
+    result.residual = at.residual;
+    result.energy = at.energy;
+    if (!std::isfinite(at.residual)) {
       result.status = StaticsStatus::NotConverged;
       result.reason = "not converged: non-finite force after " + std::to_string(it) + " iterations";
       return result;
     }
-    if (residual <= tolerance && x.allFinite()) {
+    if (at.residual <= tolerance && x.allFinite()) {
       result.status = StaticsStatus::Converged;
-      result.reason = "residual " + sci(residual) + " N after " + std::to_string(it) + " iterations";
+      result.reason = "residual " + sci(at.residual) + " N after " + std::to_string(it) + " iterations";
       return result;
     }
     if (it == max_iterations) {
       result.status = StaticsStatus::NotConverged;
-      result.reason = "not converged: residual " + sci(residual) + " N after " +
+      result.reason = "not converged: residual " + sci(at.residual) + " N after " +
                       std::to_string(it) + " iterations";
       return result;
     }
-    NewtonIterate log{.iteration = it, .residual = residual, .energy = e};
-    // Chord steps first: the true Hessian's factor from before this solve (a nearby state) is
-    // kept while its full step lowers the energy and cuts the force 4-fold. This saves the
-    // factorization, the dominant cost, on warm re-solves. Once the solve factors anew it
-    // stays with Newton: chord steps from a factor of an earlier iterate stalled Newton near
-    // buckling (seconds instead of milliseconds in `shapectl bench`), and Newton's last step
-    // leaves a factorization the sensitivities can reuse.
-    if (may_chord) {
-      Eigen::VectorXd dx;
-      {
-        std::lock_guard lock(*chord->solve_mutex);
-        dx = -chord->cholesky.solve(g);
-      }
-      if (g.dot(dx) < 0) {
-        Positions trial = x + dx;
-        const double e_trial = energy(terms, trial);
-        if (std::isfinite(e_trial) && e_trial <= e + energy_noise(e)) {
-          Eigen::VectorXd g_trial = gradient(terms, trial);
-          const double r_trial = max_force(g_trial);
-          if (r_trial <= 0.25 * residual) {
-            log.chord = true;
-            log.step_length = 1;
-            for (int i = 0; i < node_count_; ++i) log.step = std::max(log.step, dx.segment<3>(3 * i).norm());
-            result.log.push_back(log);
-            x = std::move(trial);
-            e = e_trial;
-            g = std::move(g_trial);
-            residual = r_trial;
-            continue;
-          }
-        }
-      }
+    NewtonIterate log{.iteration = it, .residual = at.residual, .energy = at.energy};
+    if (may_chord && chord_step(terms, *chord, x, at, log)) {
+      result.log.push_back(log);
+      continue;
     }
     may_chord = false;
-    // True Hessian at x; it must also give a descent direction.
-    Eigen::VectorXd dx;
-    ++result.factorizations;
-    if (factor_at(terms, ws, x, false)) {
-      dx = -ws.cholesky.solve(g);
-      if (!(g.dot(dx) < 0)) dx.resize(0);
-    }
+    const Eigen::VectorXd dx = newton_direction(terms, ws, x, at.gradient, log, result.factorizations);
     if (dx.size() == 0) {
-      log.projected = true;
-      ++result.factorizations;
-      if (!factor_at(terms, ws, x, true)) {
-        result.status = StaticsStatus::Singular;
-        result.reason = singular_reason(ws);
-        return result;
-      }
-      dx = -ws.cholesky.solve(g);
+      result.status = StaticsStatus::Singular;
+      result.reason = singular_reason(ws);
+      return result;
     }
-    // Backtracking line search (see the header). Inverted trial states have E = +inf.
-    const double slope = g.dot(dx);
-    const double noise = energy_noise(e);
-    const double force_norm2 = g.squaredNorm();
-    double alpha = 1.0;
-    Positions trial;
-    double e_trial = 0;
-    Eigen::VectorXd g_trial;
-    double r_trial = 0;
-    bool accepted = false;
-    for (int k = 0; k < 40 && !accepted; ++k, alpha *= 0.5) {
-      trial = x + alpha * dx;
-      e_trial = energy(terms, trial);
-      if (!std::isfinite(e_trial)) continue;
-      const bool armijo = e_trial <= e + 1e-4 * alpha * slope;
-      if (!armijo && e_trial > e + noise) continue;
-      g_trial = gradient(terms, trial);
-      r_trial = max_force(g_trial);
-      if (!std::isfinite(r_trial)) continue;
-      // Energy within round-off of the start: the force norm decides.
-      accepted = armijo || g_trial.squaredNorm() <= (1 - 1e-4 * alpha) * force_norm2;
-    }
-    if (!accepted) {
+    const double residual_before = at.residual;
+    if (!line_search(terms, dx, x, at, log)) {
       result.status = StaticsStatus::NotConverged;
-      result.reason = "line search failed at residual " + sci(residual) + " N after " +
+      result.reason = "line search failed at residual " + sci(residual_before) + " N after " +
                       std::to_string(it) + " iterations";
       return result;
     }
-    alpha *= 2;  // undo the last halving of the loop
-    log.step_length = alpha;
-    double step = 0;
-    for (int i = 0; i < node_count_; ++i) step = std::max(step, alpha * dx.segment<3>(3 * i).norm());
-    log.step = step;
     result.log.push_back(log);
-    x = trial;
-    e = e_trial;
-    g = g_trial;
-    residual = r_trial;
   }
 }
 

@@ -126,6 +126,23 @@ class StaticsSolver {
   double effective_tolerance() const { return std::max(options_.force_tolerance, options_.force_roundoff); }
 
  private:
+  // Energy, gradient and largest nodal force at one iterate.
+  struct Point {
+    double energy = 0;
+    Eigen::VectorXd gradient;
+    double residual = 0;
+  };
+  // The steps of solve(): each returns false when it cannot move x (x and `at` unchanged).
+  bool chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord, Positions& x, Point& at,
+                  NewtonIterate& log) const;
+  // Empty when not even the projected Hessian factors.
+  Eigen::VectorXd newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
+                                   const Eigen::VectorXd& g, NewtonIterate& log, int& factorizations) const;
+  bool line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x, Point& at,
+                   NewtonIterate& log) const;
+  double largest_node_step(const Eigen::VectorXd& dx) const;
+  // Energy differences below this are round-off (see the top of this file).
+  double energy_noise(double energy) const;
   double max_force(const Eigen::VectorXd& gradient) const;
   // Assembles and factors at x into ws; projected = use PSD-projected element Hessians.
   bool factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x, bool projected) const;
