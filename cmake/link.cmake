@@ -1,5 +1,5 @@
-# The robot link area: EGM protocol code generated from proto/egm.proto with Debian's protoc,
-# the link library, its tests. Included by the top CMakeLists.txt before the CLI target.
+# link/: robot streaming (EGM protocol code generated from proto/egm.proto with Debian's
+# protoc), the motion governor.
 find_package(Protobuf REQUIRED)
 
 set(egm_proto ${PROJECT_SOURCE_DIR}/proto/egm.proto)
@@ -11,13 +11,14 @@ add_custom_command(
   DEPENDS ${egm_proto} protobuf::protoc
   COMMENT "Generating EGM protocol code from proto/egm.proto")
 
-shapectl_area(link shapectl_control protobuf::libprotobuf)
+shapectl_area(link)
+target_link_libraries(shapectl_link PUBLIC shapectl_io nlohmann_json::nlohmann_json
+                      PRIVATE shapectl_robot protobuf::libprotobuf)
 target_sources(shapectl_link PRIVATE ${egm_generated}/egm.pb.cc)
 # Only the codec sees the generated types; nothing public depends on them.
 target_include_directories(shapectl_link PRIVATE ${egm_generated})
 set_source_files_properties(${egm_generated}/egm.pb.cc PROPERTIES COMPILE_OPTIONS "-w")
+# Its sources share helper names (to_list, ...) in anonymous namespaces: one unit each.
+set_target_properties(shapectl_link PROPERTIES UNITY_BUILD OFF)
 
-target_link_libraries(shapectl INTERFACE shapectl_link)
-
-# shapectl_tests() is defined after this file is included: call it at the end of the directory.
-cmake_language(DEFER CALL shapectl_tests link shapectl_link)
+shapectl_tests(link shapectl_link)

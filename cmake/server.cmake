@@ -1,43 +1,13 @@
-# server/: HTTP + WebSocket GUI backend (Boost.Beast, header-only), its tests and the browser tests.
+# server/: HTTP + WebSocket GUI backend (Boost.Beast, header-only).
 find_package(Boost 1.74 REQUIRED)
 find_package(Threads REQUIRED)
-shapectl_area(server shapectl_control Boost::headers Threads::Threads)
+
+shapectl_area(server)
+target_link_libraries(shapectl_server PUBLIC shapectl_control nlohmann_json::nlohmann_json
+                      PRIVATE shapectl_io shapectl_link shapectl_sim Boost::headers Threads::Threads)
 target_compile_definitions(shapectl_server PRIVATE SHAPECTL_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
-target_link_libraries(shapectl INTERFACE shapectl_server)
 
-# Tests: the top-level file defines shapectl_tests and enables testing after including this one.
-function(shapectl_server_tests)
-  shapectl_tests(server shapectl_server)
+shapectl_tests(server shapectl_server Boost::headers)
+if(TARGET server_tests)
   add_dependencies(server_tests shapectl_cli)  # serve_cli_test runs the CLI
-endfunction()
-cmake_language(DEFER CALL shapectl_server_tests)
-
-# Browser end-to-end tests and the WebSocket fuzz test (Node; web/node_modules from `npm ci`).
-# They are part of the test command: missing tools stop the configure instead of silently
-# dropping the tests (scripts/setup.sh installs them first). SHAPECTL_WEB_TESTS=OFF opts out.
-option(SHAPECTL_WEB_TESTS "Register the browser and WebSocket fuzz tests (needs node, npm ci, chromium)" ON)
-function(shapectl_web_tests)
-  if(NOT SHAPECTL_WEB_TESTS)
-    return()
-  endif()
-  find_program(NODE_EXECUTABLE node)
-  if(NOT NODE_EXECUTABLE)
-    message(FATAL_ERROR "node not found: the browser tests need it (apt-get install nodejs npm, "
-                        "or run scripts/setup.sh; -DSHAPECTL_WEB_TESTS=OFF to build without them)")
-  endif()
-  if(NOT EXISTS ${PROJECT_SOURCE_DIR}/web/node_modules/playwright-core/index.mjs)
-    message(FATAL_ERROR "web/node_modules is missing: run `npm ci` in web/ (scripts/setup.sh does) "
-                        "or configure with -DSHAPECTL_WEB_TESTS=OFF")
-  endif()
-  if(NOT EXISTS /usr/bin/chromium)
-    message(FATAL_ERROR "/usr/bin/chromium is missing: apt-get install chromium "
-                        "or configure with -DSHAPECTL_WEB_TESTS=OFF")
-  endif()
-  foreach(script gui_e2e ws_fuzz robot_link)
-    add_test(NAME web_${script}
-      COMMAND ${NODE_EXECUTABLE} --test --test-reporter=spec ${PROJECT_SOURCE_DIR}/tests/web/${script}.test.mjs)
-    set_tests_properties(web_${script} PROPERTIES TIMEOUT 300
-      ENVIRONMENT "SHAPECTL_CLI=$<TARGET_FILE:shapectl_cli>;SHAPECTL_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
-  endforeach()
-endfunction()
-cmake_language(DEFER CALL shapectl_web_tests)
+endif()

@@ -3,5 +3,5 @@
 # foam bar scene and a simulated robot. Open the printed address; Ctrl-C stops it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/setup.sh
+bash scripts/setup.sh shapectl_cli  # the CLI and its libraries only: no tests, no benchmarks
 exec ./build/shapectl serve scenes/yumi_bar.json --robot sim --port "${SHAPECTL_PORT:-8080}"

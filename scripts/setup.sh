@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Installs what shapectl needs from Debian 12 and builds it in ./build (Release).
 # Idempotent: packages already present are not touched, the build is incremental.
+# Arguments name the targets to build (scripts/run.sh: shapectl_cli); none builds everything.
+# The configuration is the same either way (tests and benchmarks on), so a later full build in
+# ./build picks up where a partial one stopped.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -47,9 +50,12 @@ if [ "$(cat web/node_modules/.shapectl-lock-sha256 2>/dev/null)" != "$lock_sum" 
 fi
 
 # CMake's progress lines are dropped; its warnings and errors are shown.
-if ! configure_log=$(cmake -S . -B build -DCMAKE_BUILD_TYPE=Release 2>&1); then
+if ! configure_log=$(cmake -S . -B build -DCMAKE_BUILD_TYPE=Release \
+                     -DSHAPECTL_BUILD_TESTS=ON -DSHAPECTL_BUILD_BENCHMARKS=ON 2>&1); then
   echo "$configure_log" >&2
   exit 1
 fi
 grep -v -e '^-- ' -e '^$' <<<"$configure_log" >&2 || true
-cmake --build build -j "$(nproc)"
+targets=()
+if [ $# -gt 0 ]; then targets=(--target "$@"); fi
+cmake --build build -j "$(nproc)" "${targets[@]}"
