@@ -69,7 +69,7 @@ BENCHMARK(BM_GovernorStepYumi);
 void BM_EgmFeedbackToCommand(benchmark::State& state) {
   const RobotModel robot = yumi_arms();
   LinkConfig config;
-  config.kind = "egm";
+  config.kind = LinkKind::Egm;
   config.egm_address = "127.0.0.1";
   config.egm_left_port = config.egm_right_port = 0;
   EgmLink link(config, robot, {}, nullptr);

@@ -48,7 +48,7 @@ std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& eve
   const Scene scene = load_scene(scene_file);
   if (!scene.robot) throw InputError(scene_file, "robot", "replay needs a scene with a robot");
   LinkConfig config = args.link;
-  config.kind = args.robot;
+  parse(args.robot, &config.kind);  // checked by the option
   config.sim_initial_joints = scene.robot->reference_joints;
   auto link = make_robot_link(config, *scene.robot->model, scene.robot->collisions);
   install_stop_signal_handlers();
@@ -119,7 +119,7 @@ void add_replay_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("replay", "Check a session log and replay it to a robot link");
   cmd->add_option("log", args->log, "LOG.jsonl written by run --log")->required();
   cmd->add_option("--robot", args->robot, "replay to this link: sim or egm (default: check only)")
-      ->check(CLI::IsMember({"sim", "egm"}));
+      ->check(CLI::IsMember(link_kind_names()));
   cmd->add_flag("--arm", args->arm, "arm the link so the robot moves");
   cmd->add_option("--speed", args->speed, "time scale (2: twice as fast)")->capture_default_str();
   cmd->add_option("--scene", args->scene, "SCENE.json (default: the one the log names)");

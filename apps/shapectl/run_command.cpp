@@ -34,6 +34,7 @@ struct RunArgs {
   bool arm = false;
   bool until_settled = false;
   double timeout = 0;  // s; 0: none
+  std::string robot = "sim";  // a LinkKind name
   LinkConfig link;
   double watchdog_ms = 100;
 };
@@ -79,6 +80,7 @@ void run(RunArgs args) {
   print_scene_notes(scene);
   if (!scene.robot) throw InputError(args.scene, "robot", "run needs a scene with a robot");
   const TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
+  parse(args.robot, &args.link.kind);  // checked by the option
   args.link.watchdog_timeout = args.watchdog_ms / 1000;
   args.link.sim_initial_joints = scene.robot->reference_joints;
   if (args.timeout < 0) throw InputError("run", "--timeout", "a number >= 0", args.timeout);
@@ -89,7 +91,7 @@ void run(RunArgs args) {
     log->write("session", {{"command", "run"},
                            {"scene", std::filesystem::absolute(args.scene).string()},
                            {"targets_file", args.targets},
-                           {"robot", args.link.kind},
+                           {"robot", to_string(args.link.kind)},
                            {"joint_names", scene.robot->model->active_joint_names()}});
   }
   auto link = make_robot_link(args.link, *scene.robot->model, scene.robot->collisions, log);
@@ -201,8 +203,8 @@ void add_run_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("run", "Run the controller and the robot link without a GUI");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
   cmd->add_option("--targets", args->targets, "TARGETS.json")->required();
-  cmd->add_option("--robot", args->link.kind, "robot link: sim (in-process) or egm (ABB EGM)")
-      ->check(CLI::IsMember({"sim", "egm"}))
+  cmd->add_option("--robot", args->robot, "robot link: sim (in-process) or egm (ABB EGM)")
+      ->check(CLI::IsMember(link_kind_names()))
       ->capture_default_str();
   cmd->add_flag("--arm", args->arm, "arm the link: let the robot move (otherwise it holds)");
   cmd->add_option("--log", args->log, "session log to write (JSON lines)");

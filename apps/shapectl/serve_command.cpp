@@ -43,7 +43,7 @@ void run_serve(const ServeArgs& args) {
     const Scene description = load_scene(scene);
     if (!description.robot) throw InputError(scene.string(), "robot", "a robot for --robot " + args.robot);
     LinkConfig config;
-    config.kind = args.robot;
+    parse(args.robot, &config.kind);  // checked by the option
     config.sim_initial_joints = description.robot->reference_joints;
     link = make_robot_link(config, *description.robot->model, description.robot->collisions);
     link->start();

@@ -29,7 +29,7 @@ double seconds(Clock::time_point a, Clock::time_point b) {
 
 LinkConfig config() {
   LinkConfig c;
-  c.kind = "egm";
+  c.kind = LinkKind::Egm;
   c.egm_address = "127.0.0.1";
   c.egm_left_port = c.egm_right_port = 0;
   c.max_velocity = v_max;

@@ -28,7 +28,7 @@ ArmJoints chain(double j1, double j2, double j7, double j3, double j4, double j5
 
 LinkConfig fast_config() {
   LinkConfig c;
-  c.kind = "egm";
+  c.kind = LinkKind::Egm;
   c.egm_address = "127.0.0.1";
   c.egm_left_port = c.egm_right_port = 0;  // any free ports
   c.max_velocity = 1.0;

@@ -55,9 +55,12 @@ TEST(LinkConfig, BadSettingsAreInputErrors) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), "link: max_velocity: expected a positive number, got -1");
   }
-  c = LinkConfig{};
-  c.kind = "ros";
-  EXPECT_THROW(make_robot_link(c, robot), InputError);
+  LinkKind kind;
+  EXPECT_FALSE(parse("ros", &kind));
+  for (LinkKind k : {LinkKind::Sim, LinkKind::Egm}) {
+    ASSERT_TRUE(parse(to_string(k), &kind));
+    EXPECT_EQ(kind, k);
+  }
 }
 
 TEST(LinkConfig, VelocityIsNeverAboveTheRobotsOwn) {

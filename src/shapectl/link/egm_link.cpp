@@ -78,7 +78,7 @@ std::vector<LinkChannel> egm_arm_channels(const RobotModel& robot) {
 EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck check,
                  std::shared_ptr<SessionLog> log)
     : SupervisedLink(config.egm_period, log,
-                     LinkSupervisor("egm", robot.active_joint_names(), egm_arm_channels(robot),
+                     LinkSupervisor(to_string(LinkKind::Egm), robot.active_joint_names(), egm_arm_channels(robot),
                                     robot.lower_limits(), robot.upper_limits(), governor_limits(config, robot),
                                     {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance,
                                      config.egm_period},
@@ -93,7 +93,7 @@ EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
   pending_.resize(sockets_.size());
   latency_us_.reserve(latency_capacity);
   if (log_)
-    log_link_started(*log_, "egm", robot.active_joint_names(), supervisor_.channels(),
+    log_link_started(*log_, to_string(LinkKind::Egm), robot.active_joint_names(), supervisor_.channels(),
                      supervisor_.limits(), period_);
 }
 

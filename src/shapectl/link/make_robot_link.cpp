@@ -19,8 +19,29 @@ void expect_positive(const char* name, double value) {
 
 }  // namespace
 
+namespace {
+constexpr std::pair<LinkKind, const char*> link_kind_names_[] = {{LinkKind::Sim, "sim"}, {LinkKind::Egm, "egm"}};
+}  // namespace
+
+const char* to_string(LinkKind kind) {
+  for (const auto& [k, name] : link_kind_names_)
+    if (k == kind) return name;
+  return "?";
+}
+
+bool parse(std::string_view name, LinkKind* kind) {
+  for (const auto& [k, n] : link_kind_names_)
+    if (name == n) return *kind = k, true;
+  return false;
+}
+
+std::vector<std::string> link_kind_names() {
+  std::vector<std::string> out;
+  for (const auto& entry : link_kind_names_) out.push_back(entry.second);
+  return out;
+}
+
 void validate(const LinkConfig& c) {
-  if (c.kind != "sim" && c.kind != "egm") throw InputError("link", "robot", "sim or egm", c.kind);
   expect_positive("max_velocity", c.max_velocity);
   expect_positive("max_acceleration", c.max_acceleration);
   if (!(c.limit_margin >= 0 && std::isfinite(c.limit_margin)))
@@ -74,7 +95,7 @@ std::unique_ptr<RobotLink> make_robot_link(const LinkConfig& config, const Robot
                                            std::shared_ptr<SessionLog> log) {
   validate(config);
   PoseCheck check = collision_pose_check(robot, std::move(collisions));
-  if (config.kind == "egm") return std::make_unique<EgmLink>(config, robot, std::move(check), std::move(log));
+  if (config.kind == LinkKind::Egm) return std::make_unique<EgmLink>(config, robot, std::move(check), std::move(log));
   return std::make_unique<SimLink>(config, robot, std::move(check), std::move(log));
 }
 

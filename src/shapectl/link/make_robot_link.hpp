@@ -3,13 +3,15 @@
 // make_robot_link (the factory the CLI and the server call).
 //
 //   LinkConfig config;                 // defaults: sim robot, conservative motion limits
-//   config.kind = "egm";
+//   config.kind = LinkKind::Egm;
 //   auto link = make_robot_link(config, scene.robot->model, scene.robot->collisions, log);
 //   link->start();
 //   link->set_target(snapshot->joints, snapshot->safe);   // whenever a snapshot appears
 //   link->arm(&why);  link->disarm("user");  link->status();
 #include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -22,8 +24,15 @@ class CollisionModel;
 class RobotModel;
 class SessionLog;
 
+// Sim: the in-process robot; Egm: ABB EGM over UDP (YuMi).
+enum class LinkKind { Sim, Egm };
+// "sim", "egm": the names of `--robot` and of the state's "link.kind" (web/js/protocol.js).
+const char* to_string(LinkKind kind);
+bool parse(std::string_view name, LinkKind* kind);
+std::vector<std::string> link_kind_names();
+
 struct LinkConfig {
-  std::string kind = "sim";  // "sim": in-process robot; "egm": ABB EGM over UDP (YuMi)
+  LinkKind kind = LinkKind::Sim;
 
   // Motion governor, per joint. The velocity is capped by the robot's own limit (URDF).
   double max_velocity = 0.5;       // rad/s

@@ -32,7 +32,7 @@ Eigen::VectorXd sim_initial(const LinkConfig& config, const RobotModel& robot) {
 SimLink::SimLink(const LinkConfig& config, const RobotModel& robot, PoseCheck check,
                  std::shared_ptr<SessionLog> log)
     : SupervisedLink(config.sim_period, log,
-                     LinkSupervisor("sim", robot.active_joint_names(),
+                     LinkSupervisor(to_string(LinkKind::Sim), robot.active_joint_names(),
                                     {{"robot", [&] {
                                         std::vector<int> all(static_cast<std::size_t>(robot.active_count()));
                                         for (int i = 0; i < robot.active_count(); ++i) all[static_cast<std::size_t>(i)] = i;
@@ -44,7 +44,7 @@ SimLink::SimLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
                                     std::move(check), log.get())),
       robot_(sim_robot_limits(config, robot, supervisor_.limits()), sim_initial(config, robot)) {
   if (log_)
-    log_link_started(*log_, "sim", robot.active_joint_names(), supervisor_.channels(),
+    log_link_started(*log_, to_string(LinkKind::Sim), robot.active_joint_names(), supervisor_.channels(),
                      supervisor_.limits(), period_);
 }
 
