@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include <shapectl/enum_names.hpp>
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/io/input_error.hpp>
 
@@ -25,10 +26,13 @@ struct Inbox {
   }
 };
 
-constexpr std::pair<ControllerStatus, const char*> controller_status_names[] = {
-    {ControllerStatus::Idle, "idle"},           {ControllerStatus::Optimizing, "optimizing"},
-    {ControllerStatus::Converged, "converged"}, {ControllerStatus::Stuck, "stuck"},
-    {ControllerStatus::OutOfTime, "out of time"}, {ControllerStatus::Paused, "paused"}};
+constexpr auto kControllerStatuses = enum_names<ControllerStatus>(
+    std::pair{ControllerStatus::Idle, "idle"},
+    std::pair{ControllerStatus::Optimizing, "optimizing"},
+    std::pair{ControllerStatus::Converged, "converged"},
+    std::pair{ControllerStatus::Stuck, "stuck"},
+    std::pair{ControllerStatus::OutOfTime, "out of time"},
+    std::pair{ControllerStatus::Paused, "paused"});
 
 // The status once iterations stopped with `outcome`.
 ControllerStatus status_after(StepOutcome outcome) {
@@ -42,17 +46,9 @@ ControllerStatus status_after(StepOutcome outcome) {
 }
 }  // namespace
 
-const char* to_string(ControllerStatus status) {
-  for (const auto& [s, name] : controller_status_names)
-    if (s == status) return name;
-  return "?";
-}
+const char* to_string(ControllerStatus status) { return kControllerStatuses.name(status); }
 
-bool parse(std::string_view name, ControllerStatus* status) {
-  for (const auto& [s, n] : controller_status_names)
-    if (name == n) return *status = s, true;
-  return false;
-}
+bool parse(std::string_view name, ControllerStatus* status) { return kControllerStatuses.parse(name, status); }
 
 struct Controller::State {
   Scene scene;

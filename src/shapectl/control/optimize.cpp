@@ -3,26 +3,22 @@
 #include <chrono>
 #include <cmath>
 
+#include <shapectl/enum_names.hpp>
+
 namespace shapectl {
 
 namespace {
-constexpr std::pair<Termination, const char*> termination_names[] = {
-    {Termination::Converged, "converged"},   {Termination::IterationLimit, "iteration limit"},
-    {Termination::TimeLimit, "time limit"},  {Termination::Stuck, "stuck"},
-    {Termination::Failed, "failed"}};
+constexpr auto kTerminations = enum_names<Termination>(
+    std::pair{Termination::Converged, "converged"},
+    std::pair{Termination::IterationLimit, "iteration limit"},
+    std::pair{Termination::TimeLimit, "time limit"},
+    std::pair{Termination::Stuck, "stuck"},
+    std::pair{Termination::Failed, "failed"});
 }  // namespace
 
-const char* to_string(Termination termination) {
-  for (const auto& [t, name] : termination_names)
-    if (t == termination) return name;
-  return "?";
-}
+const char* to_string(Termination termination) { return kTerminations.name(termination); }
 
-bool parse(std::string_view name, Termination* termination) {
-  for (const auto& [t, n] : termination_names)
-    if (name == n) return *termination = t, true;
-  return false;
-}
+bool parse(std::string_view name, Termination* termination) { return kTerminations.parse(name, termination); }
 
 OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer, Evaluation start,
                         const OptimizeOptions& options) {

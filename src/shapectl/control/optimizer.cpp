@@ -3,6 +3,8 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include <shapectl/enum_names.hpp>
+
 namespace shapectl {
 
 const char* to_string(StepOutcome outcome) {
@@ -16,27 +18,16 @@ const char* to_string(StepOutcome outcome) {
 }
 
 namespace {
-constexpr std::pair<OptimizerKind, const char*> optimizer_kind_names[] = {
-    {OptimizerKind::GaussNewton, "gauss-newton"}, {OptimizerKind::Lbfgs, "lbfgs"}};
+constexpr auto kOptimizerKinds = enum_names<OptimizerKind>(
+    std::pair{OptimizerKind::GaussNewton, "gauss-newton"},
+    std::pair{OptimizerKind::Lbfgs, "lbfgs"});
 }  // namespace
 
-const char* to_string(OptimizerKind kind) {
-  for (const auto& [k, name] : optimizer_kind_names)
-    if (k == kind) return name;
-  return "?";
-}
+const char* to_string(OptimizerKind kind) { return kOptimizerKinds.name(kind); }
 
-bool parse(std::string_view name, OptimizerKind* kind) {
-  for (const auto& [k, n] : optimizer_kind_names)
-    if (name == n) return *kind = k, true;
-  return false;
-}
+bool parse(std::string_view name, OptimizerKind* kind) { return kOptimizerKinds.parse(name, kind); }
 
-std::vector<std::string> optimizer_names() {
-  std::vector<std::string> out;
-  for (const auto& entry : optimizer_kind_names) out.push_back(entry.second);
-  return out;
-}
+std::vector<std::string> optimizer_names() { return kOptimizerKinds.names(); }
 
 namespace {
 // A trial may replace the current state if it is at least as safe and strictly better (a

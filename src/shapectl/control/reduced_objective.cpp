@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <shapectl/enum_names.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -9,29 +11,17 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
-constexpr std::pair<GradientMethod, const char*> gradient_method_names[] = {
-    {GradientMethod::Sensitivity, "sensitivity"},
-    {GradientMethod::Adjoint, "adjoint"},
-    {GradientMethod::FiniteDifference, "finite-difference"}};
+constexpr auto kGradientMethods = enum_names<GradientMethod>(
+    std::pair{GradientMethod::Sensitivity, "sensitivity"},
+    std::pair{GradientMethod::Adjoint, "adjoint"},
+    std::pair{GradientMethod::FiniteDifference, "finite-difference"});
 }  // namespace
 
-const char* to_string(GradientMethod method) {
-  for (const auto& [m, name] : gradient_method_names)
-    if (m == method) return name;
-  return "?";
-}
+const char* to_string(GradientMethod method) { return kGradientMethods.name(method); }
 
-bool parse(std::string_view name, GradientMethod* method) {
-  for (const auto& [m, n] : gradient_method_names)
-    if (name == n) return *method = m, true;
-  return false;
-}
+bool parse(std::string_view name, GradientMethod* method) { return kGradientMethods.parse(name, method); }
 
-std::vector<std::string> gradient_names() {
-  std::vector<std::string> out;
-  for (const auto& entry : gradient_method_names) out.push_back(entry.second);
-  return out;
-}
+std::vector<std::string> gradient_names() { return kGradientMethods.names(); }
 
 ReducedObjective::ReducedObjective(const GrippedObject& object, ShapeTargets targets,
                                    ObjectiveOptions options)

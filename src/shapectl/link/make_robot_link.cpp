@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <shapectl/enum_names.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/link/egm_link.hpp>
 #include <shapectl/link/sim_link.hpp>
@@ -20,26 +21,16 @@ void expect_positive(const char* name, double value) {
 }  // namespace
 
 namespace {
-constexpr std::pair<LinkKind, const char*> link_kind_names_[] = {{LinkKind::Sim, "sim"}, {LinkKind::Egm, "egm"}};
+constexpr auto kLinkKinds = enum_names<LinkKind>(
+    std::pair{LinkKind::Sim, "sim"},
+    std::pair{LinkKind::Egm, "egm"});
 }  // namespace
 
-const char* to_string(LinkKind kind) {
-  for (const auto& [k, name] : link_kind_names_)
-    if (k == kind) return name;
-  return "?";
-}
+const char* to_string(LinkKind kind) { return kLinkKinds.name(kind); }
 
-bool parse(std::string_view name, LinkKind* kind) {
-  for (const auto& [k, n] : link_kind_names_)
-    if (name == n) return *kind = k, true;
-  return false;
-}
+bool parse(std::string_view name, LinkKind* kind) { return kLinkKinds.parse(name, kind); }
 
-std::vector<std::string> link_kind_names() {
-  std::vector<std::string> out;
-  for (const auto& entry : link_kind_names_) out.push_back(entry.second);
-  return out;
-}
+std::vector<std::string> link_kind_names() { return kLinkKinds.names(); }
 
 void validate(const LinkConfig& c) {
   expect_positive("max_velocity", c.max_velocity);
