@@ -84,6 +84,10 @@ struct Controller::State {
   std::atomic<bool> running{false};
 
   void apply(Inbox in);
+  // The objective is immutable: new targets make a new one.
+  void retarget(ShapeTargets targets) {
+    objective = std::make_unique<ReducedObjective>(objective->with_targets(std::move(targets)));
+  }
   void iterate();
   void publish();
   void run();
@@ -97,29 +101,28 @@ void Controller::State::validate(const ShapeTargets& t) const {
 void Controller::State::apply(Inbox in) {
   if (in.reset) {
     current = objective->evaluate(object->reference_joints(), object->reference_positions());
-    objective = std::make_unique<ReducedObjective>(objective->with_targets({}));
+    retarget({});
     centerline.clear();
     objective->rescore(current);
     optimizer->reset();
     last_error.clear();
   }
   if (in.clear) {
-    objective = std::make_unique<ReducedObjective>(objective->with_targets({}));
+    retarget({});
     centerline.clear();
   }
   if (in.targets) {
-    objective = std::make_unique<ReducedObjective>(objective->with_targets(*in.targets));
+    retarget(*in.targets);
     centerline.clear();
   }
   if (in.centerline) {
     // Checked when posted; a target the mapping still puts out of bounds (a sketch at the edge
     // of the world, the bar's offset beyond it) is refused here, not thrown out of the thread.
     try {
-      objective = std::make_unique<ReducedObjective>(objective->with_targets(
-          centerline_targets(object->mesh(), *bar_axis, *in.centerline, current.positions)));
+      retarget(centerline_targets(object->mesh(), *bar_axis, *in.centerline, current.positions));
       centerline = *in.centerline;
     } catch (const InputError& e) {
-      objective = std::make_unique<ReducedObjective>(objective->with_targets({}));
+      retarget({});
       centerline.clear();
       last_error = std::string("centre-line refused: ") + e.what();
     }

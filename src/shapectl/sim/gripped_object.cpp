@@ -28,9 +28,14 @@ GrippedObject::GrippedObject(const Scene& scene) : scene_(scene) {
 }
 
 ObjectState GrippedObject::make_state(const Eigen::VectorXd& joints, const Positions& x) const {
-  ObjectState s;
+  ObjectState s = unsolved_state(x);
   s.joints_ = joints;
   s.kinematics_ = forward_kinematics(robot(), joints);
+  return s;
+}
+
+ObjectState GrippedObject::unsolved_state(const Positions& x) const {
+  ObjectState s;
   s.positions_ = x;
   s.workspace_ = pool_->acquire();
   return s;
@@ -48,7 +53,7 @@ const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::Vecto
 
 ObjectState GrippedObject::solve_from(const Eigen::VectorXd& joints, const Positions& x,
                                       int max_iterations, const ObjectState* chord) const {
-  ObjectState s = make_state(joints, x);
+  ObjectState s = unsolved_state(x);  // solve() sets θ and the kinematics
   solve(s, joints, max_iterations, chord);
   return s;
 }

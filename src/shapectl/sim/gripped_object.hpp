@@ -68,6 +68,7 @@ class GrippedObject {
 
  private:
   bool factored(ObjectState& state, double stale_step) const;
+  ObjectState unsolved_state(const Positions& x) const;  // positions and a workspace only
 
   Scene scene_;
   std::unique_ptr<GripSprings> grips_;
