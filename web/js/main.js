@@ -7,6 +7,8 @@ import { Command, ControllerStatus } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
+// Mean error below which the targets count as reached (the paper's 1 mm).
+const REACHED = 1e-3;
 // Badge style per controller status; the others are plain.
 const STATUS_BADGE = {
   [ControllerStatus.Converged]: 'ok', [ControllerStatus.Optimizing]: 'busy', [ControllerStatus.Stuck]: 'bad',
@@ -109,7 +111,11 @@ function onState(state) {
   plot.add(state.time, state.error.mean, state.editing);
   drawPlot();
 
-  setBadge('status', state.status, STATUS_BADGE[state.status]);
+  // "converged" means stationary; away from the targets that is no success to show in green.
+  const missed = state.status === ControllerStatus.Converged && state.targets.length > 0 &&
+    state.error.mean !== null && state.error.mean > REACHED;
+  if (missed) setBadge('status', `${state.status}, not reached`, 'busy');
+  else setBadge('status', state.status, STATUS_BADGE[state.status]);
   const mm = (v) => (v === null ? '–' : (1000 * v).toFixed(2));
   $('error-mean').textContent = state.targets.length ? mm(state.error.mean) : '–';
   $('error-max').textContent = state.targets.length ? mm(state.error.max) : '–';

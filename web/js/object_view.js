@@ -16,9 +16,12 @@ const _delta = new THREE.Vector3();
 const _target = new THREE.Vector3();
 const _vertex = new THREE.Vector3();
 
+// Centre-lines lie inside the bar: drawn over it, or the user would not see them.
 function makeLine(color) {
-  const line = new THREE.Line(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color }));
+  const material = new THREE.LineBasicMaterial({ color, depthTest: false });
+  const line = new THREE.Line(new THREE.BufferGeometry(), material);
   line.frustumCulled = false;
+  line.renderOrder = 10;
   return line;
 }
 
