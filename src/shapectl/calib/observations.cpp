@@ -1,0 +1,129 @@
+#include <shapectl/calib/observations.hpp>
+
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <shapectl/calib/point_cloud_file.hpp>
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/robot/joints_file.hpp>
+
+namespace shapectl {
+
+namespace {
+
+// θ with every active joint named; size 0 for a scene without a robot.
+Eigen::VectorXd read_frame_joints(const JsonInput& frame, const RobotModel* robot) {
+  if (!robot) {
+    if (frame.has("joints"))
+      frame.at("joints").fail_problem("the scene has no robot: expected no joints");
+    return {};
+  }
+  const JsonInput joints = frame.at("joints");
+  if (!joints.is_object()) joints.fail("an object of joint values");
+  // A measured pose is complete: a joint left out must not silently read as 0.
+  for (const std::string& name : robot->active_joint_names())
+    if (!joints.has(name))
+      throw InputError(joints.source(), joints.path(),
+                       "missing active joint '" + name + "' (every active joint needs a value)");
+  // read_joints (JOINTS.json) checks that each name is an active joint and each value a finite
+  // number; the frame is wrapped so that its messages name "frames[i].joints.<name>".
+  nlohmann::json wrapped = nlohmann::json::object();
+  wrapped["joints"] = joints.raw();
+  return read_joints(JsonInput(std::move(wrapped), frame.source(), frame.path()), *robot,
+                     Eigen::VectorXd::Zero(robot->active_count()));
+}
+
+std::vector<ObservedMarker> read_markers(const JsonInput& list, int node_count) {
+  if (list.size() > max_markers_per_frame)
+    list.fail_problem(std::to_string(list.size()) + " markers, more than the limit of " +
+                      std::to_string(max_markers_per_frame));
+  std::vector<ObservedMarker> markers;
+  std::set<int> seen;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const JsonInput m = list.at(k);
+    m.expect_only({"node", "position"});
+    const int node = static_cast<int>(m.at("node").integer_in(0, node_count - 1));
+    if (!seen.insert(node).second) m.at("node").fail("a node without another marker in this frame");
+    markers.push_back(
+        {node, m.at("position").vec3_within(max_observation_distance, "a point", "m")});
+  }
+  return markers;
+}
+
+std::vector<Vec3> read_inline_points(const JsonInput& list) {
+  if (list.size() > max_point_cloud_points)
+    list.fail_problem(std::to_string(list.size()) + " points, more than the limit of " +
+                      std::to_string(max_point_cloud_points));
+  std::vector<Vec3> points(list.size());
+  for (std::size_t k = 0; k < list.size(); ++k)
+    points[k] = list.at(k).vec3_within(max_observation_distance, "a point", "m");
+  return points;
+}
+
+std::vector<Vec3> read_points_file(const JsonInput& field, const ObservationContext& context) {
+  if (!context.allow_points_files)
+    field.fail_problem(
+        "point cloud files are read only from an observations file; expected \"points\"");
+  const std::string name = field.string();
+  if (name.empty()) field.fail("a file name");
+  const std::filesystem::path file = field.directory() / name;  // an absolute name stays as it is
+  std::vector<Vec3> points;
+  try {
+    points = read_point_cloud(file);
+  } catch (const InputError& e) {
+    field.fail_problem(std::string("cannot read the point cloud: ") + e.what());
+  }
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!(points[i].norm() <= max_observation_distance)) {
+      std::ostringstream problem;
+      problem << "in " << file.string() << ": point " << i << " is " << points[i].norm()
+              << " m from the origin, more than " << max_observation_distance << " m";
+      field.fail_problem(problem.str());
+    }
+  return points;
+}
+
+}  // namespace
+
+ObservationFrame read_observation_frame(const JsonInput& frame, const ObservationContext& context) {
+  frame.expect_only({"joints", "markers", "points", "points_file", "sigma", "time"});
+  ObservationFrame out;
+  out.joints = read_frame_joints(frame, context.robot);
+  if (frame.has("markers")) out.markers = read_markers(frame.at("markers"), context.node_count);
+  if (frame.has("points") && frame.has("points_file"))
+    frame.fail_problem("both \"points\" and \"points_file\"; expected one or the other");
+  if (frame.has("points")) out.points = read_inline_points(frame.at("points"));
+  if (frame.has("points_file")) out.points = read_points_file(frame.at("points_file"), context);
+  if (out.markers.empty() && out.points.empty())
+    frame.fail_problem("nothing observed; expected at least one marker or one point");
+  if (frame.has("sigma")) out.sigma = frame.at("sigma").positive();
+  if (frame.has("time")) out.time = frame.at("time").non_negative();
+  return out;
+}
+
+Observations read_observations(const JsonInput& json, const ObservationContext& context) {
+  json.expect_only({"frames"});
+  const JsonInput frames = json.at("frames");
+  if (frames.size() == 0) frames.fail("a non-empty list of frames");
+  if (frames.size() > max_observation_frames)
+    frames.fail_problem(std::to_string(frames.size()) + " frames, more than the limit of " +
+                        std::to_string(max_observation_frames));
+  Observations out;
+  std::size_t total_points = 0;
+  for (std::size_t k = 0; k < frames.size(); ++k) {
+    out.frames.push_back(read_observation_frame(frames.at(k), context));
+    total_points += out.frames.back().points.size();
+    if (total_points > max_observed_points)
+      frames.at(k).fail_problem("more than the limit of " + std::to_string(max_observed_points) +
+                                " points in all frames together");
+  }
+  return out;
+}
+
+Observations load_observations(const std::filesystem::path& file, ObservationContext context) {
+  context.allow_points_files = true;
+  return read_observations(JsonInput::load(file), context);
+}
+
+}  // namespace shapectl

@@ -1,0 +1,71 @@
+#pragma once
+// What was measured of the real object, frame by frame: the robot's joints, tracked markers at
+// known mesh nodes and/or an unordered point cloud; world frame, metres. OBSERVATIONS.json:
+//   {"frames": [{"joints": {"yumi_joint_1_l": 0.1, ...},
+//                "markers": [{"node": 12, "position": [x, y, z]}, ...],
+//                "points": [[x, y, z], ...]   or   "points_file": "cloud.ply",
+//                "sigma": 0.0005, "time": 12.5}]}
+// joints: every active joint of the robot (rad, m for prismatic), none other; omitted for a
+//   scene without a robot. markers: distinct nodes. points_file: .xyz, .ply or .npy
+//   (calib/point_cloud_file.hpp), relative to the JSON file's directory. Each frame observes at
+//   least one marker or one point. sigma: the measurement noise (standard deviation, m,
+//   > 0, default default_observation_sigma). time: seconds (>= 0), optional.
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include <shapectl/io/json_input.hpp>
+#include <shapectl/robot/robot_model.hpp>
+#include <shapectl/types.hpp>
+
+namespace shapectl {
+
+// m: between a good marker tracker (~0.1 mm) and a depth camera at arm's length (a few mm).
+inline constexpr double default_observation_sigma = 0.001;
+// Bounds checked before the lists are read. A frame's points are at most
+// max_point_cloud_points (2 million), inline or from a file; a JSON file is at most
+// max_json_file_bytes (8 MB, ~250,000 inline points), so large clouds go in points files.
+inline constexpr std::size_t max_observation_frames = 10'000;
+inline constexpr std::size_t max_markers_per_frame = 100'000;
+inline constexpr std::size_t max_observed_points = 20'000'000;  // all frames together: 480 MB
+inline constexpr double max_observation_distance = 1e3;         // m from the world origin
+
+struct ObservedMarker {
+  int node;       // mesh node the marker sits on
+  Vec3 position;  // world frame, m
+};
+
+struct ObservationFrame {
+  Eigen::VectorXd joints;               // θ, size robot.active_count(); size 0 without a robot
+  std::vector<ObservedMarker> markers;  // distinct nodes
+  std::vector<Vec3> points;             // unordered cloud, world frame, m
+  double sigma = default_observation_sigma;  // measurement noise (standard deviation), m
+  std::optional<double> time;                // s
+};
+
+struct Observations {
+  std::vector<ObservationFrame> frames;  // at least one
+};
+
+struct ObservationContext {
+  int node_count = 0;                 // of the object's mesh
+  const RobotModel* robot = nullptr;  // null: a scene without a robot (frames have no joints)
+  // Whether a frame may name a "points_file". load_observations allows it; JSON from a network
+  // message leaves it off, so that a client cannot make the server read its files.
+  bool allow_points_files = false;
+};
+
+// Throws InputError naming the source and field ("obs.json: frames[3].markers[0].node: expected
+// a whole number from 0 to 424, got 500"): an empty or too long list of frames, a frame with
+// nothing observed, a node out of range or repeated, non-finite numbers, points beyond
+// max_observation_distance, a joint missing or not active, joints without a robot, both points
+// and points_file, a points file that cannot be read (the message names it and the problem),
+// a points_file where they are not allowed, unknown keys, sizes over the limits above.
+Observations read_observations(const JsonInput& json, const ObservationContext& context);
+// One frame, e.g. from a WebSocket message: the object inside "frames" above.
+ObservationFrame read_observation_frame(const JsonInput& frame, const ObservationContext& context);
+// Reads the file with points files allowed, relative to its directory.
+Observations load_observations(const std::filesystem::path& file, ObservationContext context);
+
+}  // namespace shapectl
