@@ -1,6 +1,6 @@
-# calib/: observations of the real object (tracked markers, point clouds) and the geometry its
-# calibration needs (closest points on the deformed surface).
+# calib/: the real object — observations (tracked markers, point clouds), the parameters a
+# calibration fits and their sensitivities, the calibration itself.
 shapectl_area(calib)
-target_link_libraries(shapectl_calib PUBLIC shapectl_io shapectl_robot PRIVATE shapectl_mesh)
+target_link_libraries(shapectl_calib PUBLIC shapectl_fem shapectl_io shapectl_mesh shapectl_robot shapectl_sim)
 
-shapectl_tests(calib shapectl_calib shapectl_mesh)
+shapectl_tests(calib shapectl_calib)

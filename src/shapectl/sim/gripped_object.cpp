@@ -13,14 +13,27 @@ std::vector<std::pair<int, int>> node_links(const Scene& scene) {
     for (int node : g.nodes) out.emplace_back(node, scene.robot->end_effectors[g.end_effector].link);
   return out;
 }
+
+// Moves each gripped node's link-frame point by its grip's offset (about the TCP), in
+// node_links order.
+void apply_grip_offsets(const Scene& scene, std::vector<GrippedNode>& nodes) {
+  std::size_t k = 0;
+  for (const auto& g : scene.grips) {
+    const Vec3 tcp = scene.robot->end_effectors[g.end_effector].tcp_link;
+    const Eigen::Isometry3d offset_link =
+        Eigen::Translation3d(tcp) * g.offset * Eigen::Translation3d(-tcp);
+    for (std::size_t n = 0; n < g.nodes.size(); ++n, ++k) nodes[k].point_link = offset_link * nodes[k].point_link;
+  }
+}
 }  // namespace
 
 GrippedObject::GrippedObject(const Scene& scene) : scene_(scene) {
   if (!scene_.robot) throw std::invalid_argument("GrippedObject needs a scene with a robot");
   const auto pairs = node_links(scene_);
   const KinematicsState reference = forward_kinematics(robot(), scene_.robot->reference_joints);
-  grips_ = std::make_unique<GripSprings>(
-      robot(), GripSprings::attach(reference, scene_.world_rest_positions(), pairs), scene_.grip_stiffness);
+  std::vector<GrippedNode> gripped = GripSprings::attach(reference, scene_.world_rest_positions(), pairs);
+  apply_grip_offsets(scene_, gripped);
+  grips_ = std::make_unique<GripSprings>(robot(), std::move(gripped), scene_.grip_stiffness);
   std::vector<int> held;
   for (const auto& p : pairs) held.push_back(p.first);
   statics_ = std::make_unique<ObjectStatics>(scene_, held);
@@ -81,9 +94,13 @@ bool GrippedObject::stable(ObjectState& state, double stale_step) const {
 }
 
 Eigen::MatrixXd GrippedObject::sensitivity(ObjectState& state, double stale_step) const {
+  return force_response(state, grips_->force_jacobian(state.kinematics_, node_count()), stale_step);
+}
+
+Eigen::MatrixXd GrippedObject::force_response(ObjectState& state, const Eigen::MatrixXd& force_change,
+                                              double stale_step) const {
   factored(state, stale_step);
-  return statics_->solver().solve_with_factor(*state.workspace_,
-                                              grips_->force_jacobian(state.kinematics_, node_count()));
+  return statics_->solver().solve_with_factor(*state.workspace_, force_change);
 }
 
 Eigen::VectorXd GrippedObject::adjoint(ObjectState& state, const Eigen::VectorXd& v, double stale_step) const {

@@ -63,6 +63,11 @@ class GrippedObject {
   bool stable(ObjectState& state, double stale_step = 0) const;
   // dx̂/dθ (3n × m). Throws std::runtime_error at an unstable state.
   Eigen::MatrixXd sensitivity(ObjectState& state, double stale_step = 0) const;
+  // H⁻¹ ∂F/∂p: the equilibrium's response dx̂/dp to parameters p that change the applied forces
+  // by ∂F/∂p (columns, 3n each; material, density, grip offsets: see calib/). Throws
+  // std::runtime_error at an unstable state.
+  Eigen::MatrixXd force_response(ObjectState& state, const Eigen::MatrixXd& force_change,
+                                 double stale_step = 0) const;
   // (dx̂/dθ)ᵀ v by the adjoint method, one solve: λ = H⁻¹ v, result = (∂F/∂θ)ᵀ λ.
   Eigen::VectorXd adjoint(ObjectState& state, const Eigen::VectorXd& v, double stale_step = 0) const;
 

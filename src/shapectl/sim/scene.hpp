@@ -58,6 +58,10 @@ struct RobotSetup {
 struct Grip {
   int end_effector = -1;  // index into RobotSetup::end_effectors
   std::vector<int> nodes;
+  // Where the gripper really holds the object relative to where the scene places it: a rigid
+  // motion of the gripped nodes in the end effector's TCP frame, about the TCP. Identity
+  // unless given ("offset" in the scene file) or fitted by `shapectl calibrate`.
+  Eigen::Isometry3d offset = Eigen::Isometry3d::Identity();
 };
 
 struct ObjectiveWeights {

@@ -1,0 +1,71 @@
+#pragma once
+// Fits physical parameters (calib/model_parameters.hpp) to observed frames of the real object:
+// Levenberg–Marquardt on the noise-weighted residuals of every frame jointly
+// (calib/observation_residuals.hpp), each frame its own equilibrium at its joints, Jacobians
+// from the exact parameter sensitivities dx̂/dz = H⁻¹ ∂F/∂z.
+//
+// Identifiability first: the Jacobian at the start, its columns scaled by each coordinate's
+// typical size, is split by SVD; a direction whose standard deviation (the noise-weighted
+// residuals make it 1/singular value) exceeds `identifiability_threshold` is one the data
+// cannot determine. For each such direction one parameter in it is held at its initial value
+// (the one most likely known: density, then Poisson's ratio, Young's modulus, rotations,
+// translations) and reported, never fitted to noise. With gravity and grips only, for example,
+// the shape depends on stiffness and density through their ratio alone: asked for both, the
+// fit holds density and fits Young's modulus.
+#include <string>
+#include <vector>
+
+#include <shapectl/calib/model_parameters.hpp>
+#include <shapectl/calib/observations.hpp>
+
+namespace shapectl {
+
+struct CalibrationOptions {
+  int max_iterations = 30;
+  // Largest standard deviation, in units of the coordinate scales (10 % for material
+  // parameters, 1 mm and 0.01 rad for grip offsets), of a determined direction.
+  double identifiability_threshold = 0.1;
+  // Steps to walk the joints from the reference configuration to a frame's (rad, largest joint).
+  double path_step = 0.05;
+};
+
+struct FittedParameter {
+  std::string name;
+  std::string unit;       // "Pa", "", "kg/m^3", "m", "rad"
+  double initial = 0;     // physical value (grip offsets: the coordinate's, in m or rad)
+  double fitted = 0;
+  double standard_deviation = 0;  // from the Gauss–Newton covariance with the frames' σ; 0 if held
+  bool held = false;      // not identifiable from these observations: kept at `initial`
+};
+
+struct UnidentifiedDirection {
+  std::vector<std::pair<std::string, double>> combination;  // coordinate name → weight (|w| ≥ 0.1)
+  double standard_deviation = 0;  // in units of the coordinate scales
+  std::string held;               // the parameter kept at its initial value for it
+};
+
+struct FrameFit {
+  double rms_before = 0, rms_after = 0;  // m: markers' 3D errors and inlier points' distances
+  int markers = 0, points = 0, inlier_points_after = 0;
+};
+
+struct CalibrationResult {
+  Scene scene;  // the input scene with the fitted values
+  PhysicalParameters fitted;
+  std::vector<FittedParameter> parameters;
+  std::vector<UnidentifiedDirection> unidentified;
+  std::vector<FrameFit> frames;
+  double rms_before = 0, rms_after = 0;  // m, over all frames
+  double chi_squared_per_dof = 0;        // ≈ 1 when the model fits to the noise level
+  int iterations = 0;
+  bool converged = false;
+  std::string reason;  // why it stopped
+  double seconds = 0;
+};
+
+// Throws std::invalid_argument for a scene without a robot or observations that do not match
+// it, std::runtime_error when a frame's equilibrium cannot be found.
+CalibrationResult calibrate(const Scene& scene, const Observations& observations, const FitSelection& fit,
+                            const CalibrationOptions& options = {});
+
+}  // namespace shapectl

@@ -1,0 +1,14 @@
+#pragma once
+// The equilibrium at joints far from where the object is known: walk θ from the reference
+// joints in steps of at most `max_step` (rad, largest joint), carrying the gripped nodes along
+// with their grippers and solving at each step. One jump would drag the gripped nodes past
+// their neighbours and invert elements.
+#include <shapectl/sim/gripped_object.hpp>
+
+namespace shapectl {
+
+// Throws std::runtime_error naming the step when an equilibrium on the way is not found.
+ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::VectorXd& joints,
+                                   double max_step = 0.05);
+
+}  // namespace shapectl
