@@ -1,0 +1,107 @@
+#include <shapectl/control/model_error_feedback.hpp>
+
+#include <gtest/gtest.h>
+
+#include <numeric>
+#include <random>
+
+#include <shapectl/calib/joint_path.hpp>
+#include <shapectl/calib/simulated_camera.hpp>
+#include <shapectl/control/optimize.hpp>
+#include <shapectl/sim/scene.hpp>
+
+#include "support/test_support.hpp"
+
+namespace shapectl {
+namespace {
+
+// The model is the bundled YuMi bar; the world's bar is 1.5× stiffer, 0.8× as dense and held
+// 4 mm / 3° off at each grip.
+Scene world_of(const Scene& model) {
+  Scene world = model;
+  world.material = material_from_youngs(1.5 * youngs_modulus_of(model.material), poisson_ratio_of(model.material),
+                                        0.8 * model.material.density);
+  world.grips[0].offset = Eigen::Translation3d(0.004 * Vec3(0, 1, -1).normalized()) *
+                          Eigen::AngleAxisd(3 * M_PI / 180, Vec3(0, 0, 1));
+  world.grips[1].offset = Eigen::Translation3d(0.004 * Vec3(1, 0, 1).normalized()) *
+                          Eigen::AngleAxisd(3 * M_PI / 180, Vec3(0, 1, 0));
+  return world;
+}
+
+double true_error(const ShapeTargets& targets, const Positions& world) {
+  double sum = 0;
+  for (int k = 0; k < targets.size(); ++k) sum += (world.segment<3>(3 * targets.nodes[k]) - targets.positions[k]).norm();
+  return sum / targets.size();
+}
+
+TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMisses) {
+  const Scene model_scene = load_scene(test::source_path("scenes/yumi_bar.json"));
+  const GrippedObject model(model_scene), world(world_of(model_scene));
+  ReducedObjective objective(model);
+  const Evaluation reference = objective.evaluate(model.reference_joints(), model.reference_positions());
+
+  // Targets: the model's own shape at other joints (reachable by the model), 12 nodes, each
+  // carrying a tracked marker.
+  std::mt19937 rng(5);
+  Eigen::VectorXd goal = reference.joints;
+  goal[0] -= 0.03, goal[7] += 0.03;  // the shoulders push the grippers together: the bar arches
+  const Evaluation at_goal = objective.evaluate(goal, reference.positions);
+  ASSERT_TRUE(at_goal.safe());
+  ShapeTargets targets;
+  std::vector<int> nodes(model.node_count());
+  std::iota(nodes.begin(), nodes.end(), 0);
+  std::shuffle(nodes.begin(), nodes.end(), rng);
+  for (int k = 0; k < 12; ++k) targets.nodes.push_back(nodes[k]), targets.positions.push_back(at_goal.positions.segment<3>(3 * nodes[k]));
+  SimulatedCamera camera;
+  camera.marker_nodes = targets.nodes;
+  camera.sigma = 0.0003;
+
+  // Open loop: the model reaches the targets, the world misses them.
+  objective = objective.with_targets(targets);
+  Evaluation start = reference;
+  objective.rescore(start);
+  GaussNewton optimizer;
+  OptimizeResult result = optimize(objective, optimizer, start, {.max_iterations = 50});
+  ASSERT_LT(result.best.error.mean, 1e-3) << result.reason;
+  ObjectState truth = equilibrium_along_path(world, result.best.joints);
+  const double open_loop = true_error(targets, truth.positions());
+  EXPECT_GE(open_loop, 5e-3);
+
+  // Closed loop: observe the world at the joints reached, correct the targets, optimize on.
+  ModelErrorFeedback feedback(model_scene.object_mesh);
+  for (int round = 0; round < 12; ++round) {
+    const ObservationFrame frame = camera.observe(world.mesh(), truth.positions(), result.best.joints, rng);
+    std::vector<std::pair<int, Vec3>> observed;
+    for (const ObservedMarker& m : frame.markers) observed.emplace_back(m.node, m.position);
+    feedback.observe(observed, result.best.positions);
+    const ReducedObjective aimed = objective.with_targets(feedback.corrected(targets));
+    Evaluation from = result.best;
+    aimed.rescore(from);
+    result = optimize(aimed, optimizer, from, {.max_iterations = 10});
+    ASSERT_TRUE(result.best.safe()) << "round " << round;
+    truth = world.solve_from(result.best.joints, truth.positions());
+    ASSERT_TRUE(truth.statics().converged()) << truth.statics().reason;
+  }
+  const double closed_loop = true_error(targets, truth.positions());
+  EXPECT_LT(closed_loop, 1e-3) << "open loop " << open_loop * 1e3 << " mm";
+}
+
+TEST(ModelErrorFeedback, UnobservedNodesTakeTheirNeighboursEstimateAndCorrectionsAreClamped) {
+  const Scene scene = load_scene(test::source_path("scenes/yumi_bar.json"));
+  ModelErrorFeedback feedback(scene.object_mesh, {.gain = 1, .max_correction = 0.01, .neighbours = 1});
+  const Positions predicted = scene.world_rest_positions();
+  const Vec3 shift(0.002, 0, -0.001);
+  feedback.observe({{0, predicted.segment<3>(0) + shift}, {5, predicted.segment<3>(15) + Vec3(1, 0, 0)}}, predicted);
+  EXPECT_LT((feedback.estimate(0) - shift).norm(), 1e-15);
+  EXPECT_NEAR(feedback.estimate(5).norm(), 0.01, 1e-15);  // a 1 m "error" clamped to 1 cm
+  // Node 1 is next to node 0 at rest: it takes node 0's estimate (one neighbour).
+  const double d0 = (scene.object_mesh->rest_positions()[1] - scene.object_mesh->rest_positions()[0]).norm();
+  const double d5 = (scene.object_mesh->rest_positions()[1] - scene.object_mesh->rest_positions()[5]).norm();
+  ASSERT_LT(d0, d5);
+  EXPECT_LT((feedback.estimate(1) - shift).norm(), 1e-15);
+  const ShapeTargets t = feedback.corrected({{1}, {Vec3(1, 2, 3)}});
+  EXPECT_LT((t.positions[0] - (Vec3(1, 2, 3) - shift)).norm(), 1e-15);
+}
+
+}  // namespace
+}  // namespace shapectl
