@@ -31,7 +31,8 @@ endforeach()
 
 set(shapectl_python_dir ${PROJECT_BINARY_DIR}/python)
 file(GLOB python_binding_sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/python/src/*.cpp)
-pybind11_add_module(shapectl_python MODULE ${python_binding_sources})
+# NO_EXTRAS: no LTO (a serial link of minutes; the solvers live in the area libraries anyway).
+pybind11_add_module(shapectl_python MODULE NO_EXTRAS ${python_binding_sources})
 set_target_properties(shapectl_python PROPERTIES
   OUTPUT_NAME _shapectl
   LIBRARY_OUTPUT_DIRECTORY ${shapectl_python_dir}/shapectl

@@ -1,4 +1,5 @@
-"""Type stubs of the compiled module (docstrings are on the objects themselves)."""
+"""Type stubs of the compiled module (docstrings are on the objects themselves).
+Attributes are read-only properties."""
 
 import os
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union, overload
@@ -14,160 +15,97 @@ Targets = Union[str, os.PathLike, Mapping[str, Any]]
 class SolverError(RuntimeError): ...
 
 class Pose:
-    @property
-    def position(self) -> FloatArray: ...  # (3,)
-    @property
-    def rotation(self) -> FloatArray: ...  # (3, 3)
+    position: FloatArray  # (3,)
+    rotation: FloatArray  # (3, 3)
 
 class LimitViolation:
-    @property
-    def joint(self) -> str: ...
-    @property
-    def value(self) -> float: ...
-    @property
-    def lower(self) -> float: ...
-    @property
-    def upper(self) -> float: ...
+    joint: str
+    value: float
+    lower: float
+    upper: float
 
 class Robot:
     @staticmethod
     def load(urdf: Union[str, os.PathLike]) -> Robot: ...
-    @property
-    def name(self) -> str: ...
-    @property
-    def link_names(self) -> List[str]: ...
-    @property
-    def joint_names(self) -> List[str]: ...
-    @property
-    def lower_limits(self) -> FloatArray: ...
-    @property
-    def upper_limits(self) -> FloatArray: ...
-    @property
-    def has_collision_spheres(self) -> bool: ...
-    @property
-    def warnings(self) -> List[str]: ...
+    name: str
+    link_names: List[str]
+    joint_names: List[str]
+    lower_limits: FloatArray
+    upper_limits: FloatArray
+    has_collision_spheres: bool
+    warnings: List[str]
 
 class Scene:
     @staticmethod
     def load(path: Union[str, os.PathLike]) -> Scene: ...
-    @property
-    def source(self) -> str: ...
-    @property
-    def node_count(self) -> int: ...
-    @property
-    def tet_count(self) -> int: ...
-    @property
-    def tets(self) -> IntArray: ...  # (tets, 4)
-    @property
-    def rest_positions(self) -> FloatArray: ...  # (n, 3)
-    @property
-    def has_robot(self) -> bool: ...
-    @property
-    def robot(self) -> Optional[Robot]: ...
-    @property
-    def joint_names(self) -> List[str]: ...
-    @property
-    def reference_joints(self) -> FloatArray: ...  # (m,)
-    @property
-    def end_effectors(self) -> List[str]: ...
-    @property
-    def grip_nodes(self) -> List[List[int]]: ...
-    @property
-    def warnings(self) -> List[str]: ...
+    source: str
+    node_count: int
+    tet_count: int
+    tets: IntArray  # (tets, 4)
+    rest_positions: FloatArray  # (n, 3)
+    has_robot: bool
+    robot: Optional[Robot]
+    joint_names: List[str]
+    reference_joints: FloatArray  # (m,)
+    end_effectors: List[str]
+    grip_nodes: List[List[int]]
+    warnings: List[str]
 
 class StaticsResult:
-    @property
-    def converged(self) -> bool: ...
-    @property
-    def status(self) -> str: ...
-    @property
-    def reason(self) -> str: ...
-    @property
-    def iterations(self) -> int: ...
-    @property
-    def factorizations(self) -> int: ...
-    @property
-    def residual(self) -> float: ...
-    @property
-    def energy(self) -> float: ...
+    converged: bool
+    status: str
+    reason: str
+    iterations: int
+    factorizations: int
+    residual: float
+    energy: float
 
 class StaticsSolution:
-    @property
-    def converged(self) -> bool: ...
-    @property
-    def status(self) -> str: ...
-    @property
-    def reason(self) -> str: ...
-    @property
-    def iterations(self) -> int: ...
-    @property
-    def residual(self) -> float: ...
-    @property
-    def energy(self) -> float: ...
-    @property
-    def result(self) -> StaticsResult: ...
-    @property
-    def positions(self) -> FloatArray: ...  # (n, 3)
-    @property
-    def joints(self) -> Optional[FloatArray]: ...  # (m,)
-    @property
-    def joint_names(self) -> List[str]: ...
-    @property
-    def tools(self) -> Dict[str, Pose]: ...
+    converged: bool
+    status: str
+    reason: str
+    iterations: int
+    residual: float
+    energy: float
+    result: StaticsResult
+    positions: FloatArray  # (n, 3)
+    joints: Optional[FloatArray]  # (m,)
+    joint_names: List[str]
+    tools: Dict[str, Pose]
 
 def statics(scene: Scene, joints: Joints = None) -> StaticsSolution: ...
 
 class ObjectState:
-    @property
-    def joints(self) -> FloatArray: ...
-    @property
-    def positions(self) -> FloatArray: ...  # (n, 3)
-    @property
-    def statics(self) -> StaticsResult: ...
-    @property
-    def tools(self) -> Dict[str, Pose]: ...
+    joints: FloatArray
+    positions: FloatArray  # (n, 3)
+    statics: StaticsResult
+    tools: Dict[str, Pose]
 
 class GrippedObject:
     def __init__(self, scene: Scene) -> None: ...
-    @property
-    def node_count(self) -> int: ...
-    @property
-    def joint_count(self) -> int: ...
-    @property
-    def joint_names(self) -> List[str]: ...
-    @property
-    def reference_joints(self) -> FloatArray: ...
-    @property
-    def reference_positions(self) -> FloatArray: ...
+    node_count: int
+    joint_count: int
+    joint_names: List[str]
+    reference_joints: FloatArray
+    reference_positions: FloatArray
     def solve(self, joints: Joints = None, warm_start: Optional[npt.ArrayLike] = None,
               max_iterations: int = 0) -> ObjectState: ...
     def sensitivity(self, state: ObjectState) -> FloatArray: ...  # (3n, m)
 
 class SpherePair:
-    @property
-    def links(self) -> Tuple[str, str]: ...
-    @property
-    def spheres(self) -> Tuple[int, int]: ...
-    @property
-    def clearance(self) -> float: ...
+    links: Tuple[str, str]
+    spheres: Tuple[int, int]
+    clearance: float
 
 class Kinematics:
-    @property
-    def joints(self) -> FloatArray: ...
-    @property
-    def joint_names(self) -> List[str]: ...
-    @property
-    def links(self) -> Dict[str, Pose]: ...
-    @property
-    def tools(self) -> Dict[str, Pose]: ...
-    @property
-    def min_clearance(self) -> Optional[float]: ...
-    @property
-    def margin(self) -> Optional[float]: ...
-    @property
-    def closest_pairs(self) -> List[SpherePair]: ...
-    @property
-    def limit_violations(self) -> List[LimitViolation]: ...
+    joints: FloatArray
+    joint_names: List[str]
+    links: Dict[str, Pose]
+    tools: Dict[str, Pose]
+    min_clearance: Optional[float]
+    margin: Optional[float]
+    closest_pairs: List[SpherePair]
+    limit_violations: List[LimitViolation]
 
 @overload
 def kinematics(robot: Robot, joints: Joints = None,
@@ -176,106 +114,61 @@ def kinematics(robot: Robot, joints: Joints = None,
 def kinematics(scene: Scene, joints: Joints = None) -> Kinematics: ...
 
 class HistoryEntry:
-    @property
-    def iteration(self) -> int: ...
-    @property
-    def time(self) -> float: ...
-    @property
-    def error_mean(self) -> float: ...
-    @property
-    def objective(self) -> float: ...
+    iteration: int
+    time: float
+    error_mean: float
+    objective: float
 
 class SolveTiming:
-    @property
-    def statics_solves(self) -> int: ...
-    @property
-    def statics_seconds(self) -> float: ...
-    @property
-    def gradient_evaluations(self) -> int: ...
-    @property
-    def gradient_seconds(self) -> float: ...
+    statics_solves: int
+    statics_seconds: float
+    gradient_evaluations: int
+    gradient_seconds: float
 
 class SolveResult:
-    @property
-    def joints(self) -> FloatArray: ...
-    @property
-    def joint_names(self) -> List[str]: ...
-    @property
-    def converged(self) -> bool: ...
-    @property
-    def termination(self) -> str: ...
-    @property
-    def reason(self) -> str: ...
-    @property
-    def iterations(self) -> int: ...
-    @property
-    def error_mean(self) -> float: ...
-    @property
-    def error_max(self) -> float: ...
-    @property
-    def objective(self) -> float: ...
-    @property
-    def min_clearance(self) -> Optional[float]: ...
-    @property
-    def limit_violations(self) -> List[LimitViolation]: ...
-    @property
-    def positions(self) -> FloatArray: ...  # (n, 3)
-    @property
-    def target_nodes(self) -> IntArray: ...  # (k,)
-    @property
-    def target_positions(self) -> FloatArray: ...  # (k, 3)
-    @property
-    def history(self) -> List[HistoryEntry]: ...
-    @property
-    def timing(self) -> SolveTiming: ...
-    @property
-    def tools(self) -> Dict[str, Pose]: ...
+    joints: FloatArray
+    joint_names: List[str]
+    converged: bool
+    termination: str
+    reason: str
+    iterations: int
+    error_mean: float
+    error_max: float
+    objective: float
+    min_clearance: Optional[float]
+    limit_violations: List[LimitViolation]
+    positions: FloatArray  # (n, 3)
+    target_nodes: IntArray  # (k,)
+    target_positions: FloatArray  # (k, 3)
+    history: List[HistoryEntry]
+    timing: SolveTiming
+    tools: Dict[str, Pose]
 
 def solve(scene: Scene, targets: Targets, *, optimizer: str = "gauss-newton",
           gradient: str = "sensitivity", max_iterations: int = 100,
           max_seconds: float = 60.0) -> SolveResult: ...
 
 class ControllerSnapshot:
-    @property
-    def sequence(self) -> int: ...
-    @property
-    def time(self) -> float: ...
-    @property
-    def status(self) -> str: ...
-    @property
-    def joint_names(self) -> List[str]: ...
-    @property
-    def joints(self) -> FloatArray: ...
-    @property
-    def lower_limits(self) -> FloatArray: ...
-    @property
-    def upper_limits(self) -> FloatArray: ...
-    @property
-    def links(self) -> Dict[str, Pose]: ...
-    @property
-    def positions(self) -> FloatArray: ...
-    @property
-    def target_nodes(self) -> IntArray: ...
-    @property
-    def target_positions(self) -> FloatArray: ...
-    @property
-    def error_mean(self) -> float: ...
-    @property
-    def error_max(self) -> float: ...
-    @property
-    def objective(self) -> float: ...
-    @property
-    def min_clearance(self) -> float: ...
-    @property
-    def within_limits(self) -> bool: ...
-    @property
-    def safe(self) -> bool: ...
-    @property
-    def iterations(self) -> int: ...
-    @property
-    def paused(self) -> bool: ...
-    @property
-    def last_error(self) -> str: ...
+    sequence: int
+    time: float
+    status: str
+    joint_names: List[str]
+    joints: FloatArray
+    lower_limits: FloatArray
+    upper_limits: FloatArray
+    links: Dict[str, Pose]
+    positions: FloatArray
+    target_nodes: IntArray
+    target_positions: FloatArray
+    error_mean: float
+    error_max: float
+    objective: float
+    min_clearance: float
+    within_limits: bool
+    safe: bool
+    iterations: int
+    paused: bool
+    last_error: str
 
 class Controller:
     def __init__(self, scene: Scene, *, optimizer: str = "gauss-newton",
@@ -292,8 +185,7 @@ class Controller:
     def reset(self) -> None: ...
     def snapshot(self) -> ControllerSnapshot: ...
     def wait_for_snapshot(self, after: int, timeout: float = 1.0) -> ControllerSnapshot: ...
-    @property
-    def node_count(self) -> int: ...
+    node_count: int
     def close(self) -> None: ...
     def __enter__(self) -> Controller: ...
     def __exit__(self, *args: Any) -> None: ...

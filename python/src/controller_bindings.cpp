@@ -165,8 +165,8 @@ void bind_controller(py::module_& m) {
           "pass; returns the latest.")
       .def_property_readonly("node_count", [](const H& h) { return h.get().mesh().node_count(); }, "Nodes n.")
       .def("close", &close, "Stops the thread and frees the controller.")
-      .def("__enter__", [](H& h) -> H& { return h; }, py::return_value_policy::reference)
-      .def("__exit__", [](H& h, const py::args&) { close(h); });
+      .def("__enter__", [](H& h) -> H& { return h; }, py::return_value_policy::reference, "Returns the controller.")
+      .def("__exit__", [](H& h, const py::args&) { close(h); }, "Closes the controller (see close()).");
 }
 
 }  // namespace shapectl::python

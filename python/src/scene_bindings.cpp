@@ -29,7 +29,7 @@ void bind_scene(py::module_& m) {
   py::class_<Pose>(m, "Pose", "A pose in the world frame (the robot's root frame).")
       .def_readonly("position", &Pose::position, "Position, metres: array of shape (3,).")
       .def_readonly("rotation", &Pose::rotation, "Rotation matrix: array of shape (3, 3).")
-      .def("__repr__", [](const Pose& p) {
+      .def("__repr__", [](const Pose& p) {  // the position; the rotation is one attribute away
         return "Pose(position=[" + std::to_string(p.position.x()) + ", " + std::to_string(p.position.y()) +
                ", " + std::to_string(p.position.z()) + "])";
       });
