@@ -26,7 +26,8 @@ std::string shape_text(const DoubleArray& a) {
 
 void require_finite(const DoubleArray& a, const std::string& what) {
   for (py::ssize_t i = 0; i < a.size(); ++i)
-    if (!std::isfinite(a.data()[i])) throw InputError(what, "", "finite numbers", "a non-finite value");
+    if (!std::isfinite(a.data()[i]))
+      throw InputError(what, "", "finite numbers", "a non-finite value");
 }
 
 }  // namespace
@@ -44,22 +45,29 @@ py::array_t<double> positions_array(const Positions& x) {
 
 Positions positions_from(const py::handle& array, int node_count, const std::string& what) {
   const auto a = DoubleArray::ensure(array);
-  if (!a) throw InputError(what, "", "an (n, 3) array of numbers", std::string(py::str(py::type::of(array))));
+  if (!a)
+    throw InputError(what, "", "an (n, 3) array of numbers",
+                     std::string(py::str(py::type::of(array))));
   const bool stacked = a.ndim() == 1 && a.shape(0) == 3 * py::ssize_t{node_count};
   const bool rows = a.ndim() == 2 && a.shape(0) == node_count && a.shape(1) == 3;
   if (!stacked && !rows)
-    throw InputError(what, "", "an array of shape (" + std::to_string(node_count) + ", 3)", shape_text(a));
+    throw InputError(what, "", "an array of shape (" + std::to_string(node_count) + ", 3)",
+                     shape_text(a));
   require_finite(a, what);
   return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size());
 }
 
 std::vector<Vec3> points_from(const py::handle& array, const std::string& what) {
   const auto a = DoubleArray::ensure(array);
-  if (!a) throw InputError(what, "", "a (k, 3) array of numbers", std::string(py::str(py::type::of(array))));
-  if (a.ndim() != 2 || a.shape(1) != 3) throw InputError(what, "", "an array of shape (k, 3)", shape_text(a));
+  if (!a)
+    throw InputError(what, "", "a (k, 3) array of numbers",
+                     std::string(py::str(py::type::of(array))));
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw InputError(what, "", "an array of shape (k, 3)", shape_text(a));
   require_finite(a, what);
   std::vector<Vec3> points;
-  for (py::ssize_t i = 0; i < a.shape(0); ++i) points.emplace_back(a.at(i, 0), a.at(i, 1), a.at(i, 2));
+  for (py::ssize_t i = 0; i < a.shape(0); ++i)
+    points.emplace_back(a.at(i, 0), a.at(i, 1), a.at(i, 2));
   return points;
 }
 
@@ -67,12 +75,17 @@ Eigen::VectorXd joints_from(const py::handle& joints, const RobotModel& robot,
                             const Eigen::VectorXd& defaults) {
   if (joints.is_none()) return defaults;
   if (py::isinstance<py::dict>(joints))
-    return read_joints(JsonInput(json_from(py::dict{py::arg("joints") = joints}, "joints"), "joints"),
+    return read_joints(JsonInput(json_from(py::dict{py::arg("joints") = joints}, "joints"),
+                                 "joints"),
                        robot, defaults);
   const auto a = DoubleArray::ensure(joints);
-  if (!a) throw InputError("joints", "", "a {name: rad} dict or an array", std::string(py::str(py::type::of(joints))));
+  if (!a)
+    throw InputError("joints", "", "a {name: rad} dict or an array",
+                     std::string(py::str(py::type::of(joints))));
   if (a.ndim() != 1 || a.shape(0) != robot.active_count())
-    throw InputError("joints", "", "an array of shape (" + std::to_string(robot.active_count()) + ",)", shape_text(a));
+    throw InputError("joints", "",
+                     "an array of shape (" + std::to_string(robot.active_count()) + ",)",
+                     shape_text(a));
   require_finite(a, "joints");
   return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size());
 }
@@ -95,7 +108,8 @@ nlohmann::json json_from(const py::handle& value, const std::string& source) {
     if (py::hasattr(o, "tolist")) return o.attr("tolist")();
     throw py::type_error("not JSON serializable: " + std::string(py::str(py::type::of(o))));
   });
-  const std::string text = py::str(json.attr("dumps")(value, py::arg("default") = to_list, py::arg("allow_nan") = false));
+  const std::string text = py::str(
+      json.attr("dumps")(value, py::arg("default") = to_list, py::arg("allow_nan") = false));
   return parse_json_text(text, source);
 }
 
@@ -117,12 +131,14 @@ std::vector<LimitViolation> violations_at(const RobotModel& robot, const Eigen::
 
 PYBIND11_MODULE(_shapectl, m) {
   using namespace shapectl::python;
-  m.doc() = "shapectl: statics, kinematics, shape optimization and the continuous controller of "
-            "elastic objects held by a robot (the compiled part of the `shapectl` package).";
+  m.doc() =
+      "shapectl: statics, kinematics, shape optimization and the continuous controller of "
+      "elastic objects held by a robot (the compiled part of the `shapectl` package).";
   // Bad input says where and what, as the CLI prints it; a failed computation is its own type.
   static py::exception<SolverError> solver_error(m, "SolverError", PyExc_RuntimeError);
-  solver_error.doc() = "A computation that ran but failed (statics not converged at the start, a "
-                       "non-finite result, an unstable equilibrium): the CLI's exit code 2.";
+  solver_error.doc() =
+      "A computation that ran but failed (statics not converged at the start, a "
+      "non-finite result, an unstable equilibrium): the CLI's exit code 2.";
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
