@@ -1,0 +1,59 @@
+"""shapectl: shape control of elastic objects held by a robot, from Python.
+
+The library's model and algorithms (the same code as the `shapectl` command): load a scene, solve
+the object's statics at joint angles, take sensitivities dx/dθ, the robot's kinematics, optimize
+joints for a target shape, or run the continuous controller in a background thread.
+
+Arrays are float64 numpy arrays: positions (n, 3) in metres, world frame, mesh node order;
+joints (m,) in radians, in the scene's active-joint order; sensitivities (3n, m).
+Bad input raises ValueError with the CLI's message; a computation that fails raises SolverError.
+Long computations release the GIL, so other Python threads run meanwhile.
+
+    import shapectl
+    scene = shapectl.Scene.load("scenes/yumi_bar.json")
+    eq = shapectl.statics(scene)                     # eq.positions: (425, 3)
+"""
+
+from ._shapectl import (
+    Controller,
+    ControllerSnapshot,
+    GrippedObject,
+    HistoryEntry,
+    Kinematics,
+    LimitViolation,
+    ObjectState,
+    Pose,
+    Robot,
+    Scene,
+    SolveResult,
+    SolveTiming,
+    SolverError,
+    SpherePair,
+    StaticsResult,
+    StaticsSolution,
+    kinematics,
+    solve,
+    statics,
+)
+
+__all__ = [
+    "Controller",
+    "ControllerSnapshot",
+    "GrippedObject",
+    "HistoryEntry",
+    "Kinematics",
+    "LimitViolation",
+    "ObjectState",
+    "Pose",
+    "Robot",
+    "Scene",
+    "SolveResult",
+    "SolveTiming",
+    "SolverError",
+    "SpherePair",
+    "StaticsResult",
+    "StaticsSolution",
+    "kinematics",
+    "solve",
+    "statics",
+]

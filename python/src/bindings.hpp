@@ -1,0 +1,84 @@
+#pragma once
+// Shared pieces of the `shapectl` Python module: the Python-side holders of the library's
+// objects, conversions between Eigen and numpy, and one bind_* function per concept (each in its
+// own file). Arrays go out as float64 numpy arrays in the shapes Python users expect: positions
+// (n, 3), joints (m,), sensitivities (3n, m), rotations (3, 3).
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <nlohmann/json.hpp>
+
+#include <shapectl/control/targets_file.hpp>
+#include <shapectl/robot/collision_spheres.hpp>
+#include <shapectl/robot/joint_limits.hpp>
+#include <shapectl/robot/robot_model.hpp>
+#include <shapectl/sim/gripped_object.hpp>
+#include <shapectl/sim/scene.hpp>
+
+namespace shapectl::python {
+
+namespace py = pybind11;
+
+// A computation that ran but failed (the CLI's exit 2): raised as shapectl.SolverError.
+class SolverError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A loaded scene and, when it has a robot, the gripped object built from it once (immutable,
+// shared by every call and thread that uses the scene).
+struct SceneHandle {
+  std::shared_ptr<const Scene> scene;
+  std::shared_ptr<const GrippedObject> object;  // null without a robot
+  const GrippedObject& gripped() const;         // InputError if the scene has no robot
+};
+
+// A robot model and, optionally, its collision spheres.
+struct RobotHandle {
+  std::shared_ptr<const RobotModel> model;
+  std::shared_ptr<const CollisionModel> collisions;  // may be null
+};
+
+// A pose in the world frame: position (m) and rotation matrix.
+struct Pose {
+  Vec3 position = Vec3::Zero();
+  Mat3 rotation = Mat3::Identity();
+};
+
+// Stacked 3n positions as an (n, 3) array.
+py::array_t<double> positions_array(const Positions& x);
+// An (n, 3) or (3n,) array of finite numbers as stacked positions; InputError naming `what`.
+Positions positions_from(const py::handle& array, int node_count, const std::string& what);
+// A (k, 3) array of finite points.
+std::vector<Vec3> points_from(const py::handle& array, const std::string& what);
+// θ from None (→ defaults), a {name: rad} dict (others keep `defaults`, names checked as in
+// JOINTS.json) or an (m,) array.
+Eigen::VectorXd joints_from(const py::handle& joints, const RobotModel& robot,
+                            const Eigen::VectorXd& defaults);
+// A TARGETS.json path (str or os.PathLike) or a dict of its schema, read as the CLI reads the
+// file; `source` receives the name messages use (the path, or "targets" for a dict).
+TargetsInput read_targets_from(const py::handle& targets, int node_count, std::string& source);
+// A Python value (dicts, lists, numbers, numpy arrays) as JSON, parsed strictly as `source`.
+nlohmann::json json_from(const py::handle& value, const std::string& source);
+
+// Each end effector's tool pose at θ (the CLI's "tools").
+std::map<std::string, Pose> tool_poses(const Scene& scene, const Eigen::VectorXd& joints);
+// Every joint of `full_joints` outside its hard limits (the CLI's "limit_violations").
+std::vector<LimitViolation> violations_at(const RobotModel& robot, const Eigen::VectorXd& active);
+
+void bind_scene(py::module_& m);
+void bind_statics(py::module_& m);
+void bind_kinematics(py::module_& m);
+void bind_solve(py::module_& m);
+void bind_controller(py::module_& m);
+
+}  // namespace shapectl::python
