@@ -1,3 +1,4 @@
+#include <shapectl/control/controller.hpp>
 #include <shapectl/control/model_error_feedback.hpp>
 
 #include <gtest/gtest.h>
@@ -9,6 +10,8 @@
 #include <shapectl/calib/simulated_camera.hpp>
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/sim/scene.hpp>
+
+#include <shapectl/io/input_error.hpp>
 
 #include "support/test_support.hpp"
 
@@ -84,6 +87,59 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
   }
   const double closed_loop = true_error(targets, truth.positions());
   EXPECT_LT(closed_loop, 1e-3) << "open loop " << open_loop * 1e3 << " mm";
+}
+
+// The controller's own loop: it optimizes, the world settles at its joints, the camera's
+// markers come back as observations.
+TEST(ClosedLoop, TheControllerWithFeedbackOnReachesTheTargetsOnTheObservedBar) {
+  const Scene model_scene = load_scene(test::source_path("scenes/yumi_bar.json"));
+  const GrippedObject world(world_of(model_scene));
+  Controller controller(model_scene);
+  const std::shared_ptr<const ControllerSnapshot> first = controller.snapshot();
+  Eigen::VectorXd goal = first->joints;
+  goal[0] -= 0.03, goal[7] += 0.03;
+  ObjectState at_goal = equilibrium_along_path(GrippedObject(model_scene), goal);
+  ShapeTargets targets;
+  std::mt19937 rng(9);
+  for (int node = 0; node < world.node_count(); node += 37)
+    targets.nodes.push_back(node), targets.positions.push_back(at_goal.positions().segment<3>(3 * node));
+  SimulatedCamera camera;
+  camera.marker_nodes = targets.nodes;
+
+  controller.set_targets(targets);
+  controller.set_feedback(true);
+  ObjectState truth = equilibrium_along_path(world, first->joints);
+  std::shared_ptr<const ControllerSnapshot> s;
+  for (int observation = 0; observation < 15; ++observation) {
+    for (int k = 0; k < 10; ++k) controller.step_once();  // the optimizer's iterations between frames
+    s = controller.snapshot();
+    ASSERT_TRUE(s->safe);
+    truth = world.solve_from(s->joints, truth.positions());
+    ASSERT_TRUE(truth.statics().converged()) << truth.statics().reason;
+    const ObservationFrame frame = camera.observe(world.mesh(), truth.positions(), s->joints, rng);
+    ShapeObservation o{.joints = s->joints};
+    for (const ObservedMarker& m : frame.markers) o.markers.emplace_back(m.node, m.position);
+    controller.observe(o);
+  }
+  controller.step_once();
+  s = controller.snapshot();
+  EXPECT_TRUE(s->feedback);
+  EXPECT_EQ(s->observations, 15u);
+  EXPECT_GT(s->model_error, 2e-3);       // the model is wrong by millimetres...
+  EXPECT_LT(s->observed_error, 1e-3);    // ...and the observed bar is at the targets anyway
+  EXPECT_LT(true_error(targets, truth.positions()), 1e-3);
+  EXPECT_EQ(s->targets.positions[0], targets.positions[0]);  // the user's targets, not the aimed ones
+}
+
+TEST(ClosedLoop, ABadObservationIsRefusedAndChangesNothing) {
+  Controller controller(load_scene(test::source_path("scenes/yumi_bar.json")));
+  const auto before = controller.snapshot();
+  EXPECT_THROW(controller.observe({.joints = before->joints, .markers = {{100000, Vec3::Zero()}}}), InputError);
+  EXPECT_THROW(controller.observe({.joints = before->joints, .markers = {{0, Vec3(NAN, 0, 0)}}}), InputError);
+  EXPECT_THROW(controller.observe({.joints = Eigen::VectorXd::Zero(3), .markers = {{0, Vec3::Zero()}}}), InputError);
+  EXPECT_THROW(controller.observe({.joints = before->joints, .markers = {}}), InputError);
+  controller.step_once();
+  EXPECT_EQ(controller.snapshot()->observations, 0u);
 }
 
 TEST(ModelErrorFeedback, UnobservedNodesTakeTheirNeighboursEstimateAndCorrectionsAreClamped) {

@@ -21,8 +21,10 @@ struct Inbox {
   std::optional<bool> paused;
   std::optional<Eigen::VectorXd> jog;
   bool reset = false;
+  std::optional<ShapeObservation> observation;  // the newest only: an older one is stale
+  std::optional<bool> feedback;
   bool empty() const {
-    return !targets && !centerline && !clear && !paused && !jog && !reset;
+    return !targets && !centerline && !clear && !paused && !jog && !reset && !observation && !feedback;
   }
 };
 
@@ -69,6 +71,14 @@ struct Controller::State {
   double rate = 0;
   Clock::time_point last_iteration = Clock::now();
   std::string last_error;
+  // The closed loop: the user's targets, and the feedback that corrects what the optimizer
+  // aims at.
+  ShapeTargets user_targets;
+  std::unique_ptr<ModelErrorFeedback> feedback;
+  bool feedback_on = false;
+  std::vector<std::pair<int, Vec3>> observed_markers;
+  double observed_error = 0;
+  std::uint64_t observations = 0;
 
   mutable std::mutex inbox_mutex;
   std::condition_variable inbox_changed;
@@ -84,10 +94,17 @@ struct Controller::State {
   std::atomic<bool> running{false};
 
   void apply(Inbox in);
-  // The objective is immutable: new targets make a new one.
+  // The objective is immutable: new targets make a new one. It aims at the user's targets,
+  // corrected by the model-error feedback when that is on.
   void retarget(ShapeTargets targets) {
-    objective = std::make_unique<ReducedObjective>(objective->with_targets(std::move(targets)));
+    user_targets = std::move(targets);
+    aim();
   }
+  void aim() {
+    objective = std::make_unique<ReducedObjective>(
+        objective->with_targets(feedback_on ? feedback->corrected(user_targets) : user_targets));
+  }
+  void take(const ShapeObservation& observation);
   void iterate();
   void publish();
   void run();
@@ -139,11 +156,36 @@ void Controller::State::apply(Inbox in) {
       last_error = "jog refused: statics " + e.statics.reason;
     }
   }
-  if (in.clear || in.targets || in.centerline || in.reset) {
+  if (in.reset) feedback->reset(), observed_markers.clear();
+  if (in.feedback) {
+    feedback_on = *in.feedback;
+    aim();
+  }
+  if (in.observation) take(*in.observation);
+  if (in.clear || in.targets || in.centerline || in.reset || in.feedback || (in.observation && feedback_on)) {
     objective->rescore(current);
     optimizer->reset();
   }
   idle = false;
+}
+
+void Controller::State::take(const ShapeObservation& observation) {
+  // The model's prediction at the joints the observation was taken at (the robot may lag θ*).
+  Evaluation predicted = objective->evaluate(observation.joints, current.positions, 0, &current);
+  if (!predicted.statics.converged()) {
+    last_error = "observation ignored: no equilibrium at its joints (" + predicted.statics.reason + ")";
+    return;
+  }
+  feedback->observe(observation.markers, predicted.positions);
+  observed_markers = observation.markers;
+  ++observations;
+  double sum = 0;
+  int count = 0;
+  for (const auto& [node, y] : observation.markers)
+    for (int k = 0; k < user_targets.size(); ++k)
+      if (user_targets.nodes[k] == node) sum += (y - user_targets.positions[k]).norm(), ++count;
+  observed_error = count ? sum / count : NAN;
+  if (feedback_on) aim();
 }
 
 void Controller::State::iterate() {
@@ -184,7 +226,7 @@ void Controller::State::publish() {
   s->upper_limits = robot.upper_limits();
   s->T_world_link = forward_kinematics(robot, current.joints).T_world_link;
   s->positions = current.positions;
-  s->targets = objective->targets();
+  s->targets = user_targets;
   s->centerline = centerline;
   s->error = current.error;
   s->objective = current.objective;
@@ -195,6 +237,11 @@ void Controller::State::publish() {
   s->iterations_per_second = rate;
   s->paused = paused;
   s->last_error = last_error;
+  s->feedback = feedback_on;
+  s->observed_markers = observed_markers;
+  s->model_error = feedback->last_model_error();
+  s->observed_error = observed_error;
+  s->observations = observations;
   s->status = paused                       ? ControllerStatus::Paused
               : objective->targets().empty() ? ControllerStatus::Idle
               : !idle                        ? ControllerStatus::Optimizing
@@ -229,6 +276,7 @@ Controller::Controller(const Scene& scene, ControllerOptions options) : state_(s
   s.objective = std::make_unique<ReducedObjective>(*s.object);
   s.optimizer = make_optimizer(options.optimizer, options.gradient);
   s.bar_axis = find_bar_axis(s.object->mesh());
+  s.feedback = std::make_unique<ModelErrorFeedback>(s.scene.object_mesh, options.feedback);
   s.current = s.objective->evaluate(s.object->reference_joints(), s.object->reference_positions());
   s.publish();
 }
@@ -309,6 +357,27 @@ void Controller::set_joints(const Eigen::VectorXd& joints) {
     if (!pausing) throw InputError("joints", "", "the optimizer to be paused before jogging");
   }
   post(*state_, [&](Inbox& in) { in.jog = joints; });
+}
+
+void Controller::observe(ShapeObservation observation) {
+  const int joints = state_->object->joint_count(), nodes = state_->object->node_count();
+  if (observation.joints.size() != joints)
+    throw InputError("observation", "joints", "one value per active joint (" + std::to_string(joints) + ")");
+  if (!observation.joints.allFinite()) throw InputError("observation", "joints", "finite values");
+  if (observation.markers.empty()) throw InputError("observation", "markers", "at least one marker");
+  for (std::size_t k = 0; k < observation.markers.size(); ++k) {
+    const auto& [node, position] = observation.markers[k];
+    const std::string where = "markers[" + std::to_string(k) + "]";
+    if (node < 0 || node >= nodes)
+      throw InputError("observation", where + ".node", "a node from 0 to " + std::to_string(nodes - 1),
+                       std::to_string(node));
+    check_target_point(position, "observation", where + ".position");
+  }
+  post(*state_, [&](Inbox& in) { in.observation = std::move(observation); });
+}
+
+void Controller::set_feedback(bool on) {
+  post(*state_, [&](Inbox& in) { in.feedback = on; });
 }
 
 void Controller::reset() {

@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include <shapectl/control/model_error_feedback.hpp>
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/control/shape_targets.hpp>
 
@@ -23,6 +24,15 @@ namespace shapectl {
 struct ControllerOptions {
   OptimizerKind optimizer = OptimizerKind::GaussNewton;
   GradientMethod gradient = GradientMethod::Sensitivity;
+  FeedbackOptions feedback;
+};
+
+// An observation of the real object for the closed loop: tracked markers at mesh nodes (world
+// frame, m) and the joints the robot measured when they were taken.
+struct ShapeObservation {
+  Eigen::VectorXd joints;
+  std::vector<std::pair<int, Vec3>> markers;
+  double time = 0;  // s, as the observer stamped it
 };
 
 // What the controller is doing, as published.
@@ -48,7 +58,7 @@ struct ControllerSnapshot {
   Eigen::VectorXd lower_limits, upper_limits;
   std::vector<Eigen::Isometry3d> T_world_link;  // every link of the robot model
   Positions positions;            // x̂(θ), 3n
-  ShapeTargets targets;           // what is asked for now
+  ShapeTargets targets;           // what is asked for now (the user's, not the corrected ones)
   std::vector<Vec3> centerline;   // the sketched centre-line, if the targets came from one
   ShapeError error;               // of positions against targets
   double objective = 0;
@@ -60,6 +70,14 @@ struct ControllerSnapshot {
   bool paused = false;
   ControllerStatus status = ControllerStatus::Idle;
   std::string last_error;  // e.g. statics failure while jogging; empty when fine
+  // The closed loop (set_feedback, observe): the last observation, its model error (observed
+  // vs predicted at its joints, RMS, m) and observed error (observed vs targets at the
+  // observed target nodes, mean, m; NaN when no target node is observed).
+  bool feedback = false;
+  std::vector<std::pair<int, Vec3>> observed_markers;
+  double model_error = 0;
+  double observed_error = 0;
+  std::uint64_t observations = 0;
 };
 
 class Controller {
@@ -89,6 +107,12 @@ class Controller {
   // Jog: only while paused; θ is clamped to the hard limits, statics follows.
   void set_joints(const Eigen::VectorXd& joints);
   void reset();  // reference joints and shape, targets cleared
+  // The closed loop: each observation updates the model-error estimate (control/
+  // model_error_feedback.hpp); with feedback on, the optimizer aims at the corrected targets
+  // so that the observed shape reaches the user's. Markers must be nodes of the mesh and every
+  // number finite (InputError otherwise, nothing changed); joints of the robot's size.
+  void observe(ShapeObservation observation);
+  void set_feedback(bool on);
 
   std::shared_ptr<const ControllerSnapshot> snapshot() const;
   // Blocks until a snapshot with sequence > `after` exists, or the timeout passes.
