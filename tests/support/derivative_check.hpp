@@ -80,13 +80,6 @@ inline ::testing::AssertionResult derivative_matches(const Eigen::MatrixXd& anal
   return ::testing::AssertionSuccess() << what << ": " << worst.str();
 }
 
-// Largest entry of |a − b| relative to the largest entry of |b|. Superseded by
-// derivative_matches, which also refuses to compare zeros; gone once every test uses that.
-inline double relative_error(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  const double scale = b.cwiseAbs().maxCoeff();
-  return (a - b).cwiseAbs().maxCoeff() / std::max(scale, 1e-300);
-}
-
 inline Positions perturbed(const Positions& x, double amount, std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-amount, amount);
   Positions y = x;
