@@ -40,22 +40,21 @@ TEST(ReducedObjective, GradientAgreesAllThreeWaysWithCentralDifferences) {
     const Evaluation at = objective.evaluate(theta, object.reference_positions());
     ASSERT_TRUE(at.statics.converged());
     ASSERT_GT(at.joint_limits, 0);
-    Eigen::VectorXd central(theta.size());
-    const double h = 1e-5;
-    for (int j = 0; j < theta.size(); ++j) {
-      Eigen::VectorXd tp = theta, tm = theta;
-      tp[j] += h;
-      tm[j] -= h;
-      central[j] = (objective.evaluate(tp, at.positions).objective -
-                    objective.evaluate(tm, at.positions).objective) / (2 * h);
-    }
+    // Ô with the equilibrium re-solved at each perturbed θ.
+    const auto reduced = [&](const Eigen::VectorXd& t) {
+      return objective.evaluate(t, at.positions).objective;
+    };
+    const Eigen::VectorXd central = test::central_difference_gradient(reduced, theta, 1e-5);
     const Eigen::VectorXd sensitivity = objective.gradient(at, GradientMethod::Sensitivity);
     const Eigen::VectorXd adjoint = objective.gradient(at, GradientMethod::Adjoint);
     const Eigen::VectorXd forward = objective.gradient(at, GradientMethod::FiniteDifference);
-    EXPECT_LT(test::relative_error(sensitivity, central), 1e-5) << "trial " << trial;
-    EXPECT_LT(test::relative_error(adjoint, central), 1e-5) << "trial " << trial;
+    EXPECT_TRUE(test::derivative_matches(sensitivity, central, 1e-5, "sensitivity gradient"))
+        << "trial " << trial;
+    EXPECT_TRUE(test::derivative_matches(adjoint, central, 1e-5, "adjoint gradient"))
+        << "trial " << trial;
     // Forward differences carry an O(h) error: the baseline is less exact by nature.
-    EXPECT_LT(test::relative_error(forward, central), 1e-3) << "trial " << trial;
+    EXPECT_TRUE(test::derivative_matches(forward, central, 1e-3, "forward-difference gradient"))
+        << "trial " << trial;
   }
 }
 
@@ -72,20 +71,18 @@ TEST(ReducedObjective, LeastSquaresFormMatchesObjectiveAndGradient) {
   Eigen::MatrixXd J;
   objective.least_squares(at, r, J);
   EXPECT_NEAR(0.5 * r.squaredNorm(), at.objective, 1e-12 * at.objective);
-  EXPECT_LT(test::relative_error(J.transpose() * r, objective.gradient(at, GradientMethod::Sensitivity)), 1e-9);
+  EXPECT_TRUE(test::derivative_matches(J.transpose() * r,
+                                       objective.gradient(at, GradientMethod::Sensitivity), 1e-9,
+                                       "Jᵀr against the gradient"));
   // The Jacobian itself against central differences of the residuals.
-  Eigen::MatrixXd J_fd(J.rows(), J.cols());
-  const double h = 1e-6;
-  for (int j = 0; j < theta.size(); ++j) {
-    Eigen::VectorXd tp = theta, tm = theta, rp, rm;
+  const auto residuals = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
+    Eigen::VectorXd residual;
     Eigen::MatrixXd unused;
-    tp[j] += h;
-    tm[j] -= h;
-    objective.least_squares(objective.evaluate(tp, at.positions), rp, unused);
-    objective.least_squares(objective.evaluate(tm, at.positions), rm, unused);
-    J_fd.col(j) = (rp - rm) / (2 * h);
-  }
-  EXPECT_LT(test::relative_error(J, J_fd), 1e-5);
+    objective.least_squares(objective.evaluate(t, at.positions), residual, unused);
+    return residual;
+  };
+  EXPECT_TRUE(test::derivative_matches(J, test::central_difference_jacobian(residuals, theta, 1e-6),
+                                       1e-5, "least-squares Jacobian"));
 }
 
 TEST(ReducedObjective, ConfirmStableRejectsAStateWhoseHessianIsIndefinite) {

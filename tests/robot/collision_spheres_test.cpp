@@ -7,6 +7,7 @@
 
 #include <shapectl/io/input_error.hpp>
 
+#include "support/derivative_check.hpp"
 #include "support/test_support.hpp"
 
 namespace shapectl {
@@ -100,27 +101,26 @@ std::vector<Eigen::VectorXd> colliding_configurations(const RobotModel& robot,
 TEST(CollisionModel, BarrierGradientMatchesCentralDifferences) {
   const RobotModel robot = RobotModel::load_urdf_file(kYumiDir + "yumi.urdf");
   const CollisionModel model = CollisionModel::load_json_file(robot, kYumiDir + "yumi_spheres.json");
-  const double h = 1e-6;
+  const auto barrier = [&](const Eigen::VectorXd& t) {
+    return model.value(robot, forward_kinematics(robot, t));
+  };
   for (const Eigen::VectorXd& theta : colliding_configurations(robot, model, 5)) {
     Eigen::VectorXd gradient;
     model.value(robot, forward_kinematics(robot, theta), &gradient);
-    Eigen::VectorXd numeric(theta.size());
-    for (int i = 0; i < theta.size(); ++i) {
-      Eigen::VectorXd plus = theta, minus = theta;
-      plus[i] += h;
-      minus[i] -= h;
-      numeric[i] = (model.value(robot, forward_kinematics(robot, plus)) -
-                    model.value(robot, forward_kinematics(robot, minus))) / (2 * h);
-    }
-    ASSERT_GT(numeric.norm(), 0.0);
-    EXPECT_LE((gradient - numeric).norm(), 1e-6 * numeric.norm());
+    EXPECT_TRUE(test::derivative_matches(gradient,
+                                         test::central_difference_gradient(barrier, theta, 1e-6),
+                                         1e-6, "collision barrier gradient"));
   }
 }
 
 TEST(CollisionModel, ResidualsSquareToTheBarrierAndTheirJacobianMatchesCentralDifferences) {
   const RobotModel robot = RobotModel::load_urdf_file(kYumiDir + "yumi.urdf");
   const CollisionModel model = CollisionModel::load_json_file(robot, kYumiDir + "yumi_spheres.json");
-  const double h = 1e-6;
+  const auto residuals = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
+    Eigen::VectorXd r;
+    model.residuals(robot, forward_kinematics(robot, t), r);
+    return r;
+  };
   for (const Eigen::VectorXd& theta : colliding_configurations(robot, model, 3)) {
     const KinematicsState state = forward_kinematics(robot, theta);
     Eigen::VectorXd r;
@@ -128,17 +128,9 @@ TEST(CollisionModel, ResidualsSquareToTheBarrierAndTheirJacobianMatchesCentralDi
     model.residuals(robot, state, r, &jacobian);
     ASSERT_EQ(r.size(), model.pair_count());
     EXPECT_NEAR(0.5 * r.squaredNorm(), model.value(robot, state), 1e-9 * model.value(robot, state));
-    Eigen::MatrixXd numeric(r.size(), theta.size());
-    for (int i = 0; i < theta.size(); ++i) {
-      Eigen::VectorXd plus = theta, minus = theta, r_plus, r_minus;
-      plus[i] += h;
-      minus[i] -= h;
-      model.residuals(robot, forward_kinematics(robot, plus), r_plus);
-      model.residuals(robot, forward_kinematics(robot, minus), r_minus);
-      numeric.col(i) = (r_plus - r_minus) / (2 * h);
-    }
-    ASSERT_GT(numeric.norm(), 0.0);
-    EXPECT_LE((jacobian - numeric).norm(), 1e-6 * numeric.norm());
+    EXPECT_TRUE(test::derivative_matches(jacobian,
+                                         test::central_difference_jacobian(residuals, theta, 1e-6),
+                                         1e-6, "collision residual Jacobian"));
   }
 }
 

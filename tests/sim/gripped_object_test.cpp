@@ -35,24 +35,18 @@ TEST(GripSprings, ForceJacobianMatchesCentralDifferencesInJoints) {
     const Positions x = test::perturbed(object.reference_positions(), 0.003, rng);
     const KinematicsState kinematics = forward_kinematics(object.robot(), theta);
     const Eigen::MatrixXd dF = object.grips().force_jacobian(kinematics, object.node_count());
-    Eigen::MatrixXd dF_fd(dF.rows(), dF.cols());
-    const double h = 1e-6;
-    for (int j = 0; j < theta.size(); ++j) {
-      auto force = [&](double dt) {
-        Eigen::VectorXd t = theta;
-        t[j] += dt;
-        const GripEnergy springs(object.grips(), forward_kinematics(object.robot(), t));
-        Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
-        springs.add_gradient(x, g);
-        return Eigen::VectorXd(-g);
-      };
-      dF_fd.col(j) = (force(h) - force(-h)) / (2 * h);
-    }
-    EXPECT_LT(test::relative_error(dF, dF_fd), 1e-6);
+    const auto force = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
+      const GripEnergy springs(object.grips(), forward_kinematics(object.robot(), t));
+      return -test::energy_gradient(springs, x);
+    };
+    EXPECT_TRUE(test::derivative_matches(dF, test::central_difference_jacobian(force, theta, 1e-6),
+                                         1e-6, "grip force Jacobian in joints"));
     // The adjoint product agrees with the explicit matrix.
     const Eigen::VectorXd lambda = test::perturbed(Eigen::VectorXd::Zero(x.size()), 1.0, rng);
-    EXPECT_LT(test::relative_error(object.grips().force_jacobian_transpose_times(kinematics, lambda),
-                                   dF.transpose() * lambda), 1e-12);
+    EXPECT_TRUE(
+        test::derivative_matches(object.grips().force_jacobian_transpose_times(kinematics, lambda),
+                                 dF.transpose() * lambda, 1e-12,
+                                 "grip force Jacobian transpose times"));
   }
 }
 
@@ -102,20 +96,19 @@ TEST(GrippedObject, SensitivityMatchesCentralDifferencesOfStatics) {
     ASSERT_TRUE(state.statics().converged());
     const Positions x = state.positions();
     const Eigen::MatrixXd dx = object.sensitivity(state);
-    Eigen::MatrixXd dx_fd(dx.rows(), dx.cols());
-    const double h = 1e-5;
-    for (int j = 0; j < theta.size(); ++j) {
-      Eigen::VectorXd tp = theta, tm = theta;
-      tp[j] += h;
-      tm[j] -= h;
-      const ObjectState sp = object.solve_from(tp, x), sm = object.solve_from(tm, x);
-      ASSERT_TRUE(sp.statics().converged());
-      ASSERT_TRUE(sm.statics().converged());
-      dx_fd.col(j) = (sp.positions() - sm.positions()) / (2 * h);
-    }
-    EXPECT_LT(test::relative_error(dx, dx_fd), 1e-5) << "trial " << trial;
+    // The equilibrium re-solved at each perturbed θ, warm-started from x̂(θ).
+    const auto equilibrium = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
+      const ObjectState moved = object.solve_from(t, x);
+      EXPECT_TRUE(moved.statics().converged()) << moved.statics().reason;
+      return moved.positions();
+    };
+    EXPECT_TRUE(
+        test::derivative_matches(dx, test::central_difference_jacobian(equilibrium, theta, 1e-5),
+                                 1e-5, "sensitivity dx/dθ"))
+        << "trial " << trial;
     const Eigen::VectorXd v = test::perturbed(Eigen::VectorXd::Zero(x.size()), 1.0, rng);
-    EXPECT_LT(test::relative_error(object.adjoint(state, v), dx.transpose() * v), 1e-9);
+    EXPECT_TRUE(test::derivative_matches(object.adjoint(state, v), dx.transpose() * v, 1e-9,
+                                         "adjoint (dx/dθ)ᵀv"));
   }
 }
 
