@@ -139,6 +139,11 @@ function onState(state) {
     s.row.classList.toggle('near-limit', v < s.lo + margin || v > s.hi - margin);
   });
 
+  $('feedback').checked = !!state.feedback;
+  $('observed').textContent = state.observations
+    ? `${state.observations} observations · model error ${mm(state.model_error)} mm · observed error ${mm(state.observed_error)} mm`
+    : 'no observations yet';
+
   if (state.link) {
     const l = state.link;
     $('link-status').textContent = `${l.kind}: ${l.connected ? 'connected' : 'no feedback'}, ${l.armed ? 'ARMED' : 'disarmed'}` +
@@ -175,6 +180,7 @@ $('show-wireframe').onchange = (e) => view.setWireframe(e.target.checked);
 $('show-spheres').onchange = (e) => view.setSpheresVisible(e.target.checked);
 $('show-robot').onchange = (e) => view.setRobotVisible(e.target.checked);
 $('scene-select').onchange = (e) => command(Command.LoadScene, { scene: e.target.value });
+$('feedback').onchange = (e) => command(Command.SetFeedback, { on: e.target.checked });
 $('arm').onclick = () => command(Command.Arm);
 $('disarm').onclick = () => command(Command.Disarm);
 window.addEventListener('keydown', (e) => {

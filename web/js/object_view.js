@@ -1,6 +1,7 @@
 // The gripped object in the 3D view: its surface (optional wireframe) at the streamed node
 // positions, the gripped nodes in red, each target as an orange arrow from its node with a
-// handle to drag, the centre-line the server follows and the one being sketched. World frame,
+// handle to drag, the centre-line the server follows and the one being sketched, and the markers
+// a tracker observed on the real object (cyan points: where the real object is). World frame,
 // metres. Targets being dragged are shown where the hand is, ahead of the server.
 import * as THREE from 'three';
 
@@ -58,6 +59,13 @@ export class ObjectView {
     this.gripAttribute = null;
     this.gripPoints = null;
     this.centerline = makeLine(ORANGE);
+    // Observed markers: one Points object, its buffer regrown only when more markers arrive.
+    this.observedGeometry = new THREE.BufferGeometry();
+    this.observed = new THREE.Points(this.observedGeometry,
+      new THREE.PointsMaterial({ color: 0x22d3ee, size: 9, sizeAttenuation: false, depthTest: false }));
+    this.observed.renderOrder = 2;
+    this.observed.frustumCulled = false;
+    this.group.add(this.observed);
     this.sketchLine = makeLine(0xffe08a);
 
     this.targets = [];             // the last state's [{node, position}]
@@ -155,6 +163,19 @@ export class ObjectView {
   setSelected(node) {
     this.selected = node;
     this.drawTargets();
+  }
+
+  // [[node, x, y, z], ...] from the state's "observed_markers".
+  setObservedMarkers(markers) {
+    const n = markers?.length ?? 0;
+    let attribute = this.observedGeometry.getAttribute('position');
+    if (!attribute || attribute.count < n) {
+      attribute = new THREE.BufferAttribute(new Float32Array(3 * Math.max(n, 16)), 3);
+      this.observedGeometry.setAttribute('position', attribute);
+    }
+    for (let k = 0; k < n; ++k) attribute.setXYZ(k, markers[k][1], markers[k][2], markers[k][3]);
+    attribute.needsUpdate = true;
+    this.observedGeometry.setDrawRange(0, n);
   }
 
   setWireframe(on) {

@@ -17,6 +17,8 @@ export const Command = Object.freeze({
   LoadScene: 'load_scene',
   Arm: 'arm',
   Disarm: 'disarm',
+  Observe: 'observe',
+  SetFeedback: 'set_feedback',
 });
 
 // Text messages, server → client: a reply to a command (to its sender) or a broadcast.

@@ -137,6 +137,7 @@ export class View3D {
     this.robotView.setLinkPoses(state.links);
     this.objectView.setCenterline(state.centerline);
     this.objectView.setTargets(state.targets, state.centerline.length === 0);  // the curve is the handle there
+    this.objectView.setObservedMarkers(state.observed_markers);
     this.requestRender();
   }
 
