@@ -13,6 +13,7 @@
 #include <shapectl/control/controller.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/session_log.hpp>
 #include <shapectl/link/egm_link.hpp>
 #include <shapectl/link/make_robot_link.hpp>
@@ -39,8 +40,6 @@ struct RunArgs {
   double watchdog_ms = 100;
 };
 
-std::vector<double> to_list(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
-
 nlohmann::json link_json(const LinkStatus& s) {
   return {{"kind", s.kind},
           {"connected", s.connected},
@@ -52,8 +51,8 @@ nlohmann::json link_json(const LinkStatus& s) {
           {"lost_datagrams", s.lost_datagrams},
           {"stale_datagrams", s.stale_datagrams},
           {"foreign_datagrams", s.foreign_datagrams},
-          {"commanded", to_list(s.commanded)},
-          {"measured", to_list(s.measured)}};
+          {"commanded", vector_json(s.commanded)},
+          {"measured", vector_json(s.measured)}};
 }
 
 // Why running on cannot settle, or empty.
@@ -67,7 +66,7 @@ std::string cannot_settle(const ControllerSnapshot& s, const LinkStatus& link, b
 void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
   log.write("optimizer", {{"sequence", s.sequence},
                           {"status", to_string(s.status)},
-                          {"joints", to_list(s.joints)},
+                          {"joints", vector_json(s.joints)},
                           {"safe", s.safe},
                           {"error_mean", s.error.mean},
                           {"error_max", s.error.max},
@@ -103,11 +102,9 @@ void run(RunArgs args) {
   if (targets.centerline.empty()) controller.set_targets(targets.targets);
   else controller.set_centerline(targets.centerline);
   if (log) {
-    nlohmann::json t = {{"nodes", targets.targets.nodes}};
-    nlohmann::json positions = nlohmann::json::array(), line = nlohmann::json::array();
-    for (const auto& p : targets.targets.positions) positions.push_back({p.x(), p.y(), p.z()});
-    for (const auto& p : targets.centerline) line.push_back({p.x(), p.y(), p.z()});
-    log->write("targets", {{"nodes", targets.targets.nodes}, {"positions", positions}, {"centerline", line}});
+    log->write("targets", {{"nodes", targets.targets.nodes},
+                           {"positions", points_json(targets.targets.positions)},
+                           {"centerline", points_json(targets.centerline)}});
   }
   install_stop_signal_handlers();
   controller.start();
@@ -184,7 +181,7 @@ void run(RunArgs args) {
                            {"error_max", snap->error.max},
                            {"iterations", snap->iterations},
                            {"joint_names", snap->joint_names},
-                           {"joints", to_list(snap->joints)},
+                           {"joints", vector_json(snap->joints)},
                            {"link", link_json(final_status)}};
   if (auto* egm = dynamic_cast<EgmLink*>(link.get())) {
     const LatencyStats l = egm->latency();

@@ -230,12 +230,4 @@ std::string positions_frame(const ControllerSnapshot& snapshot) {
   return frame;
 }
 
-nlohmann::json pose_json(const Eigen::Isometry3d& T) {
-  nlohmann::json a = nlohmann::json::array();
-  const Eigen::Matrix4d& m = T.matrix();
-  for (int col = 0; col < 4; ++col)
-    for (int row = 0; row < 4; ++row) a.push_back(m(row, col));
-  return a;
-}
-
 }  // namespace shapectl::server
