@@ -29,7 +29,7 @@
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/robot/sphere_cover.hpp>
 #include <shapectl/robot/urdf_collision.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 

@@ -10,6 +10,8 @@
 
 #include <shapectl/control/optimizer.hpp>
 #include <shapectl/control/optimize.hpp>
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 #include "result_json.hpp"

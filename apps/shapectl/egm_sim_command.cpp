@@ -12,7 +12,7 @@
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/link/egm_simulator.hpp>
 #include <shapectl/link/stop_signal.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 

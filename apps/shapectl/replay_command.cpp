@@ -16,7 +16,7 @@
 #include <shapectl/link/command_log.hpp>
 #include <shapectl/link/make_robot_link.hpp>
 #include <shapectl/link/stop_signal.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 

@@ -18,6 +18,7 @@
 #include <shapectl/link/egm_link.hpp>
 #include <shapectl/link/make_robot_link.hpp>
 #include <shapectl/link/stop_signal.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 #include "result_json.hpp"

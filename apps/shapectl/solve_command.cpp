@@ -9,9 +9,11 @@
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/atomic_file.hpp>
+#include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/io/vtu_writer.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 #include "result_json.hpp"

@@ -4,10 +4,12 @@
 #include <iostream>
 
 #include <shapectl/io/atomic_file.hpp>
+#include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/io/vtu_writer.hpp>
 #include <shapectl/robot/joints_file.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/sim/gripped_object.hpp>
 
 #include "commands.hpp"

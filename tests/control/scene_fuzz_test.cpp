@@ -2,7 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <shapectl/control/targets_file.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/io/json_input.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "io/text_mutator.hpp"
 #include "support/test_support.hpp"

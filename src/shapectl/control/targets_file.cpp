@@ -3,6 +3,7 @@
 #include <set>
 
 #include <shapectl/io/json_eigen.hpp>
+#include <shapectl/io/json_input.hpp>
 
 namespace shapectl {
 

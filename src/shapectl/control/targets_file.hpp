@@ -7,9 +7,10 @@
 #include <nlohmann/json_fwd.hpp>
 
 #include <shapectl/control/shape_targets.hpp>
-#include <shapectl/io/json_input.hpp>
 
 namespace shapectl {
+
+class JsonInput;
 
 struct TargetsInput {
   ShapeTargets targets;          // explicit node targets (empty for a centre-line)

@@ -9,7 +9,7 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/link/robot_link.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 namespace shapectl::server {
 

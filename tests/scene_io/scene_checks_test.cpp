@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <shapectl/io/input_error.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/sim/scene_checks.hpp>
 
 #include "support/test_support.hpp"
