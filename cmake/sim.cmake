@@ -5,8 +5,8 @@ find_package(BLAS REQUIRED)
 find_package(LAPACK REQUIRED)  # OpenBLAS's: band Cholesky
 
 shapectl_area(sim)
-target_link_libraries(shapectl_sim PUBLIC shapectl_fem shapectl_io shapectl_mesh shapectl_robot
-                      PRIVATE ${CHOLMOD_LIB} ${LAPACK_LIBRARIES} ${BLAS_LIBRARIES})
+target_link_libraries(shapectl_sim PUBLIC shapectl_fem shapectl_mesh shapectl_robot
+                      PRIVATE shapectl_io ${CHOLMOD_LIB} ${LAPACK_LIBRARIES} ${BLAS_LIBRARIES})
 target_include_directories(shapectl_sim PRIVATE ${SUITESPARSE_INCLUDE})
 
 shapectl_tests(sim shapectl_sim)

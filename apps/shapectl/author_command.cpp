@@ -18,6 +18,7 @@
 #include <shapectl/io/atomic_file.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/input_file.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/mesh/load_mesh.hpp>
@@ -28,7 +29,7 @@
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/robot/sphere_cover.hpp>
 #include <shapectl/robot/urdf_collision.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 
@@ -154,7 +155,7 @@ ObjectMesh read_object_mesh(const AuthorOptions& o, const fs::path& scene_dir) {
       }
     }
     return {std::make_shared<const TetMesh>(make_box_mesh(size, cells)),
-            Json{{"box", {{"size", {size.x(), size.y(), size.z()}}, {"cells", cells}}}}};
+            Json{{"box", {{"size", vec3_json(size)}, {"cells", cells}}}}};
   }
   const fs::path file = fs::absolute(o.mesh);
   auto mesh = std::make_shared<const TetMesh>(load_mesh(file));
@@ -245,9 +246,7 @@ Spheres generate_spheres(const AuthorOptions& o, const RobotModel& model, std::v
 Eigen::Isometry3d pose_from(const std::vector<double>& v) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.translation() = Vec3(v[0], v[1], v[2]);
-  if (v.size() == 6)
-    T.linear() = (Eigen::AngleAxisd(v[5], Vec3::UnitZ()) * Eigen::AngleAxisd(v[4], Vec3::UnitY()) *
-                  Eigen::AngleAxisd(v[3], Vec3::UnitX())).toRotationMatrix();
+  if (v.size() == 6) T.linear() = rotation_from_rpy(Vec3(v[3], v[4], v[5]));
   return T;
 }
 
@@ -327,13 +326,11 @@ std::vector<ProposedGrip> propose_grips(const AuthorOptions& o, const std::vecto
   return grips;
 }
 
-Json vec_json(const Vec3& v) { return Json::array({v.x(), v.y(), v.z()}); }
-
 Json spheres_json(const RobotModel& model, const Spheres& s, double margin, const std::string& urdf) {
   Json by_link = Json::object();
   for (const auto& sphere : s.spheres)
     by_link[model.links()[static_cast<std::size_t>(sphere.link)].name].push_back(
-        {{"center", vec_json(sphere.center_link)}, {"radius", sphere.radius}});
+        {{"center", vec3_json(sphere.center_link)}, {"radius", sphere.radius}});
   Json ignore = Json::array();
   std::set<std::pair<int, int>> seen;
   for (const auto* list : {&s.adjacent, &s.always})
@@ -430,7 +427,7 @@ void run(const AuthorOptions& o) {
     grip_report.push_back({{"end_effector", ees[e].name},
                            {"link", model.links()[static_cast<std::size_t>(ees[e].link)].name},
                            {"node_count", grips[e].nodes.size()},
-                           {"region_centre", vec_json(grips[e].centre_world)},
+                           {"region_centre", vec3_json(grips[e].centre_world)},
                            {"tool_distance", distance}});
   }
   if (!violations.empty() || !(clearance > 0))
@@ -442,16 +439,15 @@ void run(const AuthorOptions& o) {
   Json end_effectors = Json::array();
   for (const auto& ee : ees)
     end_effectors.push_back({{"name", ee.name}, {"link", model.links()[static_cast<std::size_t>(ee.link)].name},
-                             {"tcp", vec_json(ee.tcp_link)}});
+                             {"tcp", vec3_json(ee.tcp_link)}});
   Json grip_list = Json::array();
   for (std::size_t e = 0; e < ees.size(); ++e) grip_list.push_back({{"end_effector", ees[e].name}, {"nodes", grips[e].nodes}});
-  const Vec3 rpy = T_world_object.linear().eulerAngles(2, 1, 0).reverse();
   const auto scene_text = [&](const fs::path& spheres_file) {
     const Json scene = {
         {"object",
          {{"mesh", object.json},
           {"material", {{"youngs_modulus", o.youngs_modulus}, {"poisson_ratio", o.poisson_ratio}, {"density", o.density}}},
-          {"pose", {{"position", vec_json(T_world_object.translation())}, {"rpy", vec_json(rpy)}}}}},
+          {"pose", scene_pose_json(T_world_object)}}},
         {"gravity", {0, 0, -9.81}},
         {"robot",
          {{"urdf", relative_to(o.urdf, scene_dir).generic_string()},

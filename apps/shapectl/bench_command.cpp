@@ -6,10 +6,13 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <random>
 
 #include <shapectl/control/optimizer.hpp>
 #include <shapectl/control/optimize.hpp>
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 #include "result_json.hpp"
@@ -53,27 +56,22 @@ bool random_goal(const ReducedObjective& objective, const Evaluation& reference,
   return true;
 }
 
-void bench_scene(const std::string& file, const BenchArgs& args) {
-  const Scene scene = load_scene(file);
-  print_scene_notes(scene);
-  if (!scene.robot) throw InputError(file, "robot", "a scene with a robot (missing key)");
-  GrippedObject object(scene);
-  ReducedObjective objective(object);
-  std::mt19937 rng(args.seed);
-  const Evaluation reference = objective.evaluate(object.reference_joints(), object.reference_positions());
-  if (!reference.statics.converged()) throw SolverFailure("statics at the reference: " + reference.statics.reason);
-  std::printf("\n%s: %d tets, %d nodes, %d joints\n", file.c_str(), object.mesh().tet_count(),
-              object.node_count(), object.joint_count());
+// Timings of one reduced-gradient variant, seconds.
+struct GradientTimes {
+  std::vector<double> sensitivity, sensitivity_factored, adjoint, adjoint_factored, fd_chord, fd_newton;
+};
 
-  // 1. Reduced gradient, each method at the same states x̂(θ), each right after the statics
-  // solve that reached θ from the reference shape. "reused": the true Hessian at x̂ is already
-  // factored, as in an optimizer, which factors it to confirm an accepted state is stable
-  // (or as the last Newton step of a solve leaves it). "counted": that factorization is part
-  // of the timed gradient. "Newton": finite differences whose re-solves factor anew (no chord steps), the
-  // paper's baseline.
+// 1. Reduced gradient, each method at the same states x̂(θ), each right after the statics
+// solve that reached θ from the reference shape. "reused": the true Hessian at x̂ is already
+// factored, as in an optimizer, which factors it to confirm an accepted state is stable
+// (or as the last Newton step of a solve leaves it). "counted": that factorization is part
+// of the timed gradient. "Newton": finite differences whose re-solves factor anew (no chord steps), the
+// paper's baseline.
+GradientTimes time_gradients(const GrippedObject& object, const ReducedObjective& objective,
+                             const Evaluation& reference, int trials, std::mt19937& rng) {
   enum class Factor { Reused, Counted, NewtonResolves, ChordResolves };
-  std::vector<double> t_sens, t_sens_factored, t_adj, t_adj_factored, t_fd_chord, t_fd_newton;
-  for (int trial = 0; trial < args.trials; ++trial) {
+  GradientTimes t;
+  for (int trial = 0; trial < trials; ++trial) {
     ShapeTargets targets;
     if (!random_goal(objective, reference, rng, targets)) continue;
     std::uniform_real_distribution<double> u(-0.1, 0.1);
@@ -81,12 +79,12 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
     for (int j = 0; j < theta.size(); ++j) theta[j] += u(rng);
     if (!objective.evaluate(theta, reference.positions).statics.converged()) continue;
     for (auto [method, times, factor] :
-         {std::tuple{GradientMethod::Sensitivity, &t_sens, Factor::Reused},
-          std::tuple{GradientMethod::Sensitivity, &t_sens_factored, Factor::Counted},
-          std::tuple{GradientMethod::Adjoint, &t_adj, Factor::Reused},
-          std::tuple{GradientMethod::Adjoint, &t_adj_factored, Factor::Counted},
-          std::tuple{GradientMethod::FiniteDifference, &t_fd_chord, Factor::ChordResolves},
-          std::tuple{GradientMethod::FiniteDifference, &t_fd_newton, Factor::NewtonResolves}}) {
+         {std::tuple{GradientMethod::Sensitivity, &t.sensitivity, Factor::Reused},
+          std::tuple{GradientMethod::Sensitivity, &t.sensitivity_factored, Factor::Counted},
+          std::tuple{GradientMethod::Adjoint, &t.adjoint, Factor::Reused},
+          std::tuple{GradientMethod::Adjoint, &t.adjoint_factored, Factor::Counted},
+          std::tuple{GradientMethod::FiniteDifference, &t.fd_chord, Factor::ChordResolves},
+          std::tuple{GradientMethod::FiniteDifference, &t.fd_newton, Factor::NewtonResolves}}) {
       const ReducedObjective variant(object, targets,
                                      {.stale_factor_step = factor == Factor::Counted ? 0.0 : 1e-6,
                                       .chord_steps = factor != Factor::NewtonResolves});
@@ -97,54 +95,66 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
       times->push_back(seconds(t0, Clock::now()));
     }
   }
-  const double fd = percentile(t_fd_newton, 0.5);
-  auto row = [&](const char* name, const std::vector<double>& t) {
-    std::printf("    %-40s %8.3f ms   %6.1fx\n", name, 1e3 * percentile(t, 0.5), fd / percentile(t, 0.5));
+  return t;
+}
+
+void print_gradient_times(const GradientTimes& t) {
+  const double fd = percentile(t.fd_newton, 0.5);
+  auto row = [&](const char* name, const std::vector<double>& times) {
+    std::printf("    %-40s %8.3f ms   %6.1fx\n", name, 1e3 * percentile(times, 0.5), fd / percentile(times, 0.5));
   };
-  std::printf("  reduced gradient (median of %zu)                time      vs finite differences (Newton re-solves)\n", t_fd_newton.size());
-  row("sensitivity, factorization at x reused", t_sens);
-  row("sensitivity, factorization counted", t_sens_factored);
-  row("adjoint, factorization at x reused", t_adj);
-  row("adjoint, factorization counted", t_adj_factored);
-  row("finite differences, chord re-solves", t_fd_chord);
-  row("finite differences, Newton re-solves", t_fd_newton);
+  std::printf("  reduced gradient (median of %zu)                time      vs finite differences (Newton re-solves)\n", t.fd_newton.size());
+  row("sensitivity, factorization at x reused", t.sensitivity);
+  row("sensitivity, factorization counted", t.sensitivity_factored);
+  row("adjoint, factorization at x reused", t.adjoint);
+  row("adjoint, factorization counted", t.adjoint_factored);
+  row("finite differences, chord re-solves", t.fd_chord);
+  row("finite differences, Newton re-solves", t.fd_newton);
+}
 
-  // 2. Target change → mean error below 1 mm, from the reference equilibrium.
-  for (auto [kind, name] : {std::pair{OptimizerKind::GaussNewton, "gauss-newton"},
-                            std::pair{OptimizerKind::Lbfgs, "lbfgs (sensitivity)"}}) {
-    std::vector<double> times, iterations;
-    int failures = 0;
-    std::mt19937 goals(args.seed + 1);
-    for (int trial = 0; trial < args.trials; ++trial) {
-      ShapeTargets targets;
-      if (!random_goal(objective, reference, goals, targets)) continue;
-      const ReducedObjective goal = objective.with_targets(targets);
-      Evaluation current = reference;
-      goal.rescore(current);
-      auto optimizer = make_optimizer(kind, GradientMethod::Sensitivity);
-      const auto t0 = Clock::now();
-      int it = 0;
-      while (current.error.mean >= 1e-3 && it < 200 && seconds(t0, Clock::now()) < 10) {
-        if (optimizer->step(goal, current) != StepOutcome::Improved) break;
-        ++it;
-      }
-      if (current.error.mean < 1e-3) {
-        times.push_back(seconds(t0, Clock::now()));
-        iterations.push_back(it);
-      } else {
-        ++failures;
-      }
-    }
-    std::printf("  target change -> mean error < 1 mm, %-20s median %7.1f ms (p90 %7.1f, max %7.1f), "
-                "iterations median %.0f (max %.0f), %d of %zu not reached\n",
-                name, 1e3 * percentile(times, 0.5), 1e3 * percentile(times, 0.9),
-                1e3 * percentile(times, 1.0), percentile(iterations, 0.5), percentile(iterations, 1.0),
-                failures, times.size() + failures);
+// Optimizer steps from the reference shape until the mean error to `goal`'s targets is below
+// 1 mm (at most 200 steps or 10 s): the seconds and steps it took, or none if it stopped short.
+std::optional<std::pair<double, int>> time_to_1mm(const ReducedObjective& goal, const Evaluation& reference,
+                                                  OptimizerKind kind) {
+  Evaluation current = reference;
+  goal.rescore(current);
+  auto optimizer = make_optimizer(kind, GradientMethod::Sensitivity);
+  const auto t0 = Clock::now();
+  int it = 0;
+  while (current.error.mean >= 1e-3 && it < 200 && seconds(t0, Clock::now()) < 10) {
+    if (optimizer->step(goal, current) != StepOutcome::Improved) break;
+    ++it;
   }
+  if (current.error.mean >= 1e-3) return std::nullopt;
+  return std::pair{seconds(t0, Clock::now()), it};
+}
 
-  // 3. The slow tail: push the gripped ends 4 cm towards each other each, so the object buckles.
+// 2. Target change → mean error below 1 mm, from the reference equilibrium.
+void bench_target_changes(const ReducedObjective& objective, const Evaluation& reference, OptimizerKind kind,
+                          const char* name, const BenchArgs& args) {
+  std::vector<double> times, iterations;
+  int failures = 0;
+  std::mt19937 goals(args.seed + 1);
+  for (int trial = 0; trial < args.trials; ++trial) {
+    ShapeTargets targets;
+    if (!random_goal(objective, reference, goals, targets)) continue;
+    if (const auto reached = time_to_1mm(objective.with_targets(targets), reference, kind)) {
+      times.push_back(reached->first);
+      iterations.push_back(reached->second);
+    } else {
+      ++failures;
+    }
+  }
+  std::printf("  target change -> mean error < 1 mm, %-20s median %7.1f ms (p90 %7.1f, max %7.1f), "
+              "iterations median %.0f (max %.0f), %d of %zu not reached\n",
+              name, 1e3 * percentile(times, 0.5), 1e3 * percentile(times, 0.9),
+              1e3 * percentile(times, 1.0), percentile(iterations, 0.5), percentile(iterations, 1.0),
+              failures, times.size() + failures);
+}
+
+// Targets that push the first two grips' nodes 4 cm towards each other each.
+ShapeTargets squeeze_targets(const Scene& scene, const Positions& x0) {
   ShapeTargets squeeze;
-  const Positions& x0 = reference.positions;
   Vec3 left = Vec3::Zero(), right = Vec3::Zero();
   for (int i : scene.grips[0].nodes) left += x0.segment<3>(3 * i) / scene.grips[0].nodes.size();
   for (int i : scene.grips[1].nodes) right += x0.segment<3>(3 * i) / scene.grips[1].nodes.size();
@@ -154,7 +164,12 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
       squeeze.nodes.push_back(i);
       squeeze.positions.push_back(x0.segment<3>(3 * i) + (e == 0 ? inward : Vec3(-inward)));
     }
-  const ReducedObjective buckle = objective.with_targets(squeeze);
+  return squeeze;
+}
+
+// 3. The slow tail: push the gripped ends 4 cm towards each other each, so the object buckles.
+void bench_buckling(const Scene& scene, const ReducedObjective& objective, const Evaluation& reference) {
+  const ReducedObjective buckle = objective.with_targets(squeeze_targets(scene, reference.positions));
   Evaluation current = reference;
   buckle.rescore(current);
   GaussNewton optimizer;
@@ -170,6 +185,24 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
               "< 1 mm after %.0f ms; final mean error %.3f mm\n",
               to_string(r.termination), r.iterations, 1e3 * seconds(t0, Clock::now()),
               1e3 * to_1mm, 1e3 * r.best.error.mean);
+}
+
+void bench_scene(const std::string& file, const BenchArgs& args) {
+  const Scene scene = load_scene(file);
+  print_scene_notes(scene);
+  if (!scene.robot) throw InputError(file, "robot", "a scene with a robot (missing key)");
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  std::mt19937 rng(args.seed);
+  const Evaluation reference = objective.evaluate(object.reference_joints(), object.reference_positions());
+  if (!reference.statics.converged()) throw SolverFailure("statics at the reference: " + reference.statics.reason);
+  std::printf("\n%s: %d tets, %d nodes, %d joints\n", file.c_str(), object.mesh().tet_count(),
+              object.node_count(), object.joint_count());
+  print_gradient_times(time_gradients(object, objective, reference, args.trials, rng));
+  for (auto [kind, name] : {std::pair{OptimizerKind::GaussNewton, "gauss-newton"},
+                            std::pair{OptimizerKind::Lbfgs, "lbfgs (sensitivity)"}})
+    bench_target_changes(objective, reference, kind, name, args);
+  bench_buckling(scene, objective, reference);
 }
 
 }  // namespace

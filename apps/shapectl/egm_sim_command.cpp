@@ -9,9 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/link/egm_simulator.hpp>
 #include <shapectl/link/stop_signal.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 
@@ -49,7 +50,7 @@ nlohmann::json arm_json(const EgmSimArmStats& s) {
           {"max_speed", s.max_speed},
           {"max_acceleration", s.max_acceleration},
           {"outside_limits", s.outside_limits},
-          {"position", std::vector<double>(s.position.data(), s.position.data() + 7)}};
+          {"position", vector_json(s.position)}};
 }
 
 void run_egm_sim(const EgmSimArgs& args) {

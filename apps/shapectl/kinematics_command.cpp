@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_input.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
@@ -37,13 +38,6 @@ std::map<std::string, double> read_joint_values(const std::string& file) {
   const JsonInput joints = json.at("joints");
   for (const auto& name : joints.keys()) values[name] = joints.at(name).number();
   return values;
-}
-
-nlohmann::ordered_json pose_json(const Eigen::Isometry3d& T) {
-  nlohmann::ordered_json rotation = nlohmann::ordered_json::array();
-  for (int r = 0; r < 3; ++r) rotation.push_back({T(r, 0), T(r, 1), T(r, 2)});
-  return {{"position", {T.translation().x(), T.translation().y(), T.translation().z()}},
-          {"rotation", rotation}};
 }
 
 nlohmann::ordered_json collision_json(const RobotModel& robot, const CollisionModel& collision,
@@ -83,9 +77,10 @@ void run(const KinematicsOptions& options) {
 
   nlohmann::ordered_json out;
   nlohmann::ordered_json links = nlohmann::ordered_json::object();
-  for (int link = 0; link < robot.link_count(); ++link)
-    links[robot.links()[static_cast<std::size_t>(link)].name] =
-        pose_json(state.T_world_link[static_cast<std::size_t>(link)]);
+  for (int link = 0; link < robot.link_count(); ++link) {
+    const Eigen::Isometry3d& T = state.T_world_link[static_cast<std::size_t>(link)];
+    links[robot.links()[static_cast<std::size_t>(link)].name] = result_pose_json(T.translation(), T.linear());
+  }
   out["links"] = links;
   if (!options.spheres.empty()) {
     const CollisionModel collision = CollisionModel::load_json_file(robot, options.spheres);

@@ -11,11 +11,12 @@
 #include <nlohmann/json.hpp>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/session_log.hpp>
 #include <shapectl/link/command_log.hpp>
 #include <shapectl/link/make_robot_link.hpp>
 #include <shapectl/link/stop_signal.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 
@@ -31,11 +32,6 @@ struct ReplayArgs {
   double speed = 1;
   LinkConfig link;
 };
-
-Eigen::VectorXd to_vector(const nlohmann::json& j) {
-  const auto v = j.get<std::vector<double>>();
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
-}
 
 // Re-streams the logged optimizer results; returns why the link disarmed, or empty.
 std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& events) {
@@ -66,7 +62,7 @@ std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& eve
   int sent = 0;
   for (const auto& e : events) {
     if (e.event != "optimizer" || stop_signal_received()) continue;
-    const Eigen::VectorXd joints = to_vector(e.fields.at("joints"));
+    const Eigen::VectorXd joints = vector_from_json(e.fields.at("joints"));
     if (joints.size() != n)
       throw InputError(args.log + ":" + std::to_string(e.line), "joints",
                        std::to_string(n) + " values for " + scene_file, joints.size());

@@ -2,6 +2,7 @@
 
 #include <iostream>
 
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/sim/scene_checks.hpp>
@@ -16,10 +17,7 @@ nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints) {
   const KinematicsState state = forward_kinematics(robot, joints);
   for (const auto& ee : scene.robot->end_effectors) {
     const Eigen::Isometry3d& T = state.T_world_link[ee.link];
-    const Vec3 p = T * ee.tcp_link;
-    nlohmann::json R = nlohmann::json::array();
-    for (int r = 0; r < 3; ++r) R.push_back({T.linear()(r, 0), T.linear()(r, 1), T.linear()(r, 2)});
-    out["tools"][ee.name] = {{"position", {p.x(), p.y(), p.z()}}, {"rotation", R}};
+    out["tools"][ee.name] = result_pose_json(T * ee.tcp_link, T.linear());
   }
   return out;
 }

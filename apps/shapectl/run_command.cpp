@@ -13,10 +13,12 @@
 #include <shapectl/control/controller.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/session_log.hpp>
 #include <shapectl/link/egm_link.hpp>
 #include <shapectl/link/make_robot_link.hpp>
 #include <shapectl/link/stop_signal.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 #include "result_json.hpp"
@@ -39,8 +41,6 @@ struct RunArgs {
   double watchdog_ms = 100;
 };
 
-std::vector<double> to_list(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
-
 nlohmann::json link_json(const LinkStatus& s) {
   return {{"kind", s.kind},
           {"connected", s.connected},
@@ -52,8 +52,8 @@ nlohmann::json link_json(const LinkStatus& s) {
           {"lost_datagrams", s.lost_datagrams},
           {"stale_datagrams", s.stale_datagrams},
           {"foreign_datagrams", s.foreign_datagrams},
-          {"commanded", to_list(s.commanded)},
-          {"measured", to_list(s.measured)}};
+          {"commanded", vector_json(s.commanded)},
+          {"measured", vector_json(s.measured)}};
 }
 
 // Why running on cannot settle, or empty.
@@ -67,7 +67,7 @@ std::string cannot_settle(const ControllerSnapshot& s, const LinkStatus& link, b
 void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
   log.write("optimizer", {{"sequence", s.sequence},
                           {"status", to_string(s.status)},
-                          {"joints", to_list(s.joints)},
+                          {"joints", vector_json(s.joints)},
                           {"safe", s.safe},
                           {"error_mean", s.error.mean},
                           {"error_max", s.error.max},
@@ -75,125 +75,179 @@ void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
                           {"iterations", s.iterations}});
 }
 
-void run(RunArgs args) {
-  const Scene scene = load_scene(args.scene);
+struct RunInputs {
+  Scene scene;
+  TargetsInput targets;
+};
+
+// The scene (with a robot) and the targets, checked; the link settings completed from them.
+RunInputs load_run_inputs(RunArgs& args) {
+  Scene scene = load_scene(args.scene);
   print_scene_notes(scene);
   if (!scene.robot) throw InputError(args.scene, "robot", "run needs a scene with a robot");
-  const TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
+  TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
   parse(args.robot, &args.link.kind);  // checked by the option
   args.link.watchdog_timeout = args.watchdog_ms / 1000;
   args.link.sim_initial_joints = scene.robot->reference_joints;
   if (args.timeout < 0) throw InputError("run", "--timeout", "a number >= 0", args.timeout);
+  return {std::move(scene), std::move(targets)};
+}
 
-  std::shared_ptr<SessionLog> log;
-  if (!args.log.empty()) {
-    log = std::make_shared<SessionLog>(args.log);
-    log->write("session", {{"command", "run"},
-                           {"scene", std::filesystem::absolute(args.scene).string()},
-                           {"targets_file", args.targets},
-                           {"robot", to_string(args.link.kind)},
-                           {"joint_names", scene.robot->model->active_joint_names()}});
-  }
+// The session log if --log names one, opened with a "session" event; else null.
+std::shared_ptr<SessionLog> open_session_log(const RunArgs& args, const Scene& scene) {
+  if (args.log.empty()) return nullptr;
+  auto log = std::make_shared<SessionLog>(args.log);
+  log->write("session", {{"command", "run"},
+                         {"scene", std::filesystem::absolute(args.scene).string()},
+                         {"targets_file", args.targets},
+                         {"robot", to_string(args.link.kind)},
+                         {"joint_names", scene.robot->model->active_joint_names()}});
+  return log;
+}
+
+std::unique_ptr<RobotLink> make_run_link(const RunArgs& args, const Scene& scene,
+                                         const std::shared_ptr<SessionLog>& log) {
   auto link = make_robot_link(args.link, *scene.robot->model, scene.robot->collisions, log);
   if (auto* egm = dynamic_cast<EgmLink*>(link.get()))
     std::cerr << "run: EGM on " << args.link.egm_address << " ports " << egm->port(0)
               << (egm->channels().size() > 1 ? " and " + std::to_string(egm->port(1)) : "") << "\n";
+  return link;
+}
 
-  Controller controller(scene);
+// Hands the file's targets (nodes or a centre-line) to the controller, and to the log.
+void set_run_targets(Controller& controller, const TargetsInput& targets, SessionLog* log) {
   if (targets.centerline.empty()) controller.set_targets(targets.targets);
   else controller.set_centerline(targets.centerline);
-  if (log) {
-    nlohmann::json t = {{"nodes", targets.targets.nodes}};
-    nlohmann::json positions = nlohmann::json::array(), line = nlohmann::json::array();
-    for (const auto& p : targets.targets.positions) positions.push_back({p.x(), p.y(), p.z()});
-    for (const auto& p : targets.centerline) line.push_back({p.x(), p.y(), p.z()});
-    log->write("targets", {{"nodes", targets.targets.nodes}, {"positions", positions}, {"centerline", line}});
-  }
-  install_stop_signal_handlers();
-  controller.start();
-  link->start();
+  if (log)
+    log->write("targets", {{"nodes", targets.targets.nodes},
+                           {"positions", points_json(targets.targets.positions)},
+                           {"centerline", points_json(targets.centerline)}});
+}
 
-  const auto start = Clock::now();
-  auto elapsed = [&] { return std::chrono::duration<double>(Clock::now() - start).count(); };
-  bool armed_once = false;
-  if (args.arm) {
-    // Arming needs feedback; give the robot a moment to appear.
-    std::string why;
-    while (!link->arm(&why)) {
-      if (elapsed() > 5 || stop_signal_received()) throw SolverFailure("cannot arm the robot link: " + why);
-      std::this_thread::sleep_for(std::chrono::milliseconds(20));
-    }
-    armed_once = true;
-    std::cerr << "run: armed\n";
-  }
+// Seconds since the robot link started.
+struct RunClock {
+  Clock::time_point start = Clock::now();
+  double elapsed() const { return std::chrono::duration<double>(Clock::now() - start).count(); }
+};
 
+// Arming needs feedback: gives the robot 5 s to appear, then fails (SolverFailure).
+void arm_when_ready(RobotLink& link, const RunClock& clock) {
+  std::string why;
+  while (!link.arm(&why)) {
+    if (clock.elapsed() > 5 || stop_signal_received()) throw SolverFailure("cannot arm the robot link: " + why);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::cerr << "run: armed\n";
+}
+
+// How following the optimizer ended.
+struct RunOutcome {
+  bool settled = false;
+  std::string failure;  // why it cannot settle; empty otherwise
+  std::shared_ptr<const ControllerSnapshot> snapshot;  // the last one seen
+};
+
+// The progress line's state: "converged; robot connected, arrived".
+std::string progress_report(const ControllerSnapshot& s, const LinkStatus& st) {
+  return std::string(to_string(s.status)) + "; robot " + (st.connected ? "connected" : "not connected") +
+         ", " + (st.armed ? (st.arrived ? "arrived" : "moving") : "not armed: " + st.reason);
+}
+
+// --until-settled: true when following should end, settled or with outcome.failure set.
+bool settle_decided(const ControllerSnapshot& s, const LinkStatus& st, bool armed, RunOutcome& outcome) {
+  outcome.failure = cannot_settle(s, st, armed);
+  if (!outcome.failure.empty()) return true;
+  if (s.status != ControllerStatus::Converged) return false;
+  // Not armed, the robot is never asked to move: it cannot arrive, so say so.
+  if (!armed) {
+    outcome.failure = "the optimizer converged, but the robot is not armed (--arm), so it cannot arrive";
+    return true;
+  }
+  outcome.settled = st.arrived;
+  return st.arrived;
+}
+
+// Sends each new snapshot's θ to the link (and the log) and prints progress, until settled,
+// failed, timed out or stopped by a signal.
+RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLink& link, SessionLog* log,
+                            const RunClock& clock) {
+  RunOutcome outcome;
   std::uint64_t seen = 0;
   std::string last_report;
-  std::string failure;
-  bool settled = false;
-  std::shared_ptr<const ControllerSnapshot> snap = controller.snapshot();
+  outcome.snapshot = controller.snapshot();
   while (!stop_signal_received()) {
-    snap = controller.wait_for_snapshot(seen, 0.02);
-    if (snap->sequence > seen) {
-      seen = snap->sequence;
-      link->set_target(snap->joints, snap->safe);
-      if (log) log_snapshot(*log, *snap);
+    outcome.snapshot = controller.wait_for_snapshot(seen, 0.02);
+    const ControllerSnapshot& snap = *outcome.snapshot;
+    if (snap.sequence > seen) {
+      seen = snap.sequence;
+      link.set_target(snap.joints, snap.safe);
+      if (log) log_snapshot(*log, snap);
     }
-    const LinkStatus st = link->status();
-    // A progress line whenever the state changes.
-    const std::string report = std::string(to_string(snap->status)) + "; robot " +
-                               (st.connected ? "connected" : "not connected") + ", " +
-                               (st.armed ? (st.arrived ? "arrived" : "moving") : "not armed: " + st.reason);
+    const LinkStatus st = link.status();
+    const std::string report = progress_report(snap, st);
     if (report != last_report) {
-      std::cerr << "run: " << elapsed() << " s: " << report << " (error " << snap->error.mean * 1000 << " mm)\n";
+      std::cerr << "run: " << clock.elapsed() << " s: " << report << " (error " << snap.error.mean * 1000 << " mm)\n";
       last_report = report;
     }
-    if (args.until_settled) {
-      failure = cannot_settle(*snap, st, armed_once);
-      if (!failure.empty()) break;
-      if (snap->status == ControllerStatus::Converged) {
-        // Not armed, the robot is never asked to move: it cannot arrive, so say so.
-        if (!armed_once) {
-          failure = "the optimizer converged, but the robot is not armed (--arm), so it cannot arrive";
-          break;
-        }
-        if (st.arrived) {
-          settled = true;
-          break;
-        }
-      }
-    }
-    if (args.timeout > 0 && elapsed() >= args.timeout) {
+    if (args.until_settled && settle_decided(snap, st, args.arm, outcome)) break;
+    if (args.timeout > 0 && clock.elapsed() >= args.timeout) {
       if (args.until_settled)
-        failure = "not settled after " + std::to_string(args.timeout) + " s: optimizer " +
-                  to_string(snap->status) + ", robot " + (st.arrived ? "arrived" : "not arrived");
+        outcome.failure = "not settled after " + std::to_string(args.timeout) + " s: optimizer " +
+                          to_string(snap.status) + ", robot " + (st.arrived ? "arrived" : "not arrived");
       break;
     }
   }
-  // Leave the robot standing: disarm, give the governor time to brake, then stop.
-  link->disarm(failure.empty() ? "run finished" : failure);
-  for (int k = 0; k < 300 && link->status().commanded != link->status().measured; ++k)
+  return outcome;
+}
+
+// Leaves the robot standing: disarm, give the governor time to brake, then stop. Returns the
+// link's last status.
+LinkStatus stop_run(RobotLink& link, Controller& controller, const std::string& failure) {
+  link.disarm(failure.empty() ? "run finished" : failure);
+  for (int k = 0; k < 300 && link.status().commanded != link.status().measured; ++k)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   controller.stop();
-  const LinkStatus final_status = link->status();
-  link->stop();
+  const LinkStatus final_status = link.status();
+  link.stop();
+  return final_status;
+}
 
-  nlohmann::json result = {{"settled", settled},
-                           {"status", to_string(snap->status)},
-                           {"error_mean", snap->error.mean},
-                           {"error_max", snap->error.max},
-                           {"iterations", snap->iterations},
-                           {"joint_names", snap->joint_names},
-                           {"joints", to_list(snap->joints)},
+// What `run` prints on stdout.
+nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status, RobotLink& link) {
+  const ControllerSnapshot& snap = *outcome.snapshot;
+  nlohmann::json result = {{"settled", outcome.settled},
+                           {"status", to_string(snap.status)},
+                           {"error_mean", snap.error.mean},
+                           {"error_max", snap.error.max},
+                           {"iterations", snap.iterations},
+                           {"joint_names", snap.joint_names},
+                           {"joints", vector_json(snap.joints)},
                            {"link", link_json(final_status)}};
-  if (auto* egm = dynamic_cast<EgmLink*>(link.get())) {
+  if (auto* egm = dynamic_cast<EgmLink*>(&link)) {
     const LatencyStats l = egm->latency();
     result["latency_us"] = {{"samples", l.samples}, {"median", l.median_us}, {"p99", l.p99_us}, {"max", l.max_us}};
   }
-  if (!failure.empty()) result["reason"] = failure;
-  if (log) log->write("end", {{"settled", settled}, {"reason", failure}});
+  if (!outcome.failure.empty()) result["reason"] = outcome.failure;
+  return result;
+}
+
+void run(RunArgs args) {
+  const RunInputs inputs = load_run_inputs(args);
+  const std::shared_ptr<SessionLog> log = open_session_log(args, inputs.scene);
+  const auto link = make_run_link(args, inputs.scene, log);
+  Controller controller(inputs.scene);
+  set_run_targets(controller, inputs.targets, log.get());
+  install_stop_signal_handlers();
+  controller.start();
+  link->start();
+  const RunClock clock;
+  if (args.arm) arm_when_ready(*link, clock);  // throws if it cannot
+  const RunOutcome outcome = follow_optimizer(args, controller, *link, log.get(), clock);
+  const LinkStatus final_status = stop_run(*link, controller, outcome.failure);
+  const nlohmann::json result = run_result(outcome, final_status, *link);
+  if (log) log->write("end", {{"settled", outcome.settled}, {"reason", outcome.failure}});
   std::cout << result.dump(2) << "\n";
-  if (!failure.empty()) throw SolverFailure(failure);
+  if (!outcome.failure.empty()) throw SolverFailure(outcome.failure);
 }
 
 }  // namespace

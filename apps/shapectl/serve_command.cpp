@@ -4,7 +4,7 @@
 
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/link/make_robot_link.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/server/server.hpp>
 #include <shapectl/server/web_paths.hpp>
 

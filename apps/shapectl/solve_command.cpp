@@ -9,8 +9,11 @@
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/atomic_file.hpp>
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/io/vtu_writer.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
 #include "result_json.hpp"
@@ -79,13 +82,8 @@ void run_solve(const SolveArgs& args) {
   for (const auto& v : limit_violations(object.robot(), state.joints))
     violations.push_back({{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
-  out["positions"] = positions_to_json(best.positions);
-  nlohmann::json targets = nlohmann::json::array();
-  for (int k = 0; k < objective.targets().size(); ++k) {
-    const Vec3& p = objective.targets().positions[k];
-    targets.push_back({{"node", objective.targets().nodes[k]}, {"position", {p.x(), p.y(), p.z()}}});
-  }
-  out["targets"] = targets;
+  out["positions"] = positions_json(best.positions);
+  out["targets"] = targets_json(objective.targets());
   for (const auto& h : result.history)
     out["history"].push_back({{"iteration", h.iteration}, {"time", h.time}, {"error_mean", h.error_mean},
                               {"objective", h.objective}});

@@ -4,9 +4,12 @@
 #include <iostream>
 
 #include <shapectl/io/atomic_file.hpp>
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/io/vtu_writer.hpp>
 #include <shapectl/robot/joints_file.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/sim/gripped_object.hpp>
 
 #include "commands.hpp"
@@ -33,7 +36,7 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMes
   result["iterations"] = r.iterations;
   result["residual"] = r.residual;
   result["energy"] = r.energy;
-  result["positions"] = positions_to_json(x);
+  result["positions"] = positions_json(x);
   require_finite(result, "statics", r.reason);
   std::vector<FileContent> files = {{args.out, to_pretty_json(result)}};
   if (!args.vtu.empty()) {

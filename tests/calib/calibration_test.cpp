@@ -6,7 +6,7 @@
 
 #include <shapectl/calib/joint_path.hpp>
 #include <shapectl/calib/simulated_camera.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "support/test_support.hpp"
 

@@ -9,7 +9,7 @@
 #include <shapectl/calib/joint_path.hpp>
 #include <shapectl/calib/simulated_camera.hpp>
 #include <shapectl/control/optimize.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include <shapectl/io/input_error.hpp>
 

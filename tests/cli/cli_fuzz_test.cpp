@@ -5,10 +5,6 @@
 // complete, finite "converged": false result when Newton fails: exit 2).
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <nlohmann/json.hpp>
 #include <cmath>
 #include <iostream>
@@ -23,23 +19,9 @@ namespace {
 
 // Runs the CLI under `timeout` (a hang is a failure: exit 124); the exit code, or 128 + signal.
 int run_with_timeout(const std::vector<std::string>& args, const std::filesystem::path& log) {
-  const pid_t pid = fork();
-  if (pid < 0) return -1;
-  if (pid == 0) {
-    const int fd = open(log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(fd, 1);
-    dup2(fd, 2);
-    std::vector<std::string> all = {"timeout", "-s", "KILL", "20", SHAPECTL_CLI};
-    all.insert(all.end(), args.begin(), args.end());
-    std::vector<char*> argv;
-    for (auto& a : all) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execvp("timeout", argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  std::vector<std::string> command = {"timeout", "-s", "KILL", "20"};
+  for (const auto& word : test::cli_command(args)) command.push_back(word);
+  return test::wait_for_exit(test::start_process(command, log));
 }
 
 bool has_null(const nlohmann::json& v) {
@@ -53,11 +35,7 @@ bool has_null(const nlohmann::json& v) {
 
 // The YuMi bar on a coarse 8 × 2 × 2 mesh, data paths made absolute.
 std::string small_yumi_scene() {
-  std::string text = test::read_text(test::source_path("scenes/yumi_bar.json"));
-  const std::string data = test::source_path("data").string();
-  for (std::size_t at = text.find("../data"); at != std::string::npos; at = text.find("../data", at + 1))
-    text.replace(at, 7, data);
-  auto json = nlohmann::json::parse(text);
+  auto json = nlohmann::json::parse(test::bundled_scene_text("yumi_bar.json"));
   json["object"]["mesh"]["box"]["cells"] = {8, 2, 2};
   return json.dump(1);
 }

@@ -1,7 +1,6 @@
 // `shapectl run`, `egm-sim` and `replay`: the headless chain end to end, exit codes, messages.
 #include <gtest/gtest.h>
 
-#include <fcntl.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -19,10 +18,8 @@ using test::TempDir;
 
 // The YuMi bar scene with a coarse mesh (fast), paths made absolute.
 std::filesystem::path small_yumi_scene(const TempDir& dir) {
-  auto scene = nlohmann::json::parse(test::read_text(test::source_path("scenes/yumi_bar.json")));
+  auto scene = nlohmann::json::parse(test::bundled_scene_text("yumi_bar.json"));
   scene["object"]["mesh"]["box"]["cells"] = {4, 1, 1};
-  scene["robot"]["urdf"] = test::source_path("data/robots/yumi/yumi.urdf").string();
-  scene["robot"]["collision_spheres"] = test::source_path("data/robots/yumi/yumi_spheres.json").string();
   return dir.write("scene.json", scene.dump());
 }
 
@@ -34,20 +31,7 @@ std::filesystem::path lift_targets(const TempDir& dir) {
 class Background {
  public:
   Background(const std::vector<std::string>& args, std::filesystem::path out) : out_(std::move(out)) {
-    pid_ = fork();
-    if (pid_ == 0) {
-      const int fd = open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(fd, 1);
-      const int null = open("/dev/null", O_WRONLY);
-      dup2(null, 2);
-      std::vector<std::string> copy = args;
-      std::string program = SHAPECTL_CLI;
-      std::vector<char*> argv{program.data()};
-      for (auto& a : copy) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(program.c_str(), argv.data());
-      _exit(127);
-    }
+    pid_ = test::start_process(test::cli_command(args), out_, "/dev/null");
   }
   // Asks it to stop (SIGTERM) and returns its exit code and output.
   std::pair<int, std::string> finish() {

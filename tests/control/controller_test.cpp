@@ -8,19 +8,13 @@
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/io/input_error.hpp>
 
+#include "support/controller_wait.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
 namespace {
 
-// Waits (bounded) until `done` holds for a snapshot.
-template <class Done>
-std::shared_ptr<const ControllerSnapshot> wait_until(const Controller& c, Done done, double seconds) {
-  auto s = c.snapshot();
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
-  while (!done(*s) && std::chrono::steady_clock::now() < deadline) s = c.wait_for_snapshot(s->sequence, 0.1);
-  return s;
-}
+using test::wait_until;
 
 TEST(Controller, FollowsTargetsSetFromAnotherThread) {
   const Scene scene = test::two_arm_scene({24, 2, 2});

@@ -8,6 +8,8 @@
 #include <numeric>
 #include <random>
 
+#include <shapectl/scene_io/scene_file.hpp>
+
 #include "support/test_support.hpp"
 #include "support/two_arm_scene.hpp"
 

@@ -2,7 +2,8 @@
 #include <gtest/gtest.h>
 
 #include <shapectl/control/targets_file.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/io/json_input.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "io/text_mutator.hpp"
 #include "support/test_support.hpp"
@@ -17,19 +18,13 @@ const test::TextMutator kSceneMutator({"{", "[", "]", "}", ",", ":", "\"", "1e99
                                        "\"density\": 1, \"density\": 2", "\"nodes\": [0, 1, 99999]",
                                        "\"linear_solver\": \"band\"", "\"max_tet_volume\": 1e-20"});
 
-// The bundled scenes with their relative paths made absolute, so they load from a temp dir.
-std::string bundled_scene(const std::string& name) {
-  std::string text = test::read_text(test::source_path("scenes/" + name));
-  const std::string data = test::source_path("data").string();
-  for (std::size_t at = text.find("../data"); at != std::string::npos; at = text.find("../data", at + 1))
-    text.replace(at, 7, data);
-  return text;
-}
+using test::bundled_scene_text;
 
 TEST(SceneFuzz, MutatedScenesLoadOrAreInputErrors) {
   const test::TempDir dir;
-  const std::vector<std::string> seeds = {bundled_scene("foam_bar_clamped.json"), bundled_scene("foam_bar_clamped.json"),
-                                          bundled_scene("yumi_bar.json"), bundled_scene("yumi_frame.json")};
+  const std::vector<std::string> seeds = {
+      bundled_scene_text("foam_bar_clamped.json"), bundled_scene_text("foam_bar_clamped.json"),
+      bundled_scene_text("yumi_bar.json"), bundled_scene_text("yumi_frame.json")};
   for (const auto& seed : seeds) ASSERT_NO_THROW(load_scene(dir.write("seed.json", seed)));
   const test::FuzzCounts counts = test::fuzz_parser(seeds, kSceneMutator, 1600, 3, [&](const std::string& text) {
     load_scene(dir.write("scene.json", text));

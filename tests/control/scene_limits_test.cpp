@@ -9,7 +9,7 @@
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/input_file.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 #include "support/test_support.hpp"
 

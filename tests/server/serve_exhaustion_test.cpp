@@ -4,7 +4,6 @@
 // short (it used to retry accept() at once forever: 100 % CPU and megabytes of log per second).
 // Loopback only; every wait has a deadline so a broken server fails the test instead of hanging it.
 #include <arpa/inet.h>
-#include <fcntl.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <signal.h>
@@ -45,23 +44,10 @@ class ServeProcess {
  public:
   ServeProcess(const TempDir& dir, const std::vector<std::string>& args, rlim_t open_file_limit)
       : out_(dir.path() / "stdout"), err_(dir.path() / "stderr") {
-    pid_ = fork();
-    if (pid_ < 0) throw std::runtime_error("fork failed");
-    if (pid_ == 0) {
+    pid_ = test::start_process(test::cli_command(args), out_, err_, [open_file_limit] {
       const rlimit limit{open_file_limit, open_file_limit};
       if (setrlimit(RLIMIT_NOFILE, &limit) != 0) _exit(126);
-      const int out = open(out_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      const int err = open(err_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      dup2(out, 1);
-      dup2(err, 2);
-      std::string program = SHAPECTL_CLI;
-      std::vector<std::string> copy = args;
-      std::vector<char*> argv{program.data()};
-      for (auto& a : copy) argv.push_back(a.data());
-      argv.push_back(nullptr);
-      execv(program.c_str(), argv.data());
-      _exit(127);
-    }
+    });
   }
   ~ServeProcess() { stop(); }
 

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/controller_wait.hpp"
 #include "support/test_support.hpp"
 
 namespace shapectl::server {
@@ -12,9 +13,7 @@ nlohmann::json reply_json(const Session::Reply& r) { return nlohmann::json::pars
 // Waits (generously) until the controller has published a snapshot that satisfies `done`.
 template <class Done>
 std::shared_ptr<const ControllerSnapshot> wait_until(Session& session, Done done) {
-  auto s = session.controller().snapshot();
-  for (int k = 0; k < 600 && !done(*s); ++k) s = session.controller().wait_for_snapshot(s->sequence, 0.1);
-  return s;
+  return test::wait_until(session.controller(), done, 60);
 }
 
 class SessionTest : public ::testing::Test {

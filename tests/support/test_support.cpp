@@ -42,30 +42,54 @@ std::string read_text(const std::filesystem::path& file) {
   return s.str();
 }
 
+std::string bundled_scene_text(const std::string& name) {
+  std::string text = read_text(source_path("scenes/" + name));
+  const std::string data = source_path("data").string();
+  for (std::size_t at = text.find("../data"); at != std::string::npos;
+       at = text.find("../data", at + 1))
+    text.replace(at, 7, data);
+  return text;
+}
+
+std::vector<std::string> cli_command(const std::vector<std::string>& args) {
+  std::vector<std::string> command = {SHAPECTL_CLI};
+  command.insert(command.end(), args.begin(), args.end());
+  return command;
+}
+
+pid_t start_process(const std::vector<std::string>& command, const std::filesystem::path& out,
+                    const std::filesystem::path& err, const std::function<void()>& in_child) {
+  // Everything the child needs is made before fork: it only opens, redirects and execs.
+  std::vector<std::string> copy = command;
+  std::vector<char*> argv;
+  for (auto& a : copy) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const pid_t pid = fork();
+  if (pid < 0) throw std::runtime_error("fork failed");
+  if (pid == 0) {
+    if (in_child) in_child();
+    const int out_fd = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int err_fd = err.empty() ? out_fd : open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    dup2(out_fd, 1);
+    dup2(err_fd, 2);
+    execvp(argv[0], argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+int wait_for_exit(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
 CliRun run_cli(const std::vector<std::string>& args) {
   TempDir dir;
   const auto out_file = dir.path() / "stdout";
   const auto err_file = dir.path() / "stderr";
-  const pid_t pid = fork();
-  if (pid < 0) throw std::runtime_error("fork failed");
-  if (pid == 0) {
-    const int out = open(out_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    const int err = open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    dup2(out, 1);
-    dup2(err, 2);
-    std::vector<char*> argv;
-    std::string program = SHAPECTL_CLI;
-    argv.push_back(program.data());
-    std::vector<std::string> copy = args;
-    for (auto& a : copy) argv.push_back(a.data());
-    argv.push_back(nullptr);
-    execv(program.c_str(), argv.data());
-    _exit(127);
-  }
-  int status = 0;
-  waitpid(pid, &status, 0);
   CliRun run;
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  run.exit_code = wait_for_exit(start_process(cli_command(args), out_file, err_file));
   run.out = read_text(out_file);
   run.err = read_text(err_file);
   return run;

@@ -1,5 +1,7 @@
 #pragma once
-// Helpers shared by the tests: temporary files and running the CLI.
+// Helpers shared by the tests: temporary files, bundled scenes and running the CLI.
+#include <sys/types.h>
+
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -24,6 +26,9 @@ class TempDir {
 
 std::string read_text(const std::filesystem::path& file);
 
+// scenes/<name> as text with its "../data" paths made absolute, so it loads from any directory.
+std::string bundled_scene_text(const std::string& name);
+
 struct CliRun {
   int exit_code = -1;
   std::string out;  // stdout
@@ -31,6 +36,17 @@ struct CliRun {
 };
 // Runs the built `shapectl` binary with `args` (each passed as one argument, no shell).
 CliRun run_cli(const std::vector<std::string>& args);
+
+// The built `shapectl` followed by `args`: a command line for start_process.
+std::vector<std::string> cli_command(const std::vector<std::string>& args);
+// Starts `command` (the program is looked up on PATH unless it is a path; no shell) in a child
+// process, its stdout going to `out` and its stderr to `err` (empty: to `out` as well).
+// `in_child` runs in the child before the program (setrlimit, ...). Returns the child's pid.
+pid_t start_process(const std::vector<std::string>& command, const std::filesystem::path& out,
+                    const std::filesystem::path& err = {},
+                    const std::function<void()>& in_child = {});
+// Waits for the child `pid` to end: its exit code, or 128 + the signal that ended it.
+int wait_for_exit(pid_t pid);
 
 // Path of a file in the source tree, e.g. source_path("scenes/yumi_bar.json").
 std::filesystem::path source_path(const std::string& relative);

@@ -2,6 +2,9 @@
 
 #include <set>
 
+#include <shapectl/io/json_eigen.hpp>
+#include <shapectl/io/json_input.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -44,6 +47,13 @@ TargetsInput read_targets(const JsonInput& json, int node_count) {
 
 TargetsInput load_targets(const std::filesystem::path& file, int node_count) {
   return read_targets(JsonInput::load(file), node_count);
+}
+
+nlohmann::json targets_json(const ShapeTargets& targets) {
+  nlohmann::json list = nlohmann::json::array();
+  for (std::size_t k = 0; k < targets.nodes.size(); ++k)
+    list.push_back({{"node", targets.nodes[k]}, {"position", vec3_json(targets.positions[k])}});
+  return list;
 }
 
 }  // namespace shapectl

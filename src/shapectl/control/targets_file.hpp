@@ -4,10 +4,13 @@
 #include <filesystem>
 #include <vector>
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <shapectl/control/shape_targets.hpp>
-#include <shapectl/io/json_input.hpp>
 
 namespace shapectl {
+
+class JsonInput;
 
 struct TargetsInput {
   ShapeTargets targets;          // explicit node targets (empty for a centre-line)
@@ -23,5 +26,9 @@ inline constexpr std::size_t max_centerline_points = 100'000;
 // max_json_file_bytes (io/input_file.hpp).
 TargetsInput read_targets(const JsonInput& json, int node_count);
 TargetsInput load_targets(const std::filesystem::path& file, int node_count);
+
+// The "targets" list of TARGETS.json, [{"node": i, "position": [x, y, z]}, …]: how `solve`'s
+// result and the GUI's state message show targets too.
+nlohmann::json targets_json(const ShapeTargets& targets);
 
 }  // namespace shapectl

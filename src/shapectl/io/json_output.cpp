@@ -79,10 +79,4 @@ std::optional<std::string> first_non_finite(const nlohmann::ordered_json& value)
   return non_finite_in(value, "");
 }
 
-nlohmann::json positions_to_json(const Positions& x) {
-  nlohmann::json out = nlohmann::json::array();
-  for (int i = 0; i < x.size() / 3; ++i) out.push_back({x[3 * i], x[3 * i + 1], x[3 * i + 2]});
-  return out;
-}
-
 }  // namespace shapectl

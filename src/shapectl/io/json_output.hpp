@@ -6,8 +6,6 @@
 #include <optional>
 #include <string>
 
-#include <shapectl/types.hpp>
-
 namespace shapectl {
 
 // Indented like dump(1), but arrays of numbers stay on one line ([x, y, z]). Strings that are
@@ -21,8 +19,5 @@ void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_
 // numbers (they would be written as null), so results are checked before they are written.
 std::optional<std::string> first_non_finite(const nlohmann::json& value);
 std::optional<std::string> first_non_finite(const nlohmann::ordered_json& value);
-
-// [[x,y,z], ...] from stacked positions.
-nlohmann::json positions_to_json(const Positions& x);
 
 }  // namespace shapectl

@@ -6,19 +6,11 @@
 #include <map>
 #include <optional>
 
+#include <shapectl/io/json_eigen.hpp>
+
 namespace shapectl {
 
 namespace {
-
-std::vector<double> to_list(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
-
-// JSON has no infinity: unbounded limits are written as null and read back as `unbounded`.
-Eigen::VectorXd to_vector(const nlohmann::json& j, double unbounded = NAN) {
-  Eigen::VectorXd v(static_cast<Eigen::Index>(j.size()));
-  for (std::size_t i = 0; i < j.size(); ++i)
-    v[static_cast<Eigen::Index>(i)] = j[i].is_null() ? unbounded : j[i].get<double>();
-  return v;
-}
 
 // Rounding slack: positions are sums of v·dt, compared as differences.
 constexpr double slack = 1e-9;
@@ -35,10 +27,10 @@ void log_link_started(SessionLog& log, const std::string& kind,
                      {"joint_names", joint_names},
                      {"channels", list},
                      {"period", period},
-                     {"lower", to_list(limits.lower)},
-                     {"upper", to_list(limits.upper)},
-                     {"velocity", to_list(limits.velocity)},
-                     {"acceleration", to_list(limits.acceleration)}});
+                     {"lower", vector_json(limits.lower)},
+                     {"upper", vector_json(limits.upper)},
+                     {"velocity", vector_json(limits.velocity)},
+                     {"acceleration", vector_json(limits.acceleration)}});
 }
 
 void log_command(SessionLog& log, const std::string& channel, std::uint64_t seq,
@@ -46,8 +38,8 @@ void log_command(SessionLog& log, const std::string& channel, std::uint64_t seq,
                  const FeedbackStep& step) {
   nlohmann::json fields = {{"channel", channel},
                            {"seq", seq},
-                           {"joints", to_list(joints)},
-                           {"measured", to_list(measured)}};
+                           {"joints", vector_json(joints)},
+                           {"measured", vector_json(measured)}};
   if (!step.advanced) fields["hold"] = true;
   if (step.from_rest) fields["from_rest"] = true;
   log.write("command", fields);
@@ -72,9 +64,10 @@ CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
     const auto& f = e.fields;
     if (e.event == "link") {
       ++check.links;
+      // JSON has no infinity: unbounded limits were written as null.
       constexpr double inf = std::numeric_limits<double>::infinity();
-      GovernorLimits all{to_vector(f.at("lower"), -inf), to_vector(f.at("upper"), inf),
-                         to_vector(f.at("velocity"), inf), to_vector(f.at("acceleration"), inf)};
+      GovernorLimits all{vector_from_json(f.at("lower"), -inf), vector_from_json(f.at("upper"), inf),
+                         vector_from_json(f.at("velocity"), inf), vector_from_json(f.at("acceleration"), inf)};
       channels.clear();
       for (const auto& c : f.at("channels"))
         channels[c.at("name").get<std::string>()] = {all.subset(c.at("joints").get<std::vector<int>>()), {}};
@@ -90,7 +83,7 @@ CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
         continue;
       }
       Channel& c = it->second;
-      const Eigen::VectorXd q = to_vector(f.at("joints"));
+      const Eigen::VectorXd q = vector_from_json(f.at("joints"), NAN);
       ++check.commands;
       if (q.size() != c.limits.size() || !q.allFinite()) {
         violation(e, name + ": command is not " + std::to_string(c.limits.size()) + " finite values");

@@ -4,13 +4,12 @@
 #include <cmath>
 #include <sstream>
 
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/session_log.hpp>
 
 namespace shapectl {
 
 namespace {
-
-std::vector<double> to_list(const Eigen::VectorXd& v) { return {v.data(), v.data() + v.size()}; }
 
 std::string format(double value, int precision = 3) {
   std::ostringstream s;
@@ -118,7 +117,7 @@ bool LinkSupervisor::arm(double now, std::string* why_not) {
     if (c.governor.at_rest()) c.governor.reset(c.measured);
   armed_ = true;
   reason_.clear();
-  log("arm", {{"commanded", to_list(full_commanded())}});
+  log("arm", {{"commanded", vector_json(full_commanded())}});
   return true;
 }
 
@@ -162,7 +161,7 @@ FeedbackStep LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& mea
     // No jump on (re)connect: command the robot where it is.
     c.governor.reset(measured);
     c.pacer.restart();
-    log("connect", {{"channel", c.spec.name}, {"measured", to_list(measured)}});
+    log("connect", {{"channel", c.spec.name}, {"measured", vector_json(measured)}});
   }
   if (armed_ && !c.fault.empty()) disarm(c.spec.name + ": " + c.fault);
   if (armed_) {

@@ -1,6 +1,7 @@
 #include <shapectl/robot/collision_spheres.hpp>
 
 #include <shapectl/io/input_file.hpp>
+#include <shapectl/io/json_input.hpp>
 
 #include <algorithm>
 #include <cassert>

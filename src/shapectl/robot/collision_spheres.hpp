@@ -18,12 +18,13 @@
 #include <utility>
 #include <vector>
 
-#include <shapectl/io/json_input.hpp>
 #include <shapectl/robot/cubic_barrier.hpp>
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/robot/robot_model.hpp>
 
 namespace shapectl {
+
+class JsonInput;
 
 struct CollisionSphere {
   int link = -1;

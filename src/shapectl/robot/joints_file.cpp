@@ -1,5 +1,7 @@
 #include <shapectl/robot/joints_file.hpp>
 
+#include <shapectl/io/json_input.hpp>
+
 namespace shapectl {
 
 Eigen::VectorXd read_joints(const JsonInput& json, const RobotModel& robot,

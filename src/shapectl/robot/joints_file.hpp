@@ -4,10 +4,11 @@
 #include <Eigen/Core>
 #include <filesystem>
 
-#include <shapectl/io/json_input.hpp>
 #include <shapectl/robot/robot_model.hpp>
 
 namespace shapectl {
+
+class JsonInput;
 
 // θ with the named active joints set; the others keep `defaults` (size active_count()).
 // Throws InputError naming the file and joint: not an active joint, not a finite number.

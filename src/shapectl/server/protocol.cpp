@@ -90,6 +90,129 @@ const std::vector<std::pair<std::string, Command::Type>>& type_names() {
   return names;
 }
 
+// "id", if given: an integer or a short string, echoed in the reply.
+nlohmann::json read_id(const JsonInput& message) {
+  if (!message.has("id")) return nullptr;
+  const nlohmann::json id = message.at("id").raw();
+  if (!valid_id(id)) message.at("id").fail("an integer or a string of at most 64 characters");
+  return id;
+}
+
+Command::Type read_type(const JsonInput& type) {
+  const std::string name = type.string();
+  const auto& names = type_names();
+  const auto found = std::find_if(names.begin(), names.end(),
+                                  [&](const auto& entry) { return entry.first == name; });
+  if (found == names.end()) {
+    std::string known;
+    for (const auto& entry : names) known += (known.empty() ? "" : ", ") + entry.first;
+    type.fail("one of " + known);
+  }
+  return found->second;
+}
+
+// set_targets: at most one target per node of the scene, each a node and a point.
+ShapeTargets read_target_list(const JsonInput& list, const ProtocolContext& context) {
+  if (list.size() > static_cast<std::size_t>(context.node_count))
+    list.fail("at most one target per node (" + std::to_string(context.node_count) + ")");
+  ShapeTargets targets;
+  std::set<int> seen;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const JsonInput t = list.at(k);
+    t.expect_only({"node", "position"});
+    const int node = read_node(t.at("node"), context);
+    if (!seen.insert(node).second) t.at("node").fail("a node not targeted twice");
+    targets.nodes.push_back(node);
+    targets.positions.push_back(read_point(t.at("position")));
+  }
+  return targets;
+}
+
+// set_centerline: 2 to max_centerline_points points, at least 1 mm long in all.
+std::vector<Vec3> read_centerline_points(const JsonInput& list) {
+  if (list.size() < 2 || list.size() > max_centerline_points)
+    list.fail("from 2 to " + std::to_string(max_centerline_points) + " points");
+  std::vector<Vec3> points;
+  double length = 0;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    points.push_back(read_point(list.at(k)));
+    if (k > 0) length += (points[k] - points[k - 1]).norm();
+  }
+  if (!(length >= min_centerline_length)) {
+    std::ostringstream arc;
+    arc << std::setprecision(3) << length;
+    list.fail("a centre-line at least 1 mm long (its arc length is " + arc.str() + " m)");
+  }
+  return points;
+}
+
+// set_joints: one value per active joint, each within its limits.
+Eigen::VectorXd read_joint_list(const JsonInput& list, const ProtocolContext& context) {
+  const std::size_t count = context.joint_names.size();
+  if (count == 0) list.fail_problem("the scene has no robot joints");
+  if (list.size() != count) list.fail("an array of " + std::to_string(count) + " joint values");
+  Eigen::VectorXd joints(static_cast<Eigen::Index>(count));
+  for (std::size_t k = 0; k < count; ++k)
+    joints[static_cast<Eigen::Index>(k)] = read_joint_value(list.at(k), context, static_cast<int>(k));
+  return joints;
+}
+
+// load_scene: one of the bundled scenes, by name.
+std::string read_scene_name(const JsonInput& scene, const ProtocolContext& context) {
+  const std::string name = scene.string();
+  const auto& known = context.scene_names;
+  if (std::find(known.begin(), known.end(), name) == known.end()) {
+    std::string list;
+    for (const auto& s : known) list += (list.empty() ? "" : ", ") + s;
+    scene.fail("one of the bundled scenes: " + list);
+  }
+  return name;
+}
+
+// The keys a command of this type may have, each read and checked into `c`.
+void read_arguments(const JsonInput& message, const ProtocolContext& context, Command& c) {
+  using T = Command::Type;
+  switch (c.type) {
+    case T::Ping: case T::ClearTargets: case T::Reset: case T::Arm: case T::Disarm:
+      message.expect_only({"type", "id"});
+      break;
+    case T::SetTarget:
+      message.expect_only({"type", "id", "node", "position"});
+      c.node = read_node(message.at("node"), context);
+      c.position = read_point(message.at("position"));
+      break;
+    case T::RemoveTarget:
+      message.expect_only({"type", "id", "node"});
+      c.node = read_node(message.at("node"), context);
+      break;
+    case T::SetTargets:
+      message.expect_only({"type", "id", "targets"});
+      c.targets = read_target_list(message.at("targets"), context);
+      break;
+    case T::SetCenterline:
+      message.expect_only({"type", "id", "points"});
+      c.points = read_centerline_points(message.at("points"));
+      break;
+    case T::SetPaused:
+      message.expect_only({"type", "id", "paused"});
+      c.paused = message.at("paused").boolean();
+      break;
+    case T::SetJoint:
+      message.expect_only({"type", "id", "joint", "value"});
+      c.joint = read_joint(message.at("joint"), context);
+      c.value = read_joint_value(message.at("value"), context, c.joint);
+      break;
+    case T::SetJoints:
+      message.expect_only({"type", "id", "joints"});
+      c.joints = read_joint_list(message.at("joints"), context);
+      break;
+    case T::LoadScene:
+      message.expect_only({"type", "id", "scene"});
+      c.scene = read_scene_name(message.at("scene"), context);
+      break;
+  }
+}
+
 }  // namespace
 
 nlohmann::json message_id(std::string_view text) {
@@ -106,102 +229,9 @@ Command parse_command(std::string_view text, const ProtocolContext& context) {
   const JsonInput message(parse_json(text), source);
   if (!message.is_object()) message.fail("a JSON object");
   Command c;
-  if (message.has("id")) {
-    c.id = message.at("id").raw();
-    if (!valid_id(c.id)) message.at("id").fail("an integer or a string of at most 64 characters");
-  }
-  const JsonInput type = message.at("type");
-  const std::string name = type.string();
-  const auto& names = type_names();
-  const auto found = std::find_if(names.begin(), names.end(),
-                                  [&](const auto& entry) { return entry.first == name; });
-  if (found == names.end()) {
-    std::string known;
-    for (const auto& entry : names) known += (known.empty() ? "" : ", ") + entry.first;
-    type.fail("one of " + known);
-  }
-  c.type = found->second;
-
-  using T = Command::Type;
-  switch (c.type) {
-    case T::Ping: case T::ClearTargets: case T::Reset: case T::Arm: case T::Disarm:
-      message.expect_only({"type", "id"});
-      break;
-    case T::SetTarget:
-      message.expect_only({"type", "id", "node", "position"});
-      c.node = read_node(message.at("node"), context);
-      c.position = read_point(message.at("position"));
-      break;
-    case T::RemoveTarget:
-      message.expect_only({"type", "id", "node"});
-      c.node = read_node(message.at("node"), context);
-      break;
-    case T::SetTargets: {
-      message.expect_only({"type", "id", "targets"});
-      const JsonInput list = message.at("targets");
-      if (list.size() > static_cast<std::size_t>(context.node_count))
-        list.fail("at most one target per node (" + std::to_string(context.node_count) + ")");
-      std::set<int> seen;
-      for (std::size_t k = 0; k < list.size(); ++k) {
-        const JsonInput t = list.at(k);
-        t.expect_only({"node", "position"});
-        const int node = read_node(t.at("node"), context);
-        if (!seen.insert(node).second) t.at("node").fail("a node not targeted twice");
-        c.targets.nodes.push_back(node);
-        c.targets.positions.push_back(read_point(t.at("position")));
-      }
-      break;
-    }
-    case T::SetCenterline: {
-      message.expect_only({"type", "id", "points"});
-      const JsonInput list = message.at("points");
-      if (list.size() < 2 || list.size() > max_centerline_points)
-        list.fail("from 2 to " + std::to_string(max_centerline_points) + " points");
-      double length = 0;
-      for (std::size_t k = 0; k < list.size(); ++k) {
-        c.points.push_back(read_point(list.at(k)));
-        if (k > 0) length += (c.points[k] - c.points[k - 1]).norm();
-      }
-      if (!(length >= min_centerline_length)) {
-        std::ostringstream arc;
-        arc << std::setprecision(3) << length;
-        list.fail("a centre-line at least 1 mm long (its arc length is " + arc.str() + " m)");
-      }
-      break;
-    }
-    case T::SetPaused:
-      message.expect_only({"type", "id", "paused"});
-      c.paused = message.at("paused").boolean();
-      break;
-    case T::SetJoint:
-      message.expect_only({"type", "id", "joint", "value"});
-      c.joint = read_joint(message.at("joint"), context);
-      c.value = read_joint_value(message.at("value"), context, c.joint);
-      break;
-    case T::SetJoints: {
-      message.expect_only({"type", "id", "joints"});
-      const JsonInput list = message.at("joints");
-      const std::size_t count = context.joint_names.size();
-      if (count == 0) list.fail_problem("the scene has no robot joints");
-      if (list.size() != count) list.fail("an array of " + std::to_string(count) + " joint values");
-      c.joints.resize(static_cast<Eigen::Index>(count));
-      for (std::size_t k = 0; k < count; ++k)
-        c.joints[static_cast<Eigen::Index>(k)] = read_joint_value(list.at(k), context, static_cast<int>(k));
-      break;
-    }
-    case T::LoadScene: {
-      message.expect_only({"type", "id", "scene"});
-      const JsonInput scene = message.at("scene");
-      c.scene = scene.string();
-      const auto& known = context.scene_names;
-      if (std::find(known.begin(), known.end(), c.scene) == known.end()) {
-        std::string list;
-        for (const auto& s : known) list += (list.empty() ? "" : ", ") + s;
-        scene.fail("one of the bundled scenes: " + list);
-      }
-      break;
-    }
-  }
+  c.id = read_id(message);
+  c.type = read_type(message.at("type"));
+  read_arguments(message, context, c);
   return c;
 }
 
@@ -228,14 +258,6 @@ std::string positions_frame(const ControllerSnapshot& snapshot) {
     std::memcpy(frame.data() + 16 + 4 * i, &v, 4);
   }
   return frame;
-}
-
-nlohmann::json pose_json(const Eigen::Isometry3d& T) {
-  nlohmann::json a = nlohmann::json::array();
-  const Eigen::Matrix4d& m = T.matrix();
-  for (int col = 0; col < 4; ++col)
-    for (int row = 0; row < 4; ++row) a.push_back(m(row, col));
-  return a;
 }
 
 }  // namespace shapectl::server

@@ -70,7 +70,6 @@ std::string error_reply(const nlohmann::json& id, const std::string& message);
 //   then 3n float32 [x0 y0 z0 x1 ...] in the world frame, metres; all little-endian.
 std::string positions_frame(const ControllerSnapshot& snapshot);
 
-// A 4×4 pose as 16 numbers in column-major order (three.js Matrix4.fromArray).
-nlohmann::json pose_json(const Eigen::Isometry3d& T);
+// Poses in messages are 16 numbers, column-major: message_pose_json (io/json_eigen.hpp).
 
 }  // namespace shapectl::server

@@ -5,9 +5,11 @@
 #include <fstream>
 
 #include <shapectl/control/centerline.hpp>
+#include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/link/robot_link.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 namespace shapectl::server {
 
@@ -18,14 +20,6 @@ nlohmann::json finite_or_null(double v) {
   if (std::isfinite(v)) return v;
   return nullptr;
 }
-
-nlohmann::json vector_json(const Eigen::VectorXd& v) {
-  nlohmann::json a = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(finite_or_null(v[i]));
-  return a;
-}
-
-nlohmann::json point_json(const Vec3& p) { return {p.x(), p.y(), p.z()}; }
 
 const char* kind_name(Shape::Kind kind) {
   switch (kind) {
@@ -38,8 +32,8 @@ const char* kind_name(Shape::Kind kind) {
 
 nlohmann::json shape_json(const Shape& s) {
   return {{"kind", kind_name(s.kind)},
-          {"pose", pose_json(s.T_link_shape)},
-          {"size", point_json(s.box_size)},
+          {"pose", message_pose_json(s.T_link_shape)},
+          {"size", vec3_json(s.box_size)},
           {"radius", s.radius},
           {"length", s.length}};
 }
@@ -55,10 +49,10 @@ nlohmann::json robot_json(const RobotSetup& setup) {
   nlohmann::json spheres = nlohmann::json::array();
   if (setup.collisions)
     for (const CollisionSphere& s : setup.collisions->spheres())
-      spheres.push_back({{"link", s.link}, {"center", point_json(s.center_link)}, {"radius", s.radius}});
+      spheres.push_back({{"link", s.link}, {"center", vec3_json(s.center_link)}, {"radius", s.radius}});
   nlohmann::json end_effectors = nlohmann::json::array();
   for (const EndEffector& e : setup.end_effectors)
-    end_effectors.push_back({{"name", e.name}, {"link", e.link}, {"tcp", point_json(e.tcp_link)}});
+    end_effectors.push_back({{"name", e.name}, {"link", e.link}, {"tcp", vec3_json(e.tcp_link)}});
   return {{"name", model.name()},
           {"links", links},
           {"joint_names", model.active_joint_names()},
@@ -306,7 +300,7 @@ nlohmann::json Session::describe_scene() const {
   }
   nlohmann::json bar = nullptr;
   if (const auto axis = find_bar_axis(mesh))
-    bar = {{"center", point_json(axis->center)}, {"direction", point_json(axis->direction)},
+    bar = {{"center", vec3_json(axis->center)}, {"direction", vec3_json(axis->direction)},
            {"length", axis->length}, {"thickness", axis->thickness}};
   nlohmann::json scenes = nlohmann::json::array();
   for (const auto& s : scenes_) scenes.push_back(s.name);
@@ -336,13 +330,7 @@ std::string Session::scene_message() const {
 std::string Session::state_message(int clients) const {
   const ControllerSnapshot& s = *snapshot_;
   nlohmann::json links = nlohmann::json::array();
-  for (const auto& T : s.T_world_link) links.push_back(pose_json(T));
-  nlohmann::json targets = nlohmann::json::array();
-  for (int k = 0; k < s.targets.size(); ++k)
-    targets.push_back({{"node", s.targets.nodes[static_cast<std::size_t>(k)]},
-                       {"position", point_json(s.targets.positions[static_cast<std::size_t>(k)])}});
-  nlohmann::json centerline = nlohmann::json::array();
-  for (const Vec3& p : s.centerline) centerline.push_back(point_json(p));
+  for (const auto& T : s.T_world_link) links.push_back(message_pose_json(T));
   const double t = now();
   const nlohmann::json m = {
       {"type", "state"},
@@ -362,8 +350,8 @@ std::string Session::state_message(int clients) const {
       {"editing", t - last_edit_time_ < editing_window},
       {"joints", vector_json(s.joints)},
       {"links", links},
-      {"targets", targets},
-      {"centerline", centerline},
+      {"targets", targets_json(s.targets)},
+      {"centerline", points_json(s.centerline)},
       {"last_error", s.last_error},
       {"clients", clients},
       {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)}};

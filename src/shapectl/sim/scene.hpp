@@ -1,6 +1,7 @@
 #pragma once
-// The immutable description of a scene, read from SCENE.json: the object (mesh, material,
-// placement), gravity and what holds it (fixed nodes). Paths are relative to the scene file.
+// The immutable description of a scene: the object (mesh, material, placement), gravity, what
+// holds it (fixed nodes, a robot's grips) and the objective's weights. Read from SCENE.json by
+// scene_io/scene_file.hpp, or built in code.
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -10,11 +11,10 @@
 #include <Eigen/Geometry>
 
 #include <shapectl/fem/material.hpp>
-#include <shapectl/io/json_input.hpp>
 #include <shapectl/mesh/tet_mesh.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/robot_model.hpp>
-#include <shapectl/sim/sparse_cholesky.hpp>
+#include <shapectl/sim/cholesky_backend.hpp>
 
 namespace shapectl {
 
@@ -36,7 +36,7 @@ struct NodeSelection {
 struct StaticsSettings {
   int max_iterations = 100;
   double relative_tolerance = 1e-6;  // force tolerance as a fraction of the object's weight
-  std::optional<SparseCholesky::Backend> backend;  // "ldlt" | "band" | "cholmod"; default: from the matrix
+  std::optional<CholeskyBackend> backend;  // "ldlt" | "band" | "cholmod"; default: from the matrix
 };
 
 struct EndEffector {
@@ -98,16 +98,5 @@ struct Scene {
   // Rest positions placed in the world, stacked (3n).
   Positions world_rest_positions() const;
 };
-
-// Reads and validates a scene, then runs check_scene (sim/scene_checks.hpp) on it: throws
-// InputError naming the file and field for bad or implausible input, fills `warnings`.
-// A mesh file may give "units" ("m", "cm", "mm") or "scale" (a factor): its nodes are scaled to
-// metres before anything else (TetGen included) sees them.
-Scene load_scene(const std::filesystem::path& file);
-
-// Parsers shared by scene-like files.
-AlignedBox read_box(const JsonInput& j);
-NodeSelection read_node_selection(const JsonInput& j, int node_count);
-Eigen::Isometry3d read_pose(const JsonInput& j);
 
 }  // namespace shapectl

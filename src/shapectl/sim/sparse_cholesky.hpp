@@ -7,13 +7,14 @@
 #include <memory>
 #include <optional>
 
+#include <shapectl/sim/cholesky_backend.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {
 
 class SparseCholesky {
  public:
-  enum class Backend { SimplicialLDLT, Band, CholmodSupernodal };
+  using Backend = CholeskyBackend;
 
   // A fixed backend, or none: then analyze() picks one for the matrix.
   explicit SparseCholesky(std::optional<Backend> backend = std::nullopt);

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include <shapectl/io/input_error.hpp>
-#include <shapectl/sim/scene.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/sim/scene_checks.hpp>
 
 #include "support/test_support.hpp"
@@ -23,13 +23,7 @@ using test::TempDir;
 std::string error_of(const std::function<void()>& f) { return test::input_error_of(f); }
 
 // A bundled scene as JSON, its relative paths made absolute so it loads from a temp dir.
-Json bundled(const std::string& name) {
-  Json scene = Json::parse(test::read_text(test::source_path("scenes/" + name)));
-  if (scene.contains("robot"))
-    for (const char* key : {"urdf", "collision_spheres"})
-      scene["robot"][key] = (test::source_path("scenes") / scene["robot"][key].get<std::string>()).string();
-  return scene;
-}
+Json bundled(const std::string& name) { return Json::parse(test::bundled_scene_text(name)); }
 
 // The foam bar clamped at its -x end, with the given mesh (no robot).
 Json clamped_bar(const Json& mesh) {

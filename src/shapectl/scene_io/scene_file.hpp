@@ -1,0 +1,27 @@
+#pragma once
+// SCENE.json → Scene (sim/scene.hpp): the strict scene reader. It sits above sim/ because it
+// needs everything a scene names: mesh files (mesh/), the URDF and collision spheres (robot/)
+// and the plausibility checks (sim/scene_checks.hpp). Paths are relative to the scene file.
+#include <filesystem>
+
+#include <Eigen/Geometry>
+
+#include <shapectl/sim/scene.hpp>
+
+namespace shapectl {
+
+class JsonInput;
+
+// Reads and validates a scene, then runs check_scene (sim/scene_checks.hpp) on it: throws
+// InputError naming the file and field for bad or implausible input, fills `warnings`.
+// A mesh file may give "units" ("m", "cm", "mm") or "scale" (a factor): its nodes are scaled to
+// metres before anything else (TetGen included) sees them.
+Scene load_scene(const std::filesystem::path& file);
+
+// Parsers shared by scene-like files.
+AlignedBox read_box(const JsonInput& j);
+NodeSelection read_node_selection(const JsonInput& j, int node_count);
+// {"position": [x, y, z], "rpy": [roll, pitch, yaw]} (io/json_eigen.hpp: scene_pose_json).
+Eigen::Isometry3d read_pose(const JsonInput& j);
+
+}  // namespace shapectl

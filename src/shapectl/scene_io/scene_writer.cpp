@@ -1,0 +1,54 @@
+#include <shapectl/scene_io/scene_writer.hpp>
+
+#include <shapectl/io/input_file.hpp>
+#include <shapectl/io/json_eigen.hpp>
+
+namespace shapectl {
+
+namespace {
+
+// `path` as written in `from_dir`'s file, rewritten for a file in `to_dir`.
+std::string rebased(const std::string& path, const std::filesystem::path& from_dir, const std::filesystem::path& to_dir) {
+  const std::filesystem::path p(path);
+  if (p.is_absolute()) return path;
+  const auto target = std::filesystem::weakly_canonical(std::filesystem::absolute(from_dir / p));
+  const auto relative = target.lexically_relative(std::filesystem::weakly_canonical(std::filesystem::absolute(to_dir)));
+  return relative.empty() ? target.string() : relative.string();
+}
+
+void rebase_member(nlohmann::ordered_json& object, const char* key, const std::filesystem::path& from_dir,
+                   const std::filesystem::path& to_dir) {
+  if (object.is_object() && object.contains(key) && object[key].is_string())
+    object[key] = rebased(object[key].get<std::string>(), from_dir, to_dir);
+}
+
+}  // namespace
+
+nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source, const Scene& scene,
+                                              const std::filesystem::path& out) {
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(read_input_file(source, max_json_file_bytes));
+  nlohmann::ordered_json& material = j["object"]["material"];
+  if (material.contains("mu")) {
+    material["mu"] = scene.material.mu;
+    material["kappa"] = scene.material.kappa;
+  } else {
+    material["youngs_modulus"] = youngs_modulus_of(scene.material);
+    material["poisson_ratio"] = poisson_ratio_of(scene.material);
+  }
+  material["density"] = scene.material.density;
+  for (std::size_t k = 0; k < scene.grips.size(); ++k) {
+    nlohmann::ordered_json& grip = j["grips"][k];
+    if (scene.grips[k].offset.matrix() == Eigen::Matrix4d::Identity()) grip.erase("offset");
+    else grip["offset"] = scene_pose_json(scene.grips[k].offset);
+  }
+  const auto from_dir = source.parent_path(), to_dir = out.parent_path();
+  rebase_member(j["object"], "mesh", from_dir, to_dir);
+  if (j["object"]["mesh"].is_object()) rebase_member(j["object"]["mesh"], "file", from_dir, to_dir);
+  if (j.contains("robot")) {
+    rebase_member(j["robot"], "urdf", from_dir, to_dir);
+    rebase_member(j["robot"], "collision_spheres", from_dir, to_dir);
+  }
+  return j;
+}
+
+}  // namespace shapectl
