@@ -3,4 +3,4 @@
 shapectl_area(calib)
 target_link_libraries(shapectl_calib PUBLIC shapectl_control shapectl_fem shapectl_io shapectl_mesh shapectl_robot shapectl_sim)
 
-shapectl_tests(calib shapectl_calib)
+shapectl_tests(calib shapectl_calib shapectl_scene_io)

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   shapectl::cli::add_kinematics_command(app);
   shapectl::cli::add_author_command(app);
   shapectl::cli::add_solve_command(app);
+  shapectl::cli::add_calibrate_command(app);
   shapectl::cli::add_bench_command(app);
   shapectl::cli::add_serve_command(app);
   shapectl::cli::add_link_commands(app);

@@ -22,6 +22,7 @@
 #include <shapectl/robot/joint_limits.hpp>
 #include <shapectl/robot/robot_model.hpp>
 #include <shapectl/sim/gripped_object.hpp>
+#include <shapectl/io/input_error.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 
 namespace shapectl::python {

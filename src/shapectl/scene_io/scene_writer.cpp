@@ -26,7 +26,7 @@ void rebase_member(nlohmann::ordered_json& object, const char* key, const std::f
 
 nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source, const Scene& scene,
                                               const std::filesystem::path& out) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::parse(read_input_file(source, max_json_file_bytes));
+  nlohmann::ordered_json j = nlohmann::ordered_json::parse(read_input_file(source, max_json_file_bytes, "JSON"));
   nlohmann::ordered_json& material = j["object"]["material"];
   if (material.contains("mu")) {
     material["mu"] = scene.material.mu;
