@@ -18,7 +18,7 @@ target_sources(shapectl_link PRIVATE ${egm_generated}/egm.pb.cc)
 # Only the codec sees the generated types; nothing public depends on them.
 target_include_directories(shapectl_link PRIVATE ${egm_generated})
 set_source_files_properties(${egm_generated}/egm.pb.cc PROPERTIES COMPILE_OPTIONS "-w")
-# Its sources share helper names (to_list, ...) in anonymous namespaces: one unit each.
+# Its sources share helper names in anonymous namespaces: one unit each.
 set_target_properties(shapectl_link PROPERTIES UNITY_BUILD OFF)
 
 shapectl_tests(link shapectl_link)

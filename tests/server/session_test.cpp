@@ -56,6 +56,40 @@ TEST_F(SessionTest, SetTargetReachesTheControllerAndTheStateMessage) {
   EXPECT_EQ(state["links"][0].size(), 16u);
 }
 
+TEST_F(SessionTest, ObserveFeedsTheClosedLoopAndBadObservationsChangeNothing) {
+  const auto first = session.controller().snapshot();
+  nlohmann::json joints = nlohmann::json::object();
+  for (std::size_t j = 0; j < first->joint_names.size(); ++j) joints[first->joint_names[j]] = first->joints[j];
+  const Vec3 seen = first->positions.segment<3>(15) + Vec3(0.002, 0, 0);  // node 5, 2 mm off the model
+  const nlohmann::json frame = {{"joints", joints}, {"markers", {{{"node", 5}, {"position", {seen.x(), seen.y(), seen.z()}}}}}};
+  auto observe = [&](const nlohmann::json& f) {
+    return session.handle(nlohmann::json{{"type", "observe"}, {"frame", f}}.dump());
+  };
+  std::vector<nlohmann::json> bad(5, frame);
+  bad[0]["markers"][0]["node"] = 100000;
+  bad[1]["joints"].erase(first->joint_names[3]);
+  bad[2]["points_file"] = "/etc/passwd";
+  bad[3].erase("markers");
+  bad[3]["points"] = {{0.4, 0, 0.3}};
+  bad[4]["markers"][0]["position"][1] = "nan";
+  for (const auto& b : bad) {
+    const auto r = observe(b);
+    EXPECT_FALSE(r.ok) << b.dump();
+    EXPECT_EQ(reply_json(r)["type"], "error");
+  }
+  EXPECT_TRUE(session.handle(R"({"type":"set_feedback","on":true})").ok);
+  const auto r = observe(frame);
+  ASSERT_TRUE(r.ok) << r.text;
+  const auto s = wait_until(session, [](const ControllerSnapshot& s) { return s.observations > 0; });
+  EXPECT_EQ(s->observations, 1u);  // the bad ones never reached the controller
+  session.tick();
+  const auto state = nlohmann::json::parse(session.state_message(1));
+  EXPECT_TRUE(state["feedback"].get<bool>());
+  EXPECT_NEAR(state["model_error"].get<double>(), 0.002, 1e-6);
+  ASSERT_EQ(state["observed_markers"].size(), 1u);
+  EXPECT_EQ(state["observed_markers"][0][0], 5);
+}
+
 TEST_F(SessionTest, SecondSetTargetMovesTheFirstAndRemoveTargetDeletesIt) {
   // Paused, requests apply without waiting for optimizer iterations.
   EXPECT_TRUE(session.handle(R"({"type":"set_paused","paused":true})").ok);

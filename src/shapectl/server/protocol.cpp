@@ -1,5 +1,7 @@
 #include <shapectl/server/protocol.hpp>
 
+#include <shapectl/calib/observations.hpp>
+
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -86,6 +88,8 @@ const std::vector<std::pair<std::string, Command::Type>>& type_names() {
       {"load_scene", Command::Type::LoadScene},
       {"arm", Command::Type::Arm},
       {"disarm", Command::Type::Disarm},
+      {"observe", Command::Type::Observe},
+      {"set_feedback", Command::Type::SetFeedback},
   };
   return names;
 }
@@ -169,6 +173,19 @@ std::string read_scene_name(const JsonInput& scene, const ProtocolContext& conte
   return name;
 }
 
+// observe: one frame of OBSERVATIONS.json (calib/observations.hpp), never a points file (a
+// client must not make the server read its files); the live loop uses its markers.
+ShapeObservation read_observation(const JsonInput& frame, const ProtocolContext& context) {
+  if (!context.robot) frame.fail_problem("the scene has no robot: nothing to close the loop with");
+  const ObservationFrame f = read_observation_frame(
+      frame, {.node_count = context.node_count, .robot = context.robot, .allow_points_files = false});
+  if (f.markers.empty())
+    frame.fail_problem("a frame without markers: the live loop uses markers (point clouds go to shapectl calibrate)");
+  ShapeObservation o{.joints = f.joints, .time = f.time.value_or(0)};
+  for (const ObservedMarker& m : f.markers) o.markers.emplace_back(m.node, m.position);
+  return o;
+}
+
 // The keys a command of this type may have, each read and checked into `c`.
 void read_arguments(const JsonInput& message, const ProtocolContext& context, Command& c) {
   using T = Command::Type;
@@ -209,6 +226,14 @@ void read_arguments(const JsonInput& message, const ProtocolContext& context, Co
     case T::LoadScene:
       message.expect_only({"type", "id", "scene"});
       c.scene = read_scene_name(message.at("scene"), context);
+      break;
+    case T::Observe:
+      message.expect_only({"type", "id", "frame"});
+      c.observation = read_observation(message.at("frame"), context);
+      break;
+    case T::SetFeedback:
+      message.expect_only({"type", "id", "on"});
+      c.feedback = message.at("on").boolean();
       break;
   }
 }

@@ -35,12 +35,13 @@ struct ProtocolContext {
   std::vector<std::string> joint_names;
   Eigen::VectorXd lower_limits, upper_limits;
   std::vector<std::string> scene_names;
+  const RobotModel* robot = nullptr;  // observe: the frame's joints by name
 };
 
 struct Command {
   enum class Type {
     Ping, SetTarget, RemoveTarget, SetTargets, ClearTargets, SetCenterline, SetPaused,
-    SetJoint, SetJoints, Reset, LoadScene, Arm, Disarm
+    SetJoint, SetJoints, Reset, LoadScene, Arm, Disarm, Observe, SetFeedback
   };
   Type type = Type::Ping;
   nlohmann::json id;            // echoed in the reply; null when the client sent none
@@ -53,6 +54,8 @@ struct Command {
   double value = 0;             // SetJoint, rad (m for prismatic joints)
   Eigen::VectorXd joints;       // SetJoints
   std::string scene;            // LoadScene: one of ProtocolContext::scene_names
+  ShapeObservation observation; // Observe: markers and the joints they were taken at
+  bool feedback = false;        // SetFeedback
 };
 
 // The client's "id" if `text` is an object carrying a valid one (integer or string of at most

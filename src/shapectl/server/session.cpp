@@ -21,6 +21,13 @@ nlohmann::json finite_or_null(double v) {
   return nullptr;
 }
 
+// [[node, x, y, z], ...]: the last observation's markers, for the page to draw.
+nlohmann::json observed_markers_json(const std::vector<std::pair<int, Vec3>>& markers) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& [node, p] : markers) out.push_back({node, p.x(), p.y(), p.z()});
+  return out;
+}
+
 const char* kind_name(Shape::Kind kind) {
   switch (kind) {
     case Shape::Kind::Sphere: return "sphere";
@@ -145,6 +152,7 @@ ProtocolContext Session::context() const {
   c.lower_limits = snapshot_->lower_limits;
   c.upper_limits = snapshot_->upper_limits;
   for (const auto& s : scenes_) c.scene_names.push_back(s.name);
+  c.robot = &controller_->robot();
   return c;
 }
 
@@ -245,6 +253,12 @@ void Session::apply(const Command& c) {
     case T::Disarm:
       if (!link_) throw InputError("message", "type", "no robot link in this session");
       link_->disarm("disarmed from the GUI");
+      break;
+    case T::Observe:
+      controller_->observe(c.observation);
+      break;
+    case T::SetFeedback:
+      controller_->set_feedback(c.feedback);
       break;
   }
 }
@@ -353,6 +367,11 @@ std::string Session::state_message(int clients) const {
       {"targets", targets_json(s.targets)},
       {"centerline", points_json(s.centerline)},
       {"last_error", s.last_error},
+      {"feedback", s.feedback},
+      {"observations", s.observations},
+      {"model_error", finite_or_null(s.model_error)},
+      {"observed_error", finite_or_null(s.observed_error)},
+      {"observed_markers", observed_markers_json(s.observed_markers)},
       {"clients", clients},
       {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)}};
   return m.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
