@@ -1,5 +1,6 @@
 // shapectl run SCENE.json --targets TARGETS.json [--robot sim|egm] [--arm] [--log LOG.jsonl]
 //              [--until-settled] [--timeout S] [link options]
+//              [--world WORLD.json [--camera-rate HZ] [--camera-sigma M] [--no-feedback]]
 // The controller and the robot link without a GUI: the optimizer's best θ goes to the link
 // whenever it changes; the link's governor moves the robot (only if armed). With
 // --until-settled it exits 0 once the optimizer has converged and the robot has arrived, or 2
@@ -10,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/control/controller.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
@@ -39,6 +41,12 @@ struct RunArgs {
   std::string robot = "sim";  // a LinkKind name
   LinkConfig link;
   double watchdog_ms = 100;
+  // The simulated real object (calib/simulated_world.hpp): its camera observes markers on the
+  // target nodes; with feedback on, the controller closes the loop on them.
+  std::string world;
+  double camera_rate = 10;      // observations per second
+  double camera_sigma = 0.0003;  // m
+  bool feedback = true;
 };
 
 nlohmann::json link_json(const LinkStatus& s) {
@@ -78,7 +86,26 @@ void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
 struct RunInputs {
   Scene scene;
   TargetsInput targets;
+  std::unique_ptr<SimulatedWorld> world;  // --world
 };
+
+// --world: the "real" object, observed on the target nodes (the centre-line's too).
+std::unique_ptr<SimulatedWorld> make_world(const RunArgs& args, const Scene& model, const ShapeTargets& targets) {
+  if (args.world.empty()) return nullptr;
+  if (args.link.kind != LinkKind::Sim)
+    throw InputError("run", "--world", "--robot sim (a real robot holds a real object)");
+  if (!(args.camera_rate > 0 && args.camera_rate <= 1000)) throw InputError("run", "--camera-rate", "0 < rate <= 1000 per second", args.camera_rate);
+  if (!(args.camera_sigma >= 0 && args.camera_sigma <= 0.1)) throw InputError("run", "--camera-sigma", "0 <= sigma <= 0.1 m", args.camera_sigma);
+  const Scene world = load_scene(args.world);
+  SimulatedCamera camera;
+  camera.marker_nodes = targets.nodes;
+  camera.sigma = args.camera_sigma;
+  try {
+    return std::make_unique<SimulatedWorld>(world, model, camera, args.camera_rate);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.world, "object", e.what());
+  }
+}
 
 // The scene (with a robot) and the targets, checked; the link settings completed from them.
 RunInputs load_run_inputs(RunArgs& args) {
@@ -90,7 +117,8 @@ RunInputs load_run_inputs(RunArgs& args) {
   args.link.watchdog_timeout = args.watchdog_ms / 1000;
   args.link.sim_initial_joints = scene.robot->reference_joints;
   if (args.timeout < 0) throw InputError("run", "--timeout", "a number >= 0", args.timeout);
-  return {std::move(scene), std::move(targets)};
+  std::unique_ptr<SimulatedWorld> world = make_world(args, scene, targets.targets);
+  return {std::move(scene), std::move(targets), std::move(world)};
 }
 
 // The session log if --log names one, opened with a "session" event; else null.
@@ -167,10 +195,32 @@ bool settle_decided(const ControllerSnapshot& s, const LinkStatus& st, bool arme
   return st.arrived;
 }
 
+// With the loop closed, settled also means the observed object is at the targets.
+bool observed_at_targets(const ControllerSnapshot& s) {
+  return !s.feedback || (s.observations > 0 && s.observed_error < 1e-3);
+}
+
+// --world: the world settles at the robot's measured joints; a due observation goes to the
+// controller and the log (with the world's true error, which only a simulation knows).
+void observe_world(SimulatedWorld& world, Controller& controller, const ControllerSnapshot& snap,
+                   const LinkStatus& st, double time, SessionLog* log) {
+  if (st.measured.size() != snap.joints.size()) return;  // no feedback from the robot yet
+  const std::optional<ObservationFrame> frame = world.step(time, st.measured);
+  if (!frame) return;
+  ShapeObservation o{.joints = frame->joints, .time = time};
+  for (const ObservedMarker& m : frame->markers) o.markers.emplace_back(m.node, m.position);
+  controller.observe(o);
+  if (log)
+    log->write("observation", {{"time", time},
+                               {"true_error", world.true_error(snap.targets)},
+                               {"observed_error", snap.observed_error},
+                               {"model_error", snap.model_error}});
+}
+
 // Sends each new snapshot's θ to the link (and the log) and prints progress, until settled,
 // failed, timed out or stopped by a signal.
 RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLink& link, SessionLog* log,
-                            const RunClock& clock) {
+                            const RunClock& clock, SimulatedWorld* world) {
   RunOutcome outcome;
   std::uint64_t seen = 0;
   std::string last_report;
@@ -184,12 +234,16 @@ RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLi
       if (log) log_snapshot(*log, snap);
     }
     const LinkStatus st = link.status();
+    if (world) observe_world(*world, controller, snap, st, clock.elapsed(), log);
     const std::string report = progress_report(snap, st);
     if (report != last_report) {
       std::cerr << "run: " << clock.elapsed() << " s: " << report << " (error " << snap.error.mean * 1000 << " mm)\n";
       last_report = report;
     }
-    if (args.until_settled && settle_decided(snap, st, args.arm, outcome)) break;
+    if (args.until_settled && settle_decided(snap, st, args.arm, outcome)) {
+      if (!outcome.failure.empty() || observed_at_targets(snap)) break;
+      outcome.settled = false;  // arrived, but the observed object is not there yet: on
+    }
     if (args.timeout > 0 && clock.elapsed() >= args.timeout) {
       if (args.until_settled)
         outcome.failure = "not settled after " + std::to_string(args.timeout) + " s: optimizer " +
@@ -213,7 +267,8 @@ LinkStatus stop_run(RobotLink& link, Controller& controller, const std::string& 
 }
 
 // What `run` prints on stdout.
-nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status, RobotLink& link) {
+nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status, RobotLink& link,
+                          const SimulatedWorld* world) {
   const ControllerSnapshot& snap = *outcome.snapshot;
   nlohmann::json result = {{"settled", outcome.settled},
                            {"status", to_string(snap.status)},
@@ -227,24 +282,32 @@ nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_sta
     const LatencyStats l = egm->latency();
     result["latency_us"] = {{"samples", l.samples}, {"median", l.median_us}, {"p99", l.p99_us}, {"max", l.max_us}};
   }
+  if (snap.observations > 0) {
+    result["observations"] = snap.observations;
+    result["feedback"] = snap.feedback;
+    result["model_error"] = snap.model_error;
+    result["observed_error"] = std::isfinite(snap.observed_error) ? nlohmann::json(snap.observed_error) : nullptr;
+  }
+  if (world) result["true_error"] = world->true_error(snap.targets);
   if (!outcome.failure.empty()) result["reason"] = outcome.failure;
   return result;
 }
 
 void run(RunArgs args) {
-  const RunInputs inputs = load_run_inputs(args);
+  RunInputs inputs = load_run_inputs(args);
   const std::shared_ptr<SessionLog> log = open_session_log(args, inputs.scene);
   const auto link = make_run_link(args, inputs.scene, log);
   Controller controller(inputs.scene);
   set_run_targets(controller, inputs.targets, log.get());
+  if (inputs.world) controller.set_feedback(args.feedback);
   install_stop_signal_handlers();
   controller.start();
   link->start();
   const RunClock clock;
   if (args.arm) arm_when_ready(*link, clock);  // throws if it cannot
-  const RunOutcome outcome = follow_optimizer(args, controller, *link, log.get(), clock);
+  const RunOutcome outcome = follow_optimizer(args, controller, *link, log.get(), clock, inputs.world.get());
   const LinkStatus final_status = stop_run(*link, controller, outcome.failure);
-  const nlohmann::json result = run_result(outcome, final_status, *link);
+  const nlohmann::json result = run_result(outcome, final_status, *link, inputs.world.get());
   if (log) log->write("end", {{"settled", outcome.settled}, {"reason", outcome.failure}});
   std::cout << result.dump(2) << "\n";
   if (!outcome.failure.empty()) throw SolverFailure(outcome.failure);
@@ -273,6 +336,14 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--egm-address", args->link.egm_address, "local address for the EGM ports")->capture_default_str();
   cmd->add_option("--egm-left-port", args->link.egm_left_port, "UDP port of the left arm (ROB_L)")->capture_default_str();
   cmd->add_option("--egm-right-port", args->link.egm_right_port, "UDP port of the right arm (ROB_R)")->capture_default_str();
+  cmd->add_option("--world", args->world,
+                  "WORLD.json: simulate the real object (true material, grip offsets; same mesh) with --robot sim; "
+                  "a camera observes markers on the target nodes")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--camera-rate", args->camera_rate, "--world: observations per second")->capture_default_str();
+  cmd->add_option("--camera-sigma", args->camera_sigma, "--world: marker noise, m")->capture_default_str();
+  cmd->add_flag("--feedback,!--no-feedback", args->feedback,
+                "--world: close the loop on the observations (default) or not (open loop)");
   cmd->callback([args] { run(*args); });
 }
 

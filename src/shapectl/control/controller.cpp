@@ -105,6 +105,8 @@ struct Controller::State {
         objective->with_targets(feedback_on ? feedback->corrected(user_targets) : user_targets));
   }
   void take(const ShapeObservation& observation);
+  // Whether the corrected targets moved past the threshold from those aimed at now.
+  bool moved_enough(const ShapeTargets& corrected) const;
   void iterate();
   void publish();
   void run();
@@ -161,8 +163,10 @@ void Controller::State::apply(Inbox in) {
     feedback_on = *in.feedback;
     aim();
   }
+  const std::vector<Vec3> aimed_before = objective->targets().positions;
   if (in.observation) take(*in.observation);
-  if (in.clear || in.targets || in.centerline || in.reset || in.feedback || (in.observation && feedback_on)) {
+  const bool reaimed = in.observation && feedback_on && objective->targets().positions != aimed_before;
+  if (in.clear || in.targets || in.centerline || in.reset || in.feedback || reaimed) {
     objective->rescore(current);
     optimizer->reset();
   }
@@ -185,7 +189,15 @@ void Controller::State::take(const ShapeObservation& observation) {
     for (int k = 0; k < user_targets.size(); ++k)
       if (user_targets.nodes[k] == node) sum += (y - user_targets.positions[k]).norm(), ++count;
   observed_error = count ? sum / count : NAN;
-  if (feedback_on) aim();
+  if (feedback_on && moved_enough(feedback->corrected(user_targets))) aim();
+}
+
+bool Controller::State::moved_enough(const ShapeTargets& corrected) const {
+  const ShapeTargets& aimed = objective->targets();
+  if (aimed.size() != corrected.size()) return true;
+  for (int k = 0; k < aimed.size(); ++k)
+    if ((aimed.positions[k] - corrected.positions[k]).norm() > options.feedback.retarget_threshold) return true;
+  return false;
 }
 
 void Controller::State::iterate() {
