@@ -18,10 +18,12 @@ namespace shapectl {
 namespace {
 
 RobotModel yumi_arms() {
-  RobotModel robot = RobotModel::load_urdf_file(std::string(SHAPECTL_SOURCE_DIR) + "/data/robots/yumi/yumi.urdf");
+  RobotModel robot =
+      RobotModel::load_urdf_file(std::string(SHAPECTL_SOURCE_DIR) + "/data/robots/yumi/yumi.urdf");
   std::vector<std::string> names;
   for (const char* arm : {"l", "r"})
-    for (int axis : {1, 2, 7, 3, 4, 5, 6}) names.push_back("yumi_joint_" + std::to_string(axis) + "_" + arm);
+    for (int axis : {1, 2, 7, 3, 4, 5, 6})
+      names.push_back("yumi_joint_" + std::to_string(axis) + "_" + arm);
   robot.set_active_joints(names);
   return robot;
 }
@@ -88,7 +90,8 @@ void BM_EgmFeedbackToCommand(benchmark::State& state) {
     controller.send_to(bytes, left);
     pollfd fd{controller.fd(), POLLIN, 0};
     while (controller.receive(reply, nullptr) < 0) ::poll(&fd, 1, 100);
-    state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count());
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count());
   }
   const LatencyStats l = link.latency();
   state.counters["link_median_us"] = l.median_us;
@@ -96,7 +99,10 @@ void BM_EgmFeedbackToCommand(benchmark::State& state) {
   state.counters["link_max_us"] = l.max_us;
   link.stop();
 }
-BENCHMARK(BM_EgmFeedbackToCommand)->UseManualTime()->Iterations(2500)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_EgmFeedbackToCommand)
+    ->UseManualTime()
+    ->Iterations(2500)
+    ->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace shapectl

@@ -19,9 +19,10 @@ namespace {
 using namespace shapectl;
 
 const std::string kYumiDir = SHAPECTL_SOURCE_DIR "/data/robots/yumi/";
-const char* const kArmJoints[] = {"yumi_joint_1_r", "yumi_joint_2_r", "yumi_joint_7_r", "yumi_joint_3_r",
-                                  "yumi_joint_4_r", "yumi_joint_5_r", "yumi_joint_6_r", "yumi_joint_1_l",
-                                  "yumi_joint_2_l", "yumi_joint_7_l", "yumi_joint_3_l", "yumi_joint_4_l",
+const char* const kArmJoints[] = {"yumi_joint_1_r", "yumi_joint_2_r", "yumi_joint_7_r",
+                                  "yumi_joint_3_r", "yumi_joint_4_r", "yumi_joint_5_r",
+                                  "yumi_joint_6_r", "yumi_joint_1_l", "yumi_joint_2_l",
+                                  "yumi_joint_7_l", "yumi_joint_3_l", "yumi_joint_4_l",
                                   "yumi_joint_5_l", "yumi_joint_6_l"};
 
 RobotModel yumi_arms() {
@@ -39,7 +40,8 @@ Eigen::VectorXd test_joints() {
 
 KDL::Frame to_kdl(const Eigen::Isometry3d& T) {
   const Mat3 R = T.linear();
-  return KDL::Frame(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)),
+  return KDL::Frame(KDL::Rotation(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0),
+                                  R(2, 1), R(2, 2)),
                     KDL::Vector(T.translation().x(), T.translation().y(), T.translation().z()));
 }
 
@@ -48,7 +50,10 @@ KDL::Frame to_kdl(const Eigen::Isometry3d& T) {
 KDL::Chain kdl_chain(const RobotModel& model, const std::string& tip) {
   std::vector<int> joints;
   for (int j = model.links()[static_cast<std::size_t>(model.link_index(tip))].parent_joint; j >= 0;
-       j = model.links()[static_cast<std::size_t>(model.joints()[static_cast<std::size_t>(j)].parent_link)].parent_joint)
+       j = model
+               .links()[static_cast<std::size_t>(
+                   model.joints()[static_cast<std::size_t>(j)].parent_link)]
+               .parent_joint)
     joints.insert(joints.begin(), j);
   KDL::Chain chain;
   for (const int j : joints) {
@@ -56,16 +61,21 @@ KDL::Chain kdl_chain(const RobotModel& model, const std::string& tip) {
     const KDL::Frame origin = to_kdl(joint.T_parent_child);
     const Vec3 axis = joint.T_parent_child.linear() * joint.axis;
     const KDL::Joint kdl_joint =
-        joint.movable() ? KDL::Joint(joint.name, origin.p, KDL::Vector(axis.x(), axis.y(), axis.z()), KDL::Joint::RotAxis)
+        joint.movable() ? KDL::Joint(joint.name, origin.p,
+                                     KDL::Vector(axis.x(), axis.y(), axis.z()), KDL::Joint::RotAxis)
                         : KDL::Joint(joint.name, KDL::Joint::None);
-    chain.addSegment(KDL::Segment(model.links()[static_cast<std::size_t>(joint.child_link)].name, kdl_joint, origin));
+    chain.addSegment(KDL::Segment(model.links()[static_cast<std::size_t>(joint.child_link)].name,
+                                  kdl_joint, origin));
   }
   return chain;
 }
 
 struct KdlArm {
   explicit KdlArm(KDL::Chain c)
-      : chain(std::move(c)), fk(chain), jac(chain), q(chain.getNrOfJoints()),
+      : chain(std::move(c)),
+        fk(chain),
+        jac(chain),
+        q(chain.getNrOfJoints()),
         jacobian(chain.getNrOfJoints()) {}
   KDL::Chain chain;
   KDL::ChainFkSolverPos_recursive fk;
@@ -94,7 +104,9 @@ void check_agreement(const RobotModel& model, KdlArm& right, KdlArm& left) {
     double error = (p - Vec3(arms[a]->tip.p.x(), arms[a]->tip.p.y(), arms[a]->tip.p.z())).norm();
     for (int i = 0; i < 7; ++i)
       for (int r = 0; r < 3; ++r)
-        error = std::max(error, std::abs(J(r, 7 * a + i) - arms[a]->jacobian(static_cast<unsigned>(r), static_cast<unsigned>(i))));
+        error = std::max(error,
+                         std::abs(J(r, 7 * a + i) - arms[a]->jacobian(static_cast<unsigned>(r),
+                                                                      static_cast<unsigned>(i))));
     if (error > 1e-12) {
       std::cerr << "KDL and shapectl disagree on " << tips[a] << " by " << error << "\n";
       std::abort();
@@ -112,9 +124,11 @@ void BM_YumiForwardKinematicsAndToolJacobians(benchmark::State& bench) {
   for (auto _ : bench) {
     q[0] += 1e-9;  // a new configuration each time
     forward_kinematics(model, q, state);
-    point_jacobian_world(model, state, right, state.T_world_link[static_cast<std::size_t>(right)].translation(),
+    point_jacobian_world(model, state, right,
+                         state.T_world_link[static_cast<std::size_t>(right)].translation(),
                          jacobian_right);
-    point_jacobian_world(model, state, left, state.T_world_link[static_cast<std::size_t>(left)].translation(),
+    point_jacobian_world(model, state, left,
+                         state.T_world_link[static_cast<std::size_t>(left)].translation(),
                          jacobian_left);
     benchmark::DoNotOptimize(jacobian_right.data());
     benchmark::DoNotOptimize(jacobian_left.data());
@@ -141,7 +155,8 @@ BENCHMARK(BM_KdlForwardKinematicsAndToolJacobians);
 // Every checked sphere pair's barrier with its gradient over the 14 arm joints.
 void collision_barrier(benchmark::State& bench, const Eigen::VectorXd& q) {
   const RobotModel model = yumi_arms();
-  const CollisionModel spheres = CollisionModel::load_json_file(model, kYumiDir + "yumi_spheres.json");
+  const CollisionModel spheres =
+      CollisionModel::load_json_file(model, kYumiDir + "yumi_spheres.json");
   const KinematicsState state = forward_kinematics(model, q);
   Eigen::VectorXd gradient(14);
   for (auto _ : bench) {
@@ -155,12 +170,15 @@ void collision_barrier(benchmark::State& bench, const Eigen::VectorXd& q) {
 void BM_YumiCollisionBarrierAtHome(benchmark::State& bench) {
   Eigen::VectorXd q(14);
   const double d = M_PI / 180;
-  q << 0, -25 * d, -50 * d, 45 * d, 70 * d, -25 * d, 0, 0, -25 * d, 50 * d, 45 * d, -70 * d, -25 * d, 0;
+  q << 0, -25 * d, -50 * d, 45 * d, 70 * d, -25 * d, 0, 0, -25 * d, 50 * d, 45 * d, -70 * d,
+      -25 * d, 0;
   collision_barrier(bench, q);
 }
 BENCHMARK(BM_YumiCollisionBarrierAtHome);
 
-void BM_YumiCollisionBarrierColliding(benchmark::State& bench) { collision_barrier(bench, test_joints()); }
+void BM_YumiCollisionBarrierColliding(benchmark::State& bench) {
+  collision_barrier(bench, test_joints());
+}
 BENCHMARK(BM_YumiCollisionBarrierColliding);
 
 }  // namespace

@@ -82,7 +82,8 @@ void BM_StaticsWarmResolve(benchmark::State& state) {
   for (auto _ : state) {
     for (int i : clamp) x[3 * i] += direction * 1e-3;
     direction = -direction;
-    const StaticsResult r = statics.solve(ws, x, nullptr, 0, &ws);  // chord steps with the last factor
+    const StaticsResult r =
+        statics.solve(ws, x, nullptr, 0, &ws);  // chord steps with the last factor
     if (!r.converged()) state.SkipWithError(r.reason.c_str());
     iterations = r.iterations;
   }
@@ -90,8 +91,12 @@ void BM_StaticsWarmResolve(benchmark::State& state) {
 }
 BENCHMARK(BM_StaticsWarmResolve)->Unit(benchmark::kMillisecond);
 
-void BM_StaticsFullSolve10k(benchmark::State& state) { full_solve(state, {40, 8, 5}, std::nullopt); }
-void BM_StaticsFullSolve50k(benchmark::State& state) { full_solve(state, {64, 12, 11}, std::nullopt); }
+void BM_StaticsFullSolve10k(benchmark::State& state) {
+  full_solve(state, {40, 8, 5}, std::nullopt);
+}
+void BM_StaticsFullSolve50k(benchmark::State& state) {
+  full_solve(state, {64, 12, 11}, std::nullopt);
+}
 BENCHMARK(BM_StaticsFullSolve10k)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_StaticsFullSolve50k)->Unit(benchmark::kMillisecond)->Iterations(1);
 
@@ -108,9 +113,27 @@ void BM_BackendBand(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   full_solve(state, {4 * n, n, n}, SparseCholesky::Backend::Band);
 }
-BENCHMARK(BM_BackendLDLT)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(2);
-BENCHMARK(BM_BackendBand)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(2);
-BENCHMARK(BM_BackendCholmod)->Arg(4)->Arg(6)->Arg(8)->Arg(10)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK(BM_BackendLDLT)
+    ->Arg(4)
+    ->Arg(6)
+    ->Arg(8)
+    ->Arg(10)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
+BENCHMARK(BM_BackendBand)
+    ->Arg(4)
+    ->Arg(6)
+    ->Arg(8)
+    ->Arg(10)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
+BENCHMARK(BM_BackendCholmod)
+    ->Arg(4)
+    ->Arg(6)
+    ->Arg(8)
+    ->Arg(10)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(2);
 
 // One numeric factorization of the default bar's Hessian at its equilibrium, and one solve
 // with 14 right-hand sides (a sensitivity dx̂/dθ for a two-arm robot), each backend.
@@ -129,12 +152,17 @@ void factorize(benchmark::State& state, SparseCholesky::Backend backend, int rhs
     else benchmark::DoNotOptimize(cholesky.solve(rhs));
   }
 }
-BENCHMARK_CAPTURE(factorize, ldlt, SparseCholesky::Backend::SimplicialLDLT, 0)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, ldlt, SparseCholesky::Backend::SimplicialLDLT, 0)
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(factorize, band, SparseCholesky::Backend::Band, 0)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(factorize, cholmod, SparseCholesky::Backend::CholmodSupernodal, 0)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(factorize, solve14_ldlt, SparseCholesky::Backend::SimplicialLDLT, 14)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(factorize, solve14_band, SparseCholesky::Backend::Band, 14)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(factorize, solve14_cholmod, SparseCholesky::Backend::CholmodSupernodal, 14)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, cholmod, SparseCholesky::Backend::CholmodSupernodal, 0)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, solve14_ldlt, SparseCholesky::Backend::SimplicialLDLT, 14)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, solve14_band, SparseCholesky::Backend::Band, 14)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(factorize, solve14_cholmod, SparseCholesky::Backend::CholmodSupernodal, 14)
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace shapectl

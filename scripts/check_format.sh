@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Lists the C++ files (src apps bench tests, *.hpp *.cpp) that clang-format would change under
+# Lists the C++ files (src apps bench tests python/src, *.hpp *.cpp) that clang-format would change under
 # the repository's .clang-format; exits 1 if there are any, 0 if none. Changes nothing.
 # Fix one file: clang-format -i FILE. Written for Debian 12's clang-format 14; other versions
 # may format some constructs differently.
@@ -16,7 +16,7 @@ fi
 unformatted=()
 while IFS= read -r -d '' file; do
   if ! clang-format --style=file "$file" | cmp -s - "$file"; then unformatted+=("$file"); fi
-done < <(find src apps bench tests -type f \( -name '*.hpp' -o -name '*.cpp' \) -print0 | sort -z)
+done < <(find src apps bench tests python/src -type f \( -name '*.hpp' -o -name '*.cpp' \) -print0 | sort -z)
 if [ ${#unformatted[@]} -gt 0 ]; then
   echo "check_format: ${#unformatted[@]} file(s) not formatted (fix: clang-format -i FILE):" >&2
   printf '%s\n' "${unformatted[@]}"

@@ -15,6 +15,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev chromium
   libprotobuf-dev protobuf-compiler
+  clang-format
   pybind11-dev python3-dev python3-numpy python3-pytest
 )
 

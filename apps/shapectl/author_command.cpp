@@ -1,7 +1,7 @@
-// shapectl author ROBOT.urdf (--mesh MESH | --box LX,LY,LZ) --end-effectors NAME=LINK,... --out SCENE.json
-// Proposes a scene from a robot and an object: collision spheres from the URDF's collision
-// geometry, grip regions at the nodes nearest the tools, the object pose, and reference joints
-// by inverse kinematics that put the tools at the grip regions. Writes the scene, its sphere
+// shapectl author ROBOT.urdf (--mesh MESH | --box LX,LY,LZ) --end-effectors NAME=LINK,... --out
+// SCENE.json Proposes a scene from a robot and an object: collision spheres from the URDF's
+// collision geometry, grip regions at the nodes nearest the tools, the object pose, and reference
+// joints by inverse kinematics that put the tools at the grip regions. Writes the scene, its sphere
 // file and a report; refuses (exit 1) what it cannot make plausible.
 #include <unistd.h>
 
@@ -61,14 +61,15 @@ struct AuthorOptions {
   std::string report;
 };
 
-constexpr double joint_limit_margin = 0.05;     // rad, as written into the scene
-constexpr double tool_tolerance = 1e-3;         // m, tool ↔ grip region centre after IK
-constexpr int collision_samples = 200;          // random poses to find always-colliding pairs
+constexpr double joint_limit_margin = 0.05;  // rad, as written into the scene
+constexpr double tool_tolerance = 1e-3;      // m, tool ↔ grip region centre after IK
+constexpr int collision_samples = 200;       // random poses to find always-colliding pairs
 constexpr double always_fraction = 0.95;
 constexpr std::size_t max_generated_spheres = 1000;  // IK's dense pair Jacobian stays small
 
 // "a,b,c" as `count` (or one of `counts`) finite numbers; `option` names the option in errors.
-std::vector<double> numbers(const std::string& text, const std::string& option, const std::string& expected,
+std::vector<double> numbers(const std::string& text, const std::string& option,
+                            const std::string& expected,
                             std::initializer_list<std::size_t> counts) {
   std::vector<double> values;
   std::size_t begin = 0;
@@ -90,7 +91,8 @@ std::vector<double> numbers(const std::string& text, const std::string& option, 
 std::pair<std::string, std::string> named(const std::string& text, const std::string& option,
                                           const std::string& expected) {
   const auto eq = text.find('=');
-  if (eq == std::string::npos || eq == 0) throw InputError("command line", option, expected, bounded_preview(text));
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("command line", option, expected, bounded_preview(text));
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
 
@@ -108,12 +110,14 @@ std::vector<EndEffector> read_end_effectors(const AuthorOptions& o, const RobotM
                        bounded_preview(item));
     for (const auto& other : ees)
       if (other.name == ee.name)
-        throw InputError("command line", "--end-effectors", "distinct names", bounded_preview(ee.name));
+        throw InputError("command line", "--end-effectors", "distinct names",
+                         bounded_preview(ee.name));
     ee.link = *index;
     ees.push_back(ee);
   }
   if (ees.empty() || ees.size() > 16)
-    throw InputError("command line", "--end-effectors", "1 to 16 end effectors", bounded_preview(o.end_effectors));
+    throw InputError("command line", "--end-effectors", "1 to 16 end effectors",
+                     bounded_preview(o.end_effectors));
   for (const auto& text : o.tool_offsets) {
     const auto [name, value] = named(text, "--tool-offset", "NAME=X,Y,Z (metres, link frame)");
     const auto xyz = numbers(value, "--tool-offset", "NAME=X,Y,Z (metres, link frame)", {3});
@@ -123,7 +127,9 @@ std::vector<EndEffector> read_end_effectors(const AuthorOptions& o, const RobotM
         ee.tcp_link = Vec3(xyz[0], xyz[1], xyz[2]);
         found = true;
       }
-    if (!found) throw InputError("command line", "--tool-offset", "the name of one of --end-effectors", bounded_preview(name));
+    if (!found)
+      throw InputError("command line", "--tool-offset", "the name of one of --end-effectors",
+                       bounded_preview(name));
   }
   return ees;
 }
@@ -135,22 +141,26 @@ struct ObjectMesh {
 
 ObjectMesh read_object_mesh(const AuthorOptions& o, const fs::path& scene_dir) {
   if (o.mesh.empty() == o.box.empty())
-    throw InputError("command line", "--mesh", "either --mesh FILE or --box LX,LY,LZ", o.mesh.empty() ? "neither" : "both");
+    throw InputError("command line", "--mesh", "either --mesh FILE or --box LX,LY,LZ",
+                     o.mesh.empty() ? "neither" : "both");
   if (!o.box.empty()) {
     const auto s = numbers(o.box, "--box", "LX,LY,LZ: three edge lengths in metres", {3});
     const Vec3 size(s[0], s[1], s[2]);
     if (!(size.minCoeff() >= 1e-4 && size.maxCoeff() <= 100))
-      throw InputError("command line", "--box", "edge lengths from 1e-4 to 100 m", bounded_preview(o.box));
+      throw InputError("command line", "--box", "edge lengths from 1e-4 to 100 m",
+                       bounded_preview(o.box));
     std::array<int, 3> cells{};
     if (o.cells.empty()) {
       // About four cells across the thinnest edge, at most 40 along any edge.
       for (int a = 0; a < 3; ++a)
-        cells[a] = static_cast<int>(std::clamp(std::round(4 * size[a] / size.minCoeff()), 1.0, 40.0));
+        cells[a] =
+            static_cast<int>(std::clamp(std::round(4 * size[a] / size.minCoeff()), 1.0, 40.0));
     } else {
       const auto c = numbers(o.cells, "--cells", "NX,NY,NZ: cell counts from 1 to 200", {3});
       for (int a = 0; a < 3; ++a) {
         if (!(c[a] >= 1 && c[a] <= 200 && c[a] == std::floor(c[a])))
-          throw InputError("command line", "--cells", "NX,NY,NZ: cell counts from 1 to 200", bounded_preview(o.cells));
+          throw InputError("command line", "--cells", "NX,NY,NZ: cell counts from 1 to 200",
+                           bounded_preview(o.cells));
         cells[a] = static_cast<int>(c[a]);
       }
     }
@@ -183,7 +193,8 @@ std::vector<CollisionSphere> cover_meshes(const AuthorOptions& o, const RobotMod
     const std::string& link = model.links()[static_cast<std::size_t>(m.link)].name;
     const auto file = resolve_mesh_file(m.filename, fs::path(o.urdf).parent_path(), package_paths);
     if (!file || !is_surface_file(*file)) {
-      warnings.push_back(o.urdf + ": link '" + link + "': collision mesh '" + bounded_preview(m.filename) +
+      warnings.push_back(o.urdf + ": link '" + link + "': collision mesh '" +
+                         bounded_preview(m.filename) +
                          (file ? "' is not OBJ, STL or OFF" : "' not found (give --package-path)") +
                          ": skipped, the link has no spheres for it");
       continue;
@@ -196,20 +207,23 @@ std::vector<CollisionSphere> cover_meshes(const AuthorOptions& o, const RobotMod
 }
 
 // Link pairs whose spheres overlap: from the centres at one pose.
-std::set<std::pair<int, int>> overlapping_links(const CollisionModel& collision, const KinematicsState& state) {
+std::set<std::pair<int, int>> overlapping_links(const CollisionModel& collision,
+                                                const KinematicsState& state) {
   std::vector<Vec3> centers;
   collision.sphere_centers(state, centers);
   std::set<std::pair<int, int>> links;
   for (const auto& [a, b] : collision.pairs()) {
     const auto& sa = collision.spheres()[static_cast<std::size_t>(a)];
     const auto& sb = collision.spheres()[static_cast<std::size_t>(b)];
-    if ((centers[static_cast<std::size_t>(a)] - centers[static_cast<std::size_t>(b)]).norm() < sa.radius + sb.radius)
+    if ((centers[static_cast<std::size_t>(a)] - centers[static_cast<std::size_t>(b)]).norm() <
+        sa.radius + sb.radius)
       links.insert(std::minmax(sa.link, sb.link));
   }
   return links;
 }
 
-Spheres generate_spheres(const AuthorOptions& o, const RobotModel& model, std::vector<std::string>& warnings) {
+Spheres generate_spheres(const AuthorOptions& o, const RobotModel& model,
+                         std::vector<std::string>& warnings) {
   Spheres s;
   for (int l = 0; l < model.link_count(); ++l)
     for (const auto& shape : model.links()[static_cast<std::size_t>(l)].collision_shapes)
@@ -218,8 +232,10 @@ Spheres generate_spheres(const AuthorOptions& o, const RobotModel& model, std::v
   s.spheres.insert(s.spheres.end(), meshes.begin(), meshes.end());
   if (s.spheres.size() > max_generated_spheres)
     throw InputError(o.urdf, "collision geometry",
-                     std::to_string(s.spheres.size()) + " spheres generated, more than the limit of " +
-                         std::to_string(max_generated_spheres) + "; simplify the collision geometry");
+                     std::to_string(s.spheres.size()) +
+                         " spheres generated, more than the limit of " +
+                         std::to_string(max_generated_spheres) +
+                         "; simplify the collision geometry");
   std::set<int> with_spheres;
   for (const auto& sphere : s.spheres) with_spheres.insert(sphere.link);
   for (const auto& joint : model.joints())
@@ -253,12 +269,14 @@ Eigen::Isometry3d pose_from(const std::vector<double>& v) {
 // Default placement: the object's longest bounding-box axis along the line between the first
 // two tools, its box centre midway between them, pulled a fifth of the way towards the robot's
 // root in the horizontal plane: tools at full stretch (a zero pose often is) cannot reach further.
-Eigen::Isometry3d default_object_pose(const TetMesh& mesh, const Vec3& first_tool, const Vec3& second_tool) {
+Eigen::Isometry3d default_object_pose(const TetMesh& mesh, const Vec3& first_tool,
+                                      const Vec3& second_tool) {
   const Vec3 lo = mesh.bounds_min(), hi = mesh.bounds_max();
   int axis = 0;
   (hi - lo).maxCoeff(&axis);
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  T.linear() = Eigen::Quaterniond::FromTwoVectors(Vec3::Unit(axis), first_tool - second_tool).toRotationMatrix();
+  T.linear() = Eigen::Quaterniond::FromTwoVectors(Vec3::Unit(axis), first_tool - second_tool)
+                   .toRotationMatrix();
   Vec3 centre = 0.5 * (first_tool + second_tool);
   centre.head<2>() *= 0.8;
   T.translation() = centre - T.linear() * (0.5 * (lo + hi));
@@ -272,14 +290,18 @@ struct ProposedGrip {
 };
 
 std::vector<ProposedGrip> propose_grips(const AuthorOptions& o, const std::vector<EndEffector>& ees,
-                                        const TetMesh& mesh, const Eigen::Isometry3d& T_world_object,
+                                        const TetMesh& mesh,
+                                        const Eigen::Isometry3d& T_world_object,
                                         const std::vector<Vec3>& tools) {
   std::map<std::string, std::string> given;
   for (const auto& text : o.grip_regions) {
-    const auto [name, value] = named(text, "--grip-region", "NAME=X0,Y0,Z0,X1,Y1,Z1 (box) or NAME=X,Y,Z,R (sphere)");
+    const auto [name, value] =
+        named(text, "--grip-region", "NAME=X0,Y0,Z0,X1,Y1,Z1 (box) or NAME=X,Y,Z,R (sphere)");
     bool known = false;
     for (const auto& ee : ees) known = known || ee.name == name;
-    if (!known) throw InputError("command line", "--grip-region", "the name of one of --end-effectors", bounded_preview(name));
+    if (!known)
+      throw InputError("command line", "--grip-region", "the name of one of --end-effectors",
+                       bounded_preview(name));
     given[name] = value;
   }
   const auto& X = mesh.rest_positions();
@@ -289,8 +311,10 @@ std::vector<ProposedGrip> propose_grips(const AuthorOptions& o, const std::vecto
     ProposedGrip g;
     const std::string where = given.count(ees[e].name) ? "--grip-region" : "--grip-radius";
     if (given.count(ees[e].name)) {
-      const auto v = numbers(given[ees[e].name], "--grip-region",
-                             "NAME=X0,Y0,Z0,X1,Y1,Z1 (box) or NAME=X,Y,Z,R (sphere), object coordinates", {4, 6});
+      const auto v =
+          numbers(given[ees[e].name], "--grip-region",
+                  "NAME=X0,Y0,Z0,X1,Y1,Z1 (box) or NAME=X,Y,Z,R (sphere), object coordinates",
+                  {4, 6});
       for (std::size_t i = 0; i < X.size(); ++i) {
         const Vec3& p = X[i];
         const bool inside = v.size() == 4 ? (p - Vec3(v[0], v[1], v[2])).norm() <= v[3]
@@ -303,17 +327,22 @@ std::vector<ProposedGrip> propose_grips(const AuthorOptions& o, const std::vecto
       const Vec3 tool_object = T_world_object.inverse() * tools[e];
       std::size_t nearest = 0;
       for (std::size_t i = 1; i < X.size(); ++i)
-        if ((X[i] - tool_object).squaredNorm() < (X[nearest] - tool_object).squaredNorm()) nearest = i;
+        if ((X[i] - tool_object).squaredNorm() < (X[nearest] - tool_object).squaredNorm())
+          nearest = i;
       g.nearest_distance = (X[nearest] - tool_object).norm();
       // Default radius: reach through the thinnest extent, so a grip holds the whole section.
-      const double radius = o.grip_radius > 0 ? o.grip_radius
-                                              : std::clamp(1.1 * (mesh.bounds_max() - mesh.bounds_min()).minCoeff(), 0.02, 0.05);
+      const double radius =
+          o.grip_radius > 0
+              ? o.grip_radius
+              : std::clamp(1.1 * (mesh.bounds_max() - mesh.bounds_min()).minCoeff(), 0.02, 0.05);
       for (std::size_t i = 0; i < X.size(); ++i)
-        if ((X[i] - X[nearest]).norm() <= radius && !taken[i]) g.nodes.push_back(static_cast<int>(i));
+        if ((X[i] - X[nearest]).norm() <= radius && !taken[i])
+          g.nodes.push_back(static_cast<int>(i));
     }
     if (g.nodes.empty())
       throw InputError("command line", where,
-                       "a grip region for end effector '" + ees[e].name + "' that catches at least one node not gripped by another end effector",
+                       "a grip region for end effector '" + ees[e].name +
+                           "' that catches at least one node not gripped by another end effector",
                        "none");
     Vec3 sum = Vec3::Zero();
     for (int i : g.nodes) {
@@ -326,7 +355,8 @@ std::vector<ProposedGrip> propose_grips(const AuthorOptions& o, const std::vecto
   return grips;
 }
 
-Json spheres_json(const RobotModel& model, const Spheres& s, double margin, const std::string& urdf) {
+Json spheres_json(const RobotModel& model, const Spheres& s, double margin,
+                  const std::string& urdf) {
   Json by_link = Json::object();
   for (const auto& sphere : s.spheres)
     by_link[model.links()[static_cast<std::size_t>(sphere.link)].name].push_back(
@@ -336,10 +366,12 @@ Json spheres_json(const RobotModel& model, const Spheres& s, double margin, cons
   for (const auto* list : {&s.adjacent, &s.always})
     for (const auto& [a, b] : *list)
       if (seen.insert({a, b}).second)
-        ignore.push_back({model.links()[static_cast<std::size_t>(a)].name, model.links()[static_cast<std::size_t>(b)].name});
-  return {{"description", "generated by shapectl author from " + fs::path(urdf).filename().string() +
-                              ": covers of the collision geometry; ignore_pairs are adjacent links and links "
-                              "overlapping in nearly every pose"},
+        ignore.push_back({model.links()[static_cast<std::size_t>(a)].name,
+                          model.links()[static_cast<std::size_t>(b)].name});
+  return {{"description",
+           "generated by shapectl author from " + fs::path(urdf).filename().string() +
+               ": covers of the collision geometry; ignore_pairs are adjacent links and links "
+               "overlapping in nearly every pose"},
           {"margin", margin},
           {"stiffness", CollisionModel::default_stiffness},
           {"spheres", by_link},
@@ -355,18 +387,22 @@ fs::path relative_to(const fs::path& file, const fs::path& dir) {
 void run(const AuthorOptions& o) {
   const fs::path out = o.out;
   const fs::path scene_dir = out.has_parent_path() ? out.parent_path() : fs::path(".");
-  const fs::path spheres_out =
-      o.spheres_out.empty() ? scene_dir / (out.stem().string() + "_spheres.json") : fs::path(o.spheres_out);
+  const fs::path spheres_out = o.spheres_out.empty()
+                                   ? scene_dir / (out.stem().string() + "_spheres.json")
+                                   : fs::path(o.spheres_out);
   if (!(o.youngs_modulus >= 1 && o.youngs_modulus <= 1e13))
-    throw InputError("command line", "--youngs-modulus", "a number from 1 to 1e13 Pa", o.youngs_modulus);
+    throw InputError("command line", "--youngs-modulus", "a number from 1 to 1e13 Pa",
+                     o.youngs_modulus);
   if (!(o.poisson_ratio > 0 && o.poisson_ratio < 0.5))
-    throw InputError("command line", "--poisson-ratio", "a number between 0 and 0.5 (exclusive)", o.poisson_ratio);
+    throw InputError("command line", "--poisson-ratio", "a number between 0 and 0.5 (exclusive)",
+                     o.poisson_ratio);
   if (!(o.density >= 1e-3 && o.density <= 1e5))
     throw InputError("command line", "--density", "a number from 1e-3 to 1e5 kg/m^3", o.density);
   if (!(o.grip_radius >= 0 && o.grip_radius <= 10))
     throw InputError("command line", "--grip-radius", "a distance from 0 to 10 m", o.grip_radius);
   if (!(o.sphere_margin >= 0 && o.sphere_margin <= 0.1))
-    throw InputError("command line", "--sphere-margin", "a distance from 0 to 0.1 m", o.sphere_margin);
+    throw InputError("command line", "--sphere-margin", "a distance from 0 to 0.1 m",
+                     o.sphere_margin);
 
   RobotModel model = RobotModel::load_urdf_file(o.urdf);
   // The loader's note that it skips meshes does not apply here: meshes are covered below.
@@ -379,23 +415,28 @@ void run(const AuthorOptions& o) {
   for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
   std::vector<std::pair<int, int>> ignore = spheres.adjacent;
   ignore.insert(ignore.end(), spheres.always.begin(), spheres.always.end());
-  const CollisionModel collision(model, spheres.spheres, o.sphere_margin, CollisionModel::default_stiffness, ignore);
+  const CollisionModel collision(model, spheres.spheres, o.sphere_margin,
+                                 CollisionModel::default_stiffness, ignore);
 
   // Start: every joint at 0, moved inside its limits.
-  const Eigen::VectorXd start = Eigen::VectorXd::Zero(model.active_count())
-                                    .cwiseMax((model.lower_limits().array() + joint_limit_margin).matrix())
-                                    .cwiseMin((model.upper_limits().array() - joint_limit_margin).matrix());
+  const Eigen::VectorXd start =
+      Eigen::VectorXd::Zero(model.active_count())
+          .cwiseMax((model.lower_limits().array() + joint_limit_margin).matrix())
+          .cwiseMin((model.upper_limits().array() - joint_limit_margin).matrix());
   const KinematicsState start_state = forward_kinematics(model, start);
   std::vector<Vec3> tools;
-  for (const auto& ee : ees) tools.push_back(start_state.T_world_link[static_cast<std::size_t>(ee.link)] * ee.tcp_link);
+  for (const auto& ee : ees)
+    tools.push_back(start_state.T_world_link[static_cast<std::size_t>(ee.link)] * ee.tcp_link);
 
   Eigen::Isometry3d T_world_object;
   if (!o.object_pose.empty()) {
-    T_world_object = pose_from(numbers(o.object_pose, "--object-pose", "X,Y,Z or X,Y,Z,ROLL,PITCH,YAW (m, rad)", {3, 6}));
+    T_world_object = pose_from(
+        numbers(o.object_pose, "--object-pose", "X,Y,Z or X,Y,Z,ROLL,PITCH,YAW (m, rad)", {3, 6}));
   } else {
     if (ees.size() < 2 || (tools[0] - tools[1]).norm() < 1e-3)
-      throw InputError("command line", "--object-pose",
-                       "an object pose (it is proposed only between two end effectors that are apart)", "none");
+      throw InputError(
+          "command line", "--object-pose",
+          "an object pose (it is proposed only between two end effectors that are apart)", "none");
     T_world_object = default_object_pose(*object.mesh, tools[0], tools[1]);
   }
   const auto grips = propose_grips(o, ees, *object.mesh, T_world_object, tools);
@@ -408,22 +449,28 @@ void run(const AuthorOptions& o) {
     goal.position_world = grips[e].centre_world;
     goals.push_back(goal);
   }
-  IkOptions ik_options{.collisions = &collision, .joint_limit_margin = joint_limit_margin,
-                       .position_tolerance = 1e-4, .seed = o.seed};
+  IkOptions ik_options{.collisions = &collision,
+                       .joint_limit_margin = joint_limit_margin,
+                       .position_tolerance = 1e-4,
+                       .seed = o.seed};
   const IkResult ik = solve_inverse_kinematics(model, goals, start, ik_options);
   if (ik.status != IkStatus::Converged)
-    throw InputError("command line", o.object_pose.empty() ? "--end-effectors" : "--object-pose",
-                     "grip regions the tools can reach without self-collision (inverse kinematics: " + ik.reason +
-                         "); place the object elsewhere or choose other grips");
+    throw InputError(
+        "command line", o.object_pose.empty() ? "--end-effectors" : "--object-pose",
+        "grip regions the tools can reach without self-collision (inverse kinematics: " +
+            ik.reason + "); place the object elsewhere or choose other grips");
   const KinematicsState reference = forward_kinematics(model, ik.joints);
   const auto violations = limit_violations(model, reference.joints);
   const double clearance = collision.min_clearance(reference);
   Json grip_report = Json::array();
   for (std::size_t e = 0; e < ees.size(); ++e) {
-    const double distance = (reference.T_world_link[static_cast<std::size_t>(ees[e].link)] * ees[e].tcp_link -
-                             grips[e].centre_world).norm();
+    const double distance =
+        (reference.T_world_link[static_cast<std::size_t>(ees[e].link)] * ees[e].tcp_link -
+         grips[e].centre_world)
+            .norm();
     if (!(distance <= tool_tolerance))
-      throw SolverFailure("tool '" + ees[e].name + "' ends " + std::to_string(distance) + " m from its grip region");
+      throw SolverFailure("tool '" + ees[e].name + "' ends " + std::to_string(distance) +
+                          " m from its grip region");
     grip_report.push_back({{"end_effector", ees[e].name},
                            {"link", model.links()[static_cast<std::size_t>(ees[e].link)].name},
                            {"node_count", grips[e].nodes.size()},
@@ -435,37 +482,45 @@ void run(const AuthorOptions& o) {
 
   Json reference_joints = Json::object();
   const auto names = model.active_joint_names();
-  for (std::size_t i = 0; i < names.size(); ++i) reference_joints[names[i]] = ik.joints[static_cast<Eigen::Index>(i)];
+  for (std::size_t i = 0; i < names.size(); ++i)
+    reference_joints[names[i]] = ik.joints[static_cast<Eigen::Index>(i)];
   Json end_effectors = Json::array();
   for (const auto& ee : ees)
-    end_effectors.push_back({{"name", ee.name}, {"link", model.links()[static_cast<std::size_t>(ee.link)].name},
+    end_effectors.push_back({{"name", ee.name},
+                             {"link", model.links()[static_cast<std::size_t>(ee.link)].name},
                              {"tcp", vec3_json(ee.tcp_link)}});
   Json grip_list = Json::array();
-  for (std::size_t e = 0; e < ees.size(); ++e) grip_list.push_back({{"end_effector", ees[e].name}, {"nodes", grips[e].nodes}});
+  for (std::size_t e = 0; e < ees.size(); ++e)
+    grip_list.push_back({{"end_effector", ees[e].name}, {"nodes", grips[e].nodes}});
   const auto scene_text = [&](const fs::path& spheres_file) {
-    const Json scene = {
-        {"object",
-         {{"mesh", object.json},
-          {"material", {{"youngs_modulus", o.youngs_modulus}, {"poisson_ratio", o.poisson_ratio}, {"density", o.density}}},
-          {"pose", scene_pose_json(T_world_object)}}},
-        {"gravity", {0, 0, -9.81}},
-        {"robot",
-         {{"urdf", relative_to(o.urdf, scene_dir).generic_string()},
-          {"collision_spheres", relative_to(spheres_file, scene_dir).generic_string()},
-          {"reference_joints", reference_joints},
-          {"end_effectors", end_effectors},
-          {"joint_limit_margin", joint_limit_margin}}},
-        {"grips", grip_list},
-        {"grip_stiffness", 1e4}};
+    const Json scene = {{"object",
+                         {{"mesh", object.json},
+                          {"material",
+                           {{"youngs_modulus", o.youngs_modulus},
+                            {"poisson_ratio", o.poisson_ratio},
+                            {"density", o.density}}},
+                          {"pose", scene_pose_json(T_world_object)}}},
+                        {"gravity", {0, 0, -9.81}},
+                        {"robot",
+                         {{"urdf", relative_to(o.urdf, scene_dir).generic_string()},
+                          {"collision_spheres",
+                           relative_to(spheres_file, scene_dir).generic_string()},
+                          {"reference_joints", reference_joints},
+                          {"end_effectors", end_effectors},
+                          {"joint_limit_margin", joint_limit_margin}}},
+                        {"grips", grip_list},
+                        {"grip_stiffness", 1e4}};
     return to_pretty_json(scene);  // names that are not valid UTF-8 written with U+FFFD
   };
-  const std::string spheres_text = to_pretty_json(spheres_json(model, spheres, o.sphere_margin, o.urdf));
+  const std::string spheres_text =
+      to_pretty_json(spheres_json(model, spheres, o.sphere_margin, o.urdf));
 
   // The scene is loaded (and so checked) as it will be written before anything is replaced: a
   // scene every command would refuse never overwrites a good one. It and its spheres go to
   // temporary names beside the results first.
   const std::string check_prefix = ".author-check-" + std::to_string(::getpid()) + "-";
-  const fs::path check_spheres = spheres_out.parent_path() / (check_prefix + spheres_out.filename().string());
+  const fs::path check_spheres =
+      spheres_out.parent_path() / (check_prefix + spheres_out.filename().string());
   const fs::path check_scene = out.parent_path() / (check_prefix + out.filename().string());
   const Scene loaded = [&] {
     struct Remove {
@@ -475,7 +530,8 @@ void run(const AuthorOptions& o) {
         for (const auto& f : files) fs::remove(f, ignored);
       }
     } remove{{check_spheres, check_scene}};
-    write_files_atomically({{check_spheres, spheres_text}, {check_scene, scene_text(check_spheres)}});
+    write_files_atomically(
+        {{check_spheres, spheres_text}, {check_scene, scene_text(check_spheres)}});
     try {
       return load_scene(check_scene);
     } catch (const InputError& e) {
@@ -489,31 +545,42 @@ void run(const AuthorOptions& o) {
   }
 
   std::map<std::string, int> per_link;
-  for (const auto& s : spheres.spheres) ++per_link[model.links()[static_cast<std::size_t>(s.link)].name];
+  for (const auto& s : spheres.spheres)
+    ++per_link[model.links()[static_cast<std::size_t>(s.link)].name];
   Json report = {{"scene", out.string()},
                  {"spheres_file", spheres_out.string()},
                  {"grips", grip_report},
                  {"inverse_kinematics",
-                  {{"status", to_string(ik.status)}, {"reason", ik.reason}, {"residual", ik.position_error},
-                   {"iterations", ik.iterations}, {"starts", ik.starts}}},
+                  {{"status", to_string(ik.status)},
+                   {"reason", ik.reason},
+                   {"residual", ik.position_error},
+                   {"iterations", ik.iterations},
+                   {"starts", ik.starts}}},
                  {"min_clearance", std::isfinite(clearance) ? Json(clearance) : Json(nullptr)},
                  {"joints_within_limits", violations.empty()},
-                 {"spheres", {{"count", spheres.spheres.size()}, {"per_link", per_link},
-                              {"ignored_adjacent", spheres.adjacent.size()}, {"ignored_always_overlapping", spheres.always.size()}}},
-                 {"object", {{"node_count", loaded.object_mesh->node_count()}, {"tet_count", loaded.object_mesh->tet_count()}}},
+                 {"spheres",
+                  {{"count", spheres.spheres.size()},
+                   {"per_link", per_link},
+                   {"ignored_adjacent", spheres.adjacent.size()},
+                   {"ignored_always_overlapping", spheres.always.size()}}},
+                 {"object",
+                  {{"node_count", loaded.object_mesh->node_count()},
+                   {"tet_count", loaded.object_mesh->tet_count()}}},
                  {"warnings", warnings}};
   // Every file or none.
   std::vector<FileContent> files = {{spheres_out, spheres_text}, {out, scene_text(spheres_out)}};
   if (!o.report.empty()) files.push_back({o.report, to_pretty_json(report)});
   write_files_atomically(files);
 
-  std::cout << "wrote " << out.string() << " and " << spheres_out.string() << " (" << spheres.spheres.size()
-            << " spheres)\n";
+  std::cout << "wrote " << out.string() << " and " << spheres_out.string() << " ("
+            << spheres.spheres.size() << " spheres)\n";
   for (const auto& g : grip_report)
-    std::cout << "grip '" << g["end_effector"].get<std::string>() << "': " << g["node_count"].get<std::size_t>()
-              << " nodes, tool " << g["tool_distance"].get<double>() * 1e3 << " mm from the region centre\n";
+    std::cout << "grip '" << g["end_effector"].get<std::string>()
+              << "': " << g["node_count"].get<std::size_t>() << " nodes, tool "
+              << g["tool_distance"].get<double>() * 1e3 << " mm from the region centre\n";
   std::cout << "reference joints within limits, min clearance "
-            << (std::isfinite(clearance) ? std::to_string(clearance * 1e3) + " mm" : std::string("n/a (no checked pairs)"))
+            << (std::isfinite(clearance) ? std::to_string(clearance * 1e3) + " mm"
+                                         : std::string("n/a (no checked pairs)"))
             << "; inverse kinematics: " << ik.reason << "\n";
 }
 
@@ -521,30 +588,44 @@ void run(const AuthorOptions& o) {
 
 void add_author_command(CLI::App& app) {
   auto o = std::make_shared<AuthorOptions>();
-  CLI::App* c = app.add_subcommand("author", "Propose a scene from a URDF robot and an object mesh");
+  CLI::App* c =
+      app.add_subcommand("author", "Propose a scene from a URDF robot and an object mesh");
   c->add_option("robot", o->urdf, "Robot description (URDF)")->required();
-  c->add_option("--mesh", o->mesh, "Object mesh: .msh, .node/.ele, or a closed surface .obj/.stl/.off (metres)");
+  c->add_option("--mesh", o->mesh,
+                "Object mesh: .msh, .node/.ele, or a closed surface .obj/.stl/.off (metres)");
   c->add_option("--box", o->box, "Instead of --mesh: a box LX,LY,LZ (metres)");
-  c->add_option("--cells", o->cells, "Cells NX,NY,NZ of --box (default: about 4 across the thinnest edge)");
-  c->add_option("--end-effectors", o->end_effectors, "NAME=LINK,... (or LINK,...): the tools that grip")->required();
-  c->add_option("--tool-offset", o->tool_offsets, "NAME=X,Y,Z: tool point in the link frame (m); repeatable");
+  c->add_option("--cells", o->cells,
+                "Cells NX,NY,NZ of --box (default: about 4 across the thinnest edge)");
+  c->add_option("--end-effectors", o->end_effectors,
+                "NAME=LINK,... (or LINK,...): the tools that grip")
+      ->required();
+  c->add_option("--tool-offset", o->tool_offsets,
+                "NAME=X,Y,Z: tool point in the link frame (m); repeatable");
   c->add_option("--grip-region", o->grip_regions,
                 "NAME=X0,Y0,Z0,X1,Y1,Z1 (box) or NAME=X,Y,Z,R (sphere) in object coordinates; "
                 "default: nodes near the tool; repeatable");
-  c->add_option("--grip-radius", o->grip_radius,
-                "Default grips: nodes this close to the node nearest the tool (m); default 1.1 x the "
-                "object's thinnest extent, clamped to 0.02..0.05");
-  c->add_option("--object-pose", o->object_pose,
-                "X,Y,Z[,ROLL,PITCH,YAW] (m, rad); default: between the first two tools at the start pose");
+  c->add_option(
+      "--grip-radius", o->grip_radius,
+      "Default grips: nodes this close to the node nearest the tool (m); default 1.1 x the "
+      "object's thinnest extent, clamped to 0.02..0.05");
+  c->add_option(
+      "--object-pose", o->object_pose,
+      "X,Y,Z[,ROLL,PITCH,YAW] (m, rad); default: between the first two tools at the start pose");
   c->add_option("--youngs-modulus", o->youngs_modulus, "Pa")->capture_default_str();
   c->add_option("--poisson-ratio", o->poisson_ratio, "")->capture_default_str();
   c->add_option("--density", o->density, "kg/m^3")->capture_default_str();
-  c->add_option("--package-path", o->package_paths, "Directory holding ROS packages for package:// meshes; repeatable");
-  c->add_option("--sphere-margin", o->sphere_margin, "Collision margin written to the sphere file (m)")->capture_default_str();
-  c->add_option("--seed", o->seed, "Seed of the random poses (ignore pairs, IK restarts)")->capture_default_str();
+  c->add_option("--package-path", o->package_paths,
+                "Directory holding ROS packages for package:// meshes; repeatable");
+  c->add_option("--sphere-margin", o->sphere_margin,
+                "Collision margin written to the sphere file (m)")
+      ->capture_default_str();
+  c->add_option("--seed", o->seed, "Seed of the random poses (ignore pairs, IK restarts)")
+      ->capture_default_str();
   c->add_option("--out", o->out, "Scene JSON to write")->required();
-  c->add_option("--spheres-out", o->spheres_out, "Sphere JSON to write (default: beside the scene, <name>_spheres.json)");
-  c->add_option("--report", o->report, "Report JSON: grips, IK, clearance, limits, spheres, warnings");
+  c->add_option("--spheres-out", o->spheres_out,
+                "Sphere JSON to write (default: beside the scene, <name>_spheres.json)");
+  c->add_option("--report", o->report,
+                "Report JSON: grips, IK, clearance, limits, spheres, warnings");
   c->callback([o] { run(*o); });
 }
 

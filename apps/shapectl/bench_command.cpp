@@ -13,8 +13,8 @@
 #include <shapectl/calib/calibration.hpp>
 #include <shapectl/calib/joint_path.hpp>
 #include <shapectl/calib/simulated_camera.hpp>
-#include <shapectl/control/optimizer.hpp>
 #include <shapectl/control/optimize.hpp>
+#include <shapectl/control/optimizer.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 
@@ -26,7 +26,9 @@ namespace shapectl::cli {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+double seconds(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
 
 double percentile(std::vector<double> v, double p) {
   if (v.empty()) return NAN;
@@ -62,15 +64,16 @@ bool random_goal(const ReducedObjective& objective, const Evaluation& reference,
 
 // Timings of one reduced-gradient variant, seconds.
 struct GradientTimes {
-  std::vector<double> sensitivity, sensitivity_factored, adjoint, adjoint_factored, fd_chord, fd_newton;
+  std::vector<double> sensitivity, sensitivity_factored, adjoint, adjoint_factored, fd_chord,
+      fd_newton;
 };
 
 // 1. Reduced gradient, each method at the same states x̂(θ), each right after the statics
 // solve that reached θ from the reference shape. "reused": the true Hessian at x̂ is already
 // factored, as in an optimizer, which factors it to confirm an accepted state is stable
 // (or as the last Newton step of a solve leaves it). "counted": that factorization is part
-// of the timed gradient. "Newton": finite differences whose re-solves factor anew (no chord steps), the
-// paper's baseline.
+// of the timed gradient. "Newton": finite differences whose re-solves factor anew (no chord steps),
+// the paper's baseline.
 GradientTimes time_gradients(const GrippedObject& object, const ReducedObjective& objective,
                              const Evaluation& reference, int trials, std::mt19937& rng) {
   enum class Factor { Reused, Counted, NewtonResolves, ChordResolves };
@@ -105,9 +108,13 @@ GradientTimes time_gradients(const GrippedObject& object, const ReducedObjective
 void print_gradient_times(const GradientTimes& t) {
   const double fd = percentile(t.fd_newton, 0.5);
   auto row = [&](const char* name, const std::vector<double>& times) {
-    std::printf("    %-40s %8.3f ms   %6.1fx\n", name, 1e3 * percentile(times, 0.5), fd / percentile(times, 0.5));
+    std::printf("    %-40s %8.3f ms   %6.1fx\n", name, 1e3 * percentile(times, 0.5),
+                fd / percentile(times, 0.5));
   };
-  std::printf("  reduced gradient (median of %zu)                time      vs finite differences (Newton re-solves)\n", t.fd_newton.size());
+  std::printf(
+      "  reduced gradient (median of %zu)                time      vs finite differences (Newton "
+      "re-solves)\n",
+      t.fd_newton.size());
   row("sensitivity, factorization at x reused", t.sensitivity);
   row("sensitivity, factorization counted", t.sensitivity_factored);
   row("adjoint, factorization at x reused", t.adjoint);
@@ -118,8 +125,8 @@ void print_gradient_times(const GradientTimes& t) {
 
 // Optimizer steps from the reference shape until the mean error to `goal`'s targets is below
 // 1 mm (at most 200 steps or 10 s): the seconds and steps it took, or none if it stopped short.
-std::optional<std::pair<double, int>> time_to_1mm(const ReducedObjective& goal, const Evaluation& reference,
-                                                  OptimizerKind kind) {
+std::optional<std::pair<double, int>> time_to_1mm(const ReducedObjective& goal,
+                                                  const Evaluation& reference, OptimizerKind kind) {
   Evaluation current = reference;
   goal.rescore(current);
   auto optimizer = make_optimizer(kind, GradientMethod::Sensitivity);
@@ -134,8 +141,8 @@ std::optional<std::pair<double, int>> time_to_1mm(const ReducedObjective& goal, 
 }
 
 // 2. Target change → mean error below 1 mm, from the reference equilibrium.
-void bench_target_changes(const ReducedObjective& objective, const Evaluation& reference, OptimizerKind kind,
-                          const char* name, const BenchArgs& args) {
+void bench_target_changes(const ReducedObjective& objective, const Evaluation& reference,
+                          OptimizerKind kind, const char* name, const BenchArgs& args) {
   std::vector<double> times, iterations;
   int failures = 0;
   std::mt19937 goals(args.seed + 1);
@@ -149,11 +156,12 @@ void bench_target_changes(const ReducedObjective& objective, const Evaluation& r
       ++failures;
     }
   }
-  std::printf("  target change -> mean error < 1 mm, %-20s median %7.1f ms (p90 %7.1f, max %7.1f), "
-              "iterations median %.0f (max %.0f), %d of %zu not reached\n",
-              name, 1e3 * percentile(times, 0.5), 1e3 * percentile(times, 0.9),
-              1e3 * percentile(times, 1.0), percentile(iterations, 0.5), percentile(iterations, 1.0),
-              failures, times.size() + failures);
+  std::printf(
+      "  target change -> mean error < 1 mm, %-20s median %7.1f ms (p90 %7.1f, max %7.1f), "
+      "iterations median %.0f (max %.0f), %d of %zu not reached\n",
+      name, 1e3 * percentile(times, 0.5), 1e3 * percentile(times, 0.9),
+      1e3 * percentile(times, 1.0), percentile(iterations, 0.5), percentile(iterations, 1.0),
+      failures, times.size() + failures);
 }
 
 // Targets that push the first two grips' nodes 4 cm towards each other each.
@@ -172,27 +180,32 @@ ShapeTargets squeeze_targets(const Scene& scene, const Positions& x0) {
 }
 
 // 3. The slow tail: push the gripped ends 4 cm towards each other each, so the object buckles.
-void bench_buckling(const Scene& scene, const ReducedObjective& objective, const Evaluation& reference) {
+void bench_buckling(const Scene& scene, const ReducedObjective& objective,
+                    const Evaluation& reference) {
   if (scene.grips.size() < 2) {
-    std::printf("  buckling: needs two grips to push together (this scene has %zu)\n", scene.grips.size());
+    std::printf("  buckling: needs two grips to push together (this scene has %zu)\n",
+                scene.grips.size());
     return;
   }
-  const ReducedObjective buckle = objective.with_targets(squeeze_targets(scene, reference.positions));
+  const ReducedObjective buckle =
+      objective.with_targets(squeeze_targets(scene, reference.positions));
   Evaluation current = reference;
   buckle.rescore(current);
   GaussNewton optimizer;
   const auto t0 = Clock::now();
-  const OptimizeResult r = optimize(buckle, optimizer, current, {.max_iterations = 100, .max_seconds = 20});
+  const OptimizeResult r =
+      optimize(buckle, optimizer, current, {.max_iterations = 100, .max_seconds = 20});
   double to_1mm = NAN;
   for (const auto& h : r.history)
     if (h.error_mean < 1e-3) {
       to_1mm = h.time;
       break;
     }
-  std::printf("  buckling (grips pushed 2 x 4 cm together), gauss-newton: %s after %d iterations, %.0f ms; "
-              "< 1 mm after %.0f ms; final mean error %.3f mm\n",
-              to_string(r.termination), r.iterations, 1e3 * seconds(t0, Clock::now()),
-              1e3 * to_1mm, 1e3 * r.best.error.mean);
+  std::printf(
+      "  buckling (grips pushed 2 x 4 cm together), gauss-newton: %s after %d iterations, %.0f ms; "
+      "< 1 mm after %.0f ms; final mean error %.3f mm\n",
+      to_string(r.termination), r.iterations, 1e3 * seconds(t0, Clock::now()), 1e3 * to_1mm,
+      1e3 * r.best.error.mean);
 }
 
 // Calibration (docs/calibration.md) on synthetic observations: the "real" object 1.8× stiffer
@@ -200,17 +213,20 @@ void bench_buckling(const Scene& scene, const ReducedObjective& objective, const
 // modulus and the grip offsets. Median wall time over noise seeds.
 void bench_calibration(const Scene& scene, const BenchArgs& args) {
   Scene truth = scene;
-  truth.material = material_from_youngs(1.8 * youngs_modulus_of(scene.material), poisson_ratio_of(scene.material),
-                                        scene.material.density);
+  truth.material = material_from_youngs(1.8 * youngs_modulus_of(scene.material),
+                                        poisson_ratio_of(scene.material), scene.material.density);
   for (Grip& g : truth.grips)
-    g.offset = Eigen::Translation3d(0.004 * Vec3(1, 1, -1).normalized()) * Eigen::AngleAxisd(3 * M_PI / 180, Vec3::UnitZ());
+    g.offset = Eigen::Translation3d(0.004 * Vec3(1, 1, -1).normalized()) *
+               Eigen::AngleAxisd(3 * M_PI / 180, Vec3::UnitZ());
   const GrippedObject world(truth);
   std::vector<Eigen::VectorXd> poses(3, scene.robot->reference_joints);
   // The first arm's shoulder, elbow and wrist: turning the object against gravity is what
   // separates its sag (stiffness) from a tilt in the gripper (grip rotation).
-  if (poses[0].size() >= 7) poses[1][0] += 0.15, poses[1][6] += 0.5, poses[2][3] -= 0.2, poses[2][5] += 0.3;
+  if (poses[0].size() >= 7)
+    poses[1][0] += 0.15, poses[1][6] += 0.5, poses[2][3] -= 0.2, poses[2][5] += 0.3;
   std::vector<Positions> shapes;
-  for (const auto& joints : poses) shapes.push_back(equilibrium_along_path(world, joints).positions());
+  for (const auto& joints : poses)
+    shapes.push_back(equilibrium_along_path(world, joints).positions());
   SimulatedCamera camera;
   std::vector<int> nodes(world.node_count());
   std::iota(nodes.begin(), nodes.end(), 0);
@@ -224,18 +240,21 @@ void bench_calibration(const Scene& scene, const BenchArgs& args) {
     Observations observations;
     for (std::size_t f = 0; f < poses.size(); ++f)
       observations.frames.push_back(camera.observe(world.mesh(), shapes[f], poses[f], rng));
-    const CalibrationResult r = calibrate(scene, observations, parse_fit_selection("youngs_modulus,grip_offsets"));
+    const CalibrationResult r =
+        calibrate(scene, observations, parse_fit_selection("youngs_modulus,grip_offsets"));
     times.push_back(r.seconds);
-    stiffness_errors.push_back(std::abs(r.fitted.youngs_modulus / youngs_modulus_of(truth.material) - 1));
+    stiffness_errors.push_back(
+        std::abs(r.fitted.youngs_modulus / youngs_modulus_of(truth.material) - 1));
     stiffness_deviations.push_back(r.parameters[0].standard_deviation / r.fitted.youngs_modulus);
     held.clear();
     for (const auto& d : r.unidentified) held += " " + d.held;
   }
-  std::printf("  calibration, 3 frames x 15 markers, E + grip offsets (%d noise seeds): median %.3f s, "
-              "max %.3f s; E off by %.1f %% (median; reported standard deviation %.1f %%)%s\n",
-              trials, percentile(times, 0.5), percentile(times, 1), 100 * percentile(stiffness_errors, 0.5),
-              100 * percentile(stiffness_deviations, 0.5),
-              held.empty() ? "" : ("; not identifiable, held:" + held).c_str());
+  std::printf(
+      "  calibration, 3 frames x 15 markers, E + grip offsets (%d noise seeds): median %.3f s, "
+      "max %.3f s; E off by %.1f %% (median; reported standard deviation %.1f %%)%s\n",
+      trials, percentile(times, 0.5), percentile(times, 1), 100 * percentile(stiffness_errors, 0.5),
+      100 * percentile(stiffness_deviations, 0.5),
+      held.empty() ? "" : ("; not identifiable, held:" + held).c_str());
 }
 
 void bench_scene(const std::string& file, const BenchArgs& args) {
@@ -245,8 +264,10 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
   GrippedObject object(scene);
   ReducedObjective objective(object);
   std::mt19937 rng(args.seed);
-  const Evaluation reference = objective.evaluate(object.reference_joints(), object.reference_positions());
-  if (!reference.statics.converged()) throw SolverFailure("statics at the reference: " + reference.statics.reason);
+  const Evaluation reference =
+      objective.evaluate(object.reference_joints(), object.reference_positions());
+  if (!reference.statics.converged())
+    throw SolverFailure("statics at the reference: " + reference.statics.reason);
   std::printf("\n%s: %d tets, %d nodes, %d joints\n", file.c_str(), object.mesh().tet_count(),
               object.node_count(), object.joint_count());
   print_gradient_times(time_gradients(object, objective, reference, args.trials, rng));
@@ -261,9 +282,12 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
 
 void add_bench_command(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
-  auto* cmd = app.add_subcommand("bench", "Reproduce the paper's performance table on the bundled scenes");
-  cmd->add_option("scenes", args->scenes, "scene files (default: scenes/yumi_bar.json scenes/yumi_frame.json)");
-  cmd->add_option("--trials", args->trials, "random target sets per measurement")->check(CLI::Range(1, 10000));
+  auto* cmd =
+      app.add_subcommand("bench", "Reproduce the paper's performance table on the bundled scenes");
+  cmd->add_option("scenes", args->scenes,
+                  "scene files (default: scenes/yumi_bar.json scenes/yumi_frame.json)");
+  cmd->add_option("--trials", args->trials, "random target sets per measurement")
+      ->check(CLI::Range(1, 10000));
   cmd->add_option("--seed", args->seed, "random seed");
   cmd->callback([args] {
     for (const auto& s : args->scenes) bench_scene(s, *args);

@@ -10,7 +10,6 @@
 #include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/scene_io/scene_writer.hpp>
 
-
 #include "commands.hpp"
 #include "result_json.hpp"
 
@@ -32,9 +31,14 @@ nlohmann::ordered_json report_json(const CalibrationResult& r) {
   out["seconds"] = r.seconds;
   out["parameters"] = nlohmann::ordered_json::array();
   for (const FittedParameter& p : r.parameters)
-    out["parameters"].push_back({{"name", p.name}, {"unit", p.unit}, {"initial", p.initial}, {"fitted", p.fitted},
-                                 {"standard_deviation", p.held ? nlohmann::ordered_json() : nlohmann::ordered_json(p.standard_deviation)},
-                                 {"identifiable", !p.held}});
+    out["parameters"].push_back(
+        {{"name", p.name},
+         {"unit", p.unit},
+         {"initial", p.initial},
+         {"fitted", p.fitted},
+         {"standard_deviation",
+          p.held ? nlohmann::ordered_json() : nlohmann::ordered_json(p.standard_deviation)},
+         {"identifiable", !p.held}});
   out["identifiability"] = nlohmann::ordered_json::array();
   for (const UnidentifiedDirection& d : r.unidentified) {
     nlohmann::ordered_json combination;
@@ -48,15 +52,19 @@ nlohmann::ordered_json report_json(const CalibrationResult& r) {
   out["chi_squared_per_dof"] = r.chi_squared_per_dof;
   out["frames"] = nlohmann::ordered_json::array();
   for (const FrameFit& f : r.frames)
-    out["frames"].push_back({{"rms_before", f.rms_before}, {"rms_after", f.rms_after}, {"markers", f.markers},
-                             {"points", f.points}, {"inlier_points_after", f.inlier_points_after}});
+    out["frames"].push_back({{"rms_before", f.rms_before},
+                             {"rms_after", f.rms_after},
+                             {"markers", f.markers},
+                             {"points", f.points},
+                             {"inlier_points_after", f.inlier_points_after}});
   return out;
 }
 
 void print_summary(const CalibrationResult& r) {
   for (const UnidentifiedDirection& d : r.unidentified) {
     std::cerr << "calibrate: not identifiable from these observations:";
-    for (const auto& [name, weight] : d.combination) std::cerr << " " << name << " (" << weight << ")";
+    for (const auto& [name, weight] : d.combination)
+      std::cerr << " " << name << " (" << weight << ")";
     std::cerr << " together; " << d.held << " held at its initial value\n";
   }
   for (const FittedParameter& p : r.parameters) {
@@ -66,22 +74,26 @@ void print_summary(const CalibrationResult& r) {
     std::cerr << " " << p.unit << "\n";
   }
   std::cerr << "calibrate: " << r.reason << "; RMS residual " << r.rms_before * 1e3 << " mm -> "
-            << r.rms_after * 1e3 << " mm (χ²/dof " << r.chi_squared_per_dof << ") in " << r.seconds << " s\n";
+            << r.rms_after * 1e3 << " mm (χ²/dof " << r.chi_squared_per_dof << ") in " << r.seconds
+            << " s\n";
 }
 
 void run_calibrate(const CalibrateArgs& args) {
   const Scene scene = load_scene(args.scene);
   print_scene_notes(scene);
-  if (!scene.robot) throw InputError(args.scene, "robot", "a robot holding the object (missing key)");
+  if (!scene.robot)
+    throw InputError(args.scene, "robot", "a robot holding the object (missing key)");
   FitSelection fit;
   try {
     fit = parse_fit_selection(args.fit);
   } catch (const std::invalid_argument& e) {
-    throw InputError("--fit", "", "a comma-separated list of youngs_modulus, poisson_ratio, density, grip_offsets",
-                     args.fit);
+    throw InputError(
+        "--fit", "",
+        "a comma-separated list of youngs_modulus, poisson_ratio, density, grip_offsets", args.fit);
   }
-  const Observations observations = load_observations(
-      args.observations, {.node_count = scene.object_mesh->node_count(), .robot = scene.robot->model.get()});
+  const Observations observations =
+      load_observations(args.observations, {.node_count = scene.object_mesh->node_count(),
+                                            .robot = scene.robot->model.get()});
   CalibrationResult result;
   try {
     result = calibrate(scene, observations, fit, {.max_iterations = args.max_iterations});
@@ -90,27 +102,36 @@ void run_calibrate(const CalibrateArgs& args) {
   }
   const nlohmann::ordered_json report = report_json(result);
   require_finite(report, "calibrate", result.reason);
-  std::vector<FileContent> files = {{args.out, to_pretty_json(scene_json_with_values(args.scene, result.scene, args.out))}};
+  std::vector<FileContent> files = {
+      {args.out, to_pretty_json(scene_json_with_values(args.scene, result.scene, args.out))}};
   if (!args.report.empty()) files.push_back({args.report, to_pretty_json(report)});
   write_files_atomically(files);
   print_summary(result);
   if (!result.converged)
-    throw SolverFailure("calibrate: not converged (" + result.reason + "); the best values so far are written");
+    throw SolverFailure("calibrate: not converged (" + result.reason +
+                        "); the best values so far are written");
 }
 
 }  // namespace
 
 void add_calibrate_command(CLI::App& app) {
   auto args = std::make_shared<CalibrateArgs>();
-  auto* cmd = app.add_subcommand("calibrate", "Fit material and grip offsets to observations of the real object");
+  auto* cmd =
+      app.add_subcommand("calibrate",
+                         "Fit material and grip offsets to observations of the real object");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
-  cmd->add_option("--observations", args->observations, "OBSERVATIONS.json (docs/calibration.md)")->required();
-  cmd->add_option("--out", args->out, "CALIBRATED.json: the scene with the fitted values")->required();
-  cmd->add_option("--fit", args->fit,
-                  "parameters to fit, comma-separated: youngs_modulus, poisson_ratio, density, grip_offsets "
-                  "(default youngs_modulus,grip_offsets)");
-  cmd->add_option("--report", args->report, "REPORT.json: values, standard deviations, residuals, identifiability");
-  cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")->check(CLI::Range(1, 1000));
+  cmd->add_option("--observations", args->observations, "OBSERVATIONS.json (docs/calibration.md)")
+      ->required();
+  cmd->add_option("--out", args->out, "CALIBRATED.json: the scene with the fitted values")
+      ->required();
+  cmd->add_option(
+      "--fit", args->fit,
+      "parameters to fit, comma-separated: youngs_modulus, poisson_ratio, density, grip_offsets "
+      "(default youngs_modulus,grip_offsets)");
+  cmd->add_option("--report", args->report,
+                  "REPORT.json: values, standard deviations, residuals, identifiability");
+  cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")
+      ->check(CLI::Range(1, 1000));
   cmd->callback([args] { run_calibrate(*args); });
 }
 

@@ -18,7 +18,7 @@ void add_author_command(CLI::App& app);
 void add_solve_command(CLI::App& app);
 void add_calibrate_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
-void add_serve_command(CLI::App& app);    // server area (GUI)
-void add_link_commands(CLI::App& app);    // link area: run, egm-sim, replay
+void add_serve_command(CLI::App& app);  // server area (GUI)
+void add_link_commands(CLI::App& app);  // link area: run, egm-sim, replay
 
 }  // namespace shapectl::cli

@@ -55,7 +55,8 @@ nlohmann::json arm_json(const EgmSimArmStats& s) {
 
 void run_egm_sim(const EgmSimArgs& args) {
   if (args.duration < 0) throw InputError("egm-sim", "--duration", "a number >= 0", args.duration);
-  if (!(args.acceleration > 0)) throw InputError("egm-sim", "--acceleration", "a positive number", args.acceleration);
+  if (!(args.acceleration > 0))
+    throw InputError("egm-sim", "--acceleration", "a positive number", args.acceleration);
   EgmSimulatorConfig config;
   config.sensor_address = args.address;
   config.left_port = args.left_port;
@@ -74,7 +75,8 @@ void run_egm_sim(const EgmSimArgs& args) {
   const auto start = std::chrono::steady_clock::now();
   while (!stop_signal_received()) {
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (args.duration > 0 && elapsed >= args.duration) break;
   }
   sim.stop();
@@ -88,16 +90,20 @@ void run_egm_sim(const EgmSimArgs& args) {
 
 void add_egm_sim_command(CLI::App& app) {
   auto args = std::make_shared<EgmSimArgs>();
-  auto* cmd = app.add_subcommand("egm-sim", "Stand-in for the YuMi controller's EGM side (testing)");
-  cmd->add_option("--address", args->address, "IPv4 address the sensor (shapectl run/serve) listens on")
+  auto* cmd =
+      app.add_subcommand("egm-sim", "Stand-in for the YuMi controller's EGM side (testing)");
+  cmd->add_option("--address", args->address,
+                  "IPv4 address the sensor (shapectl run/serve) listens on")
       ->capture_default_str();
   cmd->add_option("--left-port", args->left_port, "left arm's sensor port (0: no left arm)")
       ->capture_default_str();
   cmd->add_option("--right-port", args->right_port, "right arm's sensor port (0: no right arm)")
       ->capture_default_str();
   cmd->add_option("--scene", args->scene, "start the arms at this scene's reference joints");
-  cmd->add_option("--duration", args->duration, "seconds to run (0: until Ctrl-C)")->capture_default_str();
-  cmd->add_option("--acceleration", args->acceleration, "simulated arms' acceleration limit, rad/s²")
+  cmd->add_option("--duration", args->duration, "seconds to run (0: until Ctrl-C)")
+      ->capture_default_str();
+  cmd->add_option("--acceleration", args->acceleration,
+                  "simulated arms' acceleration limit, rad/s²")
       ->capture_default_str();
   cmd->callback([args] { run_egm_sim(*args); });
 }

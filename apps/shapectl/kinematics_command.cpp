@@ -52,15 +52,17 @@ nlohmann::ordered_json collision_json(const RobotModel& robot, const CollisionMo
     const auto a = static_cast<std::size_t>(pair.first);
     const auto b = static_cast<std::size_t>(pair.second);
     closest.push_back(
-        {{"links", {robot.links()[static_cast<std::size_t>(collision.spheres()[a].link)].name,
-                    robot.links()[static_cast<std::size_t>(collision.spheres()[b].link)].name}},
+        {{"links",
+          {robot.links()[static_cast<std::size_t>(collision.spheres()[a].link)].name,
+           robot.links()[static_cast<std::size_t>(collision.spheres()[b].link)].name}},
          {"spheres", {index_in_link[a], index_in_link[b]}},
          {"clearance", pair.clearance}});
   }
   nlohmann::ordered_json out;
   // +inf when no sphere pair is checked: then there is no clearance to report.
   const double min_clearance = collision.min_clearance(state);
-  if (min_clearance != std::numeric_limits<double>::infinity()) out["min_clearance"] = min_clearance;
+  if (min_clearance != std::numeric_limits<double>::infinity())
+    out["min_clearance"] = min_clearance;
   out["margin"] = collision.margin();
   out["closest_pairs"] = closest;
   return out;
@@ -79,7 +81,8 @@ void run(const KinematicsOptions& options) {
   nlohmann::ordered_json links = nlohmann::ordered_json::object();
   for (int link = 0; link < robot.link_count(); ++link) {
     const Eigen::Isometry3d& T = state.T_world_link[static_cast<std::size_t>(link)];
-    links[robot.links()[static_cast<std::size_t>(link)].name] = result_pose_json(T.translation(), T.linear());
+    links[robot.links()[static_cast<std::size_t>(link)].name] =
+        result_pose_json(T.translation(), T.linear());
   }
   out["links"] = links;
   if (!options.spheres.empty()) {
@@ -89,7 +92,8 @@ void run(const KinematicsOptions& options) {
   }
   nlohmann::ordered_json violations = nlohmann::ordered_json::array();
   for (const auto& v : limit_violations(robot, state.joints))
-    violations.push_back({{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
+    violations.push_back(
+        {{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
 
   require_finite(out, "kinematics", "");

@@ -12,7 +12,7 @@ int main(int argc, char** argv) {
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"shapectl: interactive robotic shape control of elastic objects"};
   app.set_version_flag("--version", std::string("shapectl ") + SHAPECTL_VERSION + " (git " +
-                                         SHAPECTL_GIT_REVISION + ")");
+                                        SHAPECTL_GIT_REVISION + ")");
   app.require_subcommand(1);
   shapectl::cli::add_statics_command(app);
   shapectl::cli::add_kinematics_command(app);

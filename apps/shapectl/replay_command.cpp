@@ -53,7 +53,8 @@ std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& eve
   if (args.arm) {
     std::string why;
     while (!link->arm(&why)) {
-      if (std::chrono::steady_clock::now() - start > std::chrono::seconds(5) || stop_signal_received())
+      if (std::chrono::steady_clock::now() - start > std::chrono::seconds(5) ||
+          stop_signal_received())
         throw SolverFailure("cannot arm the robot link: " + why);
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
@@ -66,8 +67,9 @@ std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& eve
     if (joints.size() != n)
       throw InputError(args.log + ":" + std::to_string(e.line), "joints",
                        std::to_string(n) + " values for " + scene_file, joints.size());
-    std::this_thread::sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                              std::chrono::duration<double>(e.t / args.speed)));
+    std::this_thread::sleep_until(start +
+                                  std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                      std::chrono::duration<double>(e.t / args.speed)));
     link->set_target(joints, e.fields.value("safe", false));
     ++sent;
   }
@@ -78,7 +80,8 @@ std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& eve
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   const LinkStatus s = link->status();
   std::cerr << "replay: " << sent << " optimizer results streamed to the " << s.kind << " robot; "
-            << (s.armed ? (s.arrived ? "arrived" : "armed, not arrived") : "not armed: " + s.reason) << "\n";
+            << (s.armed ? (s.arrived ? "arrived" : "armed, not arrived") : "not armed: " + s.reason)
+            << "\n";
   const std::string failure = args.arm && !s.armed ? s.reason : "";
   link->disarm("replay finished");
   link->stop();
@@ -119,11 +122,16 @@ void add_replay_command(CLI::App& app) {
   cmd->add_flag("--arm", args->arm, "arm the link so the robot moves");
   cmd->add_option("--speed", args->speed, "time scale (2: twice as fast)")->capture_default_str();
   cmd->add_option("--scene", args->scene, "SCENE.json (default: the one the log names)");
-  cmd->add_option("--max-velocity", args->link.max_velocity, "rad/s per joint")->capture_default_str();
-  cmd->add_option("--max-acceleration", args->link.max_acceleration, "rad/s² per joint")->capture_default_str();
-  cmd->add_option("--egm-address", args->link.egm_address, "local address for the EGM ports")->capture_default_str();
-  cmd->add_option("--egm-left-port", args->link.egm_left_port, "UDP port of the left arm")->capture_default_str();
-  cmd->add_option("--egm-right-port", args->link.egm_right_port, "UDP port of the right arm")->capture_default_str();
+  cmd->add_option("--max-velocity", args->link.max_velocity, "rad/s per joint")
+      ->capture_default_str();
+  cmd->add_option("--max-acceleration", args->link.max_acceleration, "rad/s² per joint")
+      ->capture_default_str();
+  cmd->add_option("--egm-address", args->link.egm_address, "local address for the EGM ports")
+      ->capture_default_str();
+  cmd->add_option("--egm-left-port", args->link.egm_left_port, "UDP port of the left arm")
+      ->capture_default_str();
+  cmd->add_option("--egm-right-port", args->link.egm_right_port, "UDP port of the right arm")
+      ->capture_default_str();
   cmd->callback([args] { replay(*args); });
 }
 

@@ -30,14 +30,16 @@ void print_scene_notes(const Scene& scene) {
 
 namespace {
 template <class Json>
-void require_finite_numbers(const Json& result, const std::string& what, const std::string& context) {
+void require_finite_numbers(const Json& result, const std::string& what,
+                            const std::string& context) {
   if (const auto where = first_non_finite(result))
     throw SolverFailure(what + ": " + (where->empty() ? "the result" : *where) + " is not finite" +
                         (context.empty() ? "" : " (" + context + ")") + "; nothing written");
 }
 }  // namespace
 
-void require_finite(const nlohmann::json& result, const std::string& what, const std::string& context) {
+void require_finite(const nlohmann::json& result, const std::string& what,
+                    const std::string& context) {
   require_finite_numbers(result, what, context);
 }
 void require_finite(const nlohmann::ordered_json& result, const std::string& what,

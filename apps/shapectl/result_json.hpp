@@ -13,7 +13,8 @@ namespace shapectl::cli {
 nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints);
 // Throws SolverFailure ("<what>: <field> is not finite (<context>)") if any number in `result` is
 // NaN or infinite: JSON would write it as null, and a result is never written with one.
-void require_finite(const nlohmann::json& result, const std::string& what, const std::string& context);
+void require_finite(const nlohmann::json& result, const std::string& what,
+                    const std::string& context);
 void require_finite(const nlohmann::ordered_json& result, const std::string& what,
                     const std::string& context);
 // The scene's warnings ("warning: <file>: <field>: ...") and the nodes each grip caught, one line

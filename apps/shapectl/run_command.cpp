@@ -37,14 +37,14 @@ struct RunArgs {
   std::string log;
   bool arm = false;
   bool until_settled = false;
-  double timeout = 0;  // s; 0: none
+  double timeout = 0;         // s; 0: none
   std::string robot = "sim";  // a LinkKind name
   LinkConfig link;
   double watchdog_ms = 100;
   // The simulated real object (calib/simulated_world.hpp): its camera observes markers on the
   // target nodes; with feedback on, the controller closes the loop on them.
   std::string world;
-  double camera_rate = 10;      // observations per second
+  double camera_rate = 10;       // observations per second
   double camera_sigma = 0.0003;  // m
   bool feedback = true;
 };
@@ -66,7 +66,8 @@ nlohmann::json link_json(const LinkStatus& s) {
 
 // Why running on cannot settle, or empty.
 std::string cannot_settle(const ControllerSnapshot& s, const LinkStatus& link, bool armed_once) {
-  if (s.status == ControllerStatus::Stuck) return "optimizer stuck: no acceptable step (error " + std::to_string(s.error.mean) + " m)";
+  if (s.status == ControllerStatus::Stuck)
+    return "optimizer stuck: no acceptable step (error " + std::to_string(s.error.mean) + " m)";
   if (!s.last_error.empty()) return "optimizer: " + s.last_error;
   if (armed_once && !link.armed) return "robot link disarmed: " + link.reason;
   return {};
@@ -90,12 +91,15 @@ struct RunInputs {
 };
 
 // --world: the "real" object, observed on the target nodes (the centre-line's too).
-std::unique_ptr<SimulatedWorld> make_world(const RunArgs& args, const Scene& model, const ShapeTargets& targets) {
+std::unique_ptr<SimulatedWorld> make_world(const RunArgs& args, const Scene& model,
+                                           const ShapeTargets& targets) {
   if (args.world.empty()) return nullptr;
   if (args.link.kind != LinkKind::Sim)
     throw InputError("run", "--world", "--robot sim (a real robot holds a real object)");
-  if (!(args.camera_rate > 0 && args.camera_rate <= 1000)) throw InputError("run", "--camera-rate", "0 < rate <= 1000 per second", args.camera_rate);
-  if (!(args.camera_sigma >= 0 && args.camera_sigma <= 0.1)) throw InputError("run", "--camera-sigma", "0 <= sigma <= 0.1 m", args.camera_sigma);
+  if (!(args.camera_rate > 0 && args.camera_rate <= 1000))
+    throw InputError("run", "--camera-rate", "0 < rate <= 1000 per second", args.camera_rate);
+  if (!(args.camera_sigma >= 0 && args.camera_sigma <= 0.1))
+    throw InputError("run", "--camera-sigma", "0 <= sigma <= 0.1 m", args.camera_sigma);
   const Scene world = load_scene(args.world);
   SimulatedCamera camera;
   camera.marker_nodes = targets.nodes;
@@ -162,7 +166,8 @@ struct RunClock {
 void arm_when_ready(RobotLink& link, const RunClock& clock) {
   std::string why;
   while (!link.arm(&why)) {
-    if (clock.elapsed() > 5 || stop_signal_received()) throw SolverFailure("cannot arm the robot link: " + why);
+    if (clock.elapsed() > 5 || stop_signal_received())
+      throw SolverFailure("cannot arm the robot link: " + why);
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
   std::cerr << "run: armed\n";
@@ -171,24 +176,27 @@ void arm_when_ready(RobotLink& link, const RunClock& clock) {
 // How following the optimizer ended.
 struct RunOutcome {
   bool settled = false;
-  std::string failure;  // why it cannot settle; empty otherwise
+  std::string failure;                                 // why it cannot settle; empty otherwise
   std::shared_ptr<const ControllerSnapshot> snapshot;  // the last one seen
 };
 
 // The progress line's state: "converged; robot connected, arrived".
 std::string progress_report(const ControllerSnapshot& s, const LinkStatus& st) {
-  return std::string(to_string(s.status)) + "; robot " + (st.connected ? "connected" : "not connected") +
-         ", " + (st.armed ? (st.arrived ? "arrived" : "moving") : "not armed: " + st.reason);
+  return std::string(to_string(s.status)) + "; robot " +
+         (st.connected ? "connected" : "not connected") + ", " +
+         (st.armed ? (st.arrived ? "arrived" : "moving") : "not armed: " + st.reason);
 }
 
 // --until-settled: true when following should end, settled or with outcome.failure set.
-bool settle_decided(const ControllerSnapshot& s, const LinkStatus& st, bool armed, RunOutcome& outcome) {
+bool settle_decided(const ControllerSnapshot& s, const LinkStatus& st, bool armed,
+                    RunOutcome& outcome) {
   outcome.failure = cannot_settle(s, st, armed);
   if (!outcome.failure.empty()) return true;
   if (s.status != ControllerStatus::Converged) return false;
   // Not armed, the robot is never asked to move: it cannot arrive, so say so.
   if (!armed) {
-    outcome.failure = "the optimizer converged, but the robot is not armed (--arm), so it cannot arrive";
+    outcome.failure =
+        "the optimizer converged, but the robot is not armed (--arm), so it cannot arrive";
     return true;
   }
   outcome.settled = st.arrived;
@@ -207,7 +215,9 @@ void observe_world(SimulatedWorld& world, Controller& controller, const Controll
   if (st.measured.size() != snap.joints.size()) return;  // no feedback from the robot yet
   const std::optional<ObservationFrame> frame = world.step(time, st.measured);
   if (!frame) return;
-  ShapeObservation o{.joints = frame->joints, .time = time};
+  ShapeObservation o;
+  o.joints = frame->joints;
+  o.time = time;
   for (const ObservedMarker& m : frame->markers) o.markers.emplace_back(m.node, m.position);
   controller.observe(o);
   if (log)
@@ -219,8 +229,8 @@ void observe_world(SimulatedWorld& world, Controller& controller, const Controll
 
 // Sends each new snapshot's θ to the link (and the log) and prints progress, until settled,
 // failed, timed out or stopped by a signal.
-RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLink& link, SessionLog* log,
-                            const RunClock& clock, SimulatedWorld* world) {
+RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLink& link,
+                            SessionLog* log, const RunClock& clock, SimulatedWorld* world) {
   RunOutcome outcome;
   std::uint64_t seen = 0;
   std::string last_report;
@@ -237,7 +247,8 @@ RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLi
     if (world) observe_world(*world, controller, snap, st, clock.elapsed(), log);
     const std::string report = progress_report(snap, st);
     if (report != last_report) {
-      std::cerr << "run: " << clock.elapsed() << " s: " << report << " (error " << snap.error.mean * 1000 << " mm)\n";
+      std::cerr << "run: " << clock.elapsed() << " s: " << report << " (error "
+                << snap.error.mean * 1000 << " mm)\n";
       last_report = report;
     }
     if (args.until_settled && settle_decided(snap, st, args.arm, outcome)) {
@@ -247,7 +258,8 @@ RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLi
     if (args.timeout > 0 && clock.elapsed() >= args.timeout) {
       if (args.until_settled)
         outcome.failure = "not settled after " + std::to_string(args.timeout) + " s: optimizer " +
-                          to_string(snap.status) + ", robot " + (st.arrived ? "arrived" : "not arrived");
+                          to_string(snap.status) + ", robot " +
+                          (st.arrived ? "arrived" : "not arrived");
       break;
     }
   }
@@ -267,26 +279,26 @@ LinkStatus stop_run(RobotLink& link, Controller& controller, const std::string& 
 }
 
 // What `run` prints on stdout.
-nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status, RobotLink& link,
-                          const SimulatedWorld* world) {
+nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status,
+                          RobotLink& link, const SimulatedWorld* world) {
   const ControllerSnapshot& snap = *outcome.snapshot;
-  nlohmann::json result = {{"settled", outcome.settled},
-                           {"status", to_string(snap.status)},
-                           {"error_mean", snap.error.mean},
-                           {"error_max", snap.error.max},
-                           {"iterations", snap.iterations},
-                           {"joint_names", snap.joint_names},
-                           {"joints", vector_json(snap.joints)},
-                           {"link", link_json(final_status)}};
+  nlohmann::json result = {{"settled", outcome.settled},         {"status", to_string(snap.status)},
+                           {"error_mean", snap.error.mean},      {"error_max", snap.error.max},
+                           {"iterations", snap.iterations},      {"joint_names", snap.joint_names},
+                           {"joints", vector_json(snap.joints)}, {"link", link_json(final_status)}};
   if (auto* egm = dynamic_cast<EgmLink*>(&link)) {
     const LatencyStats l = egm->latency();
-    result["latency_us"] = {{"samples", l.samples}, {"median", l.median_us}, {"p99", l.p99_us}, {"max", l.max_us}};
+    result["latency_us"] = {{"samples", l.samples},
+                            {"median", l.median_us},
+                            {"p99", l.p99_us},
+                            {"max", l.max_us}};
   }
   if (snap.observations > 0) {
     result["observations"] = snap.observations;
     result["feedback"] = snap.feedback;
     result["model_error"] = snap.model_error;
-    result["observed_error"] = std::isfinite(snap.observed_error) ? nlohmann::json(snap.observed_error) : nullptr;
+    result["observed_error"] =
+        std::isfinite(snap.observed_error) ? nlohmann::json(snap.observed_error) : nullptr;
   }
   if (world) result["true_error"] = world->true_error(snap.targets);
   if (!outcome.failure.empty()) result["reason"] = outcome.failure;
@@ -305,7 +317,8 @@ void run(RunArgs args) {
   link->start();
   const RunClock clock;
   if (args.arm) arm_when_ready(*link, clock);  // throws if it cannot
-  const RunOutcome outcome = follow_optimizer(args, controller, *link, log.get(), clock, inputs.world.get());
+  const RunOutcome outcome =
+      follow_optimizer(args, controller, *link, log.get(), clock, inputs.world.get());
   const LinkStatus final_status = stop_run(*link, controller, outcome.failure);
   const nlohmann::json result = run_result(outcome, final_status, *link, inputs.world.get());
   if (log) log->write("end", {{"settled", outcome.settled}, {"reason", outcome.failure}});
@@ -327,21 +340,33 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--log", args->log, "session log to write (JSON lines)");
   cmd->add_flag("--until-settled", args->until_settled,
                 "exit 0 once converged and arrived; exit 2 with the reason if that cannot happen");
-  cmd->add_option("--timeout", args->timeout, "seconds before giving up (0: none)")->capture_default_str();
-  cmd->add_option("--max-velocity", args->link.max_velocity, "rad/s per joint (capped by the robot's own)")
+  cmd->add_option("--timeout", args->timeout, "seconds before giving up (0: none)")
       ->capture_default_str();
-  cmd->add_option("--max-acceleration", args->link.max_acceleration, "rad/s² per joint")->capture_default_str();
-  cmd->add_option("--limit-margin", args->link.limit_margin, "rad kept from each joint limit")->capture_default_str();
-  cmd->add_option("--watchdog-ms", args->watchdog_ms, "feedback gap that holds and disarms, ms")->capture_default_str();
-  cmd->add_option("--egm-address", args->link.egm_address, "local address for the EGM ports")->capture_default_str();
-  cmd->add_option("--egm-left-port", args->link.egm_left_port, "UDP port of the left arm (ROB_L)")->capture_default_str();
-  cmd->add_option("--egm-right-port", args->link.egm_right_port, "UDP port of the right arm (ROB_R)")->capture_default_str();
+  cmd->add_option("--max-velocity", args->link.max_velocity,
+                  "rad/s per joint (capped by the robot's own)")
+      ->capture_default_str();
+  cmd->add_option("--max-acceleration", args->link.max_acceleration, "rad/s² per joint")
+      ->capture_default_str();
+  cmd->add_option("--limit-margin", args->link.limit_margin, "rad kept from each joint limit")
+      ->capture_default_str();
+  cmd->add_option("--watchdog-ms", args->watchdog_ms, "feedback gap that holds and disarms, ms")
+      ->capture_default_str();
+  cmd->add_option("--egm-address", args->link.egm_address, "local address for the EGM ports")
+      ->capture_default_str();
+  cmd->add_option("--egm-left-port", args->link.egm_left_port, "UDP port of the left arm (ROB_L)")
+      ->capture_default_str();
+  cmd->add_option("--egm-right-port", args->link.egm_right_port,
+                  "UDP port of the right arm (ROB_R)")
+      ->capture_default_str();
   cmd->add_option("--world", args->world,
-                  "WORLD.json: simulate the real object (true material, grip offsets; same mesh) with --robot sim; "
+                  "WORLD.json: simulate the real object (true material, grip offsets; same mesh) "
+                  "with --robot sim; "
                   "a camera observes markers on the target nodes")
       ->check(CLI::ExistingFile);
-  cmd->add_option("--camera-rate", args->camera_rate, "--world: observations per second")->capture_default_str();
-  cmd->add_option("--camera-sigma", args->camera_sigma, "--world: marker noise, m")->capture_default_str();
+  cmd->add_option("--camera-rate", args->camera_rate, "--world: observations per second")
+      ->capture_default_str();
+  cmd->add_option("--camera-sigma", args->camera_sigma, "--world: marker noise, m")
+      ->capture_default_str();
   cmd->add_flag("--feedback,!--no-feedback", args->feedback,
                 "--world: close the loop on the observations (default) or not (open loop)");
   cmd->callback([args] { run(*args); });

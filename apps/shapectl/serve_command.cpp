@@ -1,5 +1,6 @@
-// shapectl serve [SCENE.json] [--host 127.0.0.1] [--port 8080] [--robot none|sim|egm] [--web-root DIR]
-// The browser GUI: serves web/ over HTTP and the session over a WebSocket at /ws (docs/gui.md).
+// shapectl serve [SCENE.json] [--host 127.0.0.1] [--port 8080] [--robot none|sim|egm] [--web-root
+// DIR] The browser GUI: serves web/ over HTTP and the session over a WebSocket at /ws
+// (docs/gui.md).
 #include <iostream>
 
 #include <shapectl/io/input_error.hpp>
@@ -29,11 +30,14 @@ void run_serve(const ServeArgs& args) {
   options.host = args.host;
   options.port = static_cast<unsigned short>(args.port);
   options.state_rate = args.rate;
-  options.web_root = args.web_root.empty() ? server::default_web_root() : std::filesystem::path(args.web_root);
+  options.web_root =
+      args.web_root.empty() ? server::default_web_root() : std::filesystem::path(args.web_root);
   if (!std::filesystem::is_regular_file(options.web_root / "index.html"))
-    throw InputError("serve", "--web-root", "a directory with index.html", options.web_root.string());
-  const std::filesystem::path scenes_dir =
-      args.scenes_dir.empty() ? server::default_scenes_dir() : std::filesystem::path(args.scenes_dir);
+    throw InputError("serve", "--web-root", "a directory with index.html",
+                     options.web_root.string());
+  const std::filesystem::path scenes_dir = args.scenes_dir.empty()
+                                               ? server::default_scenes_dir()
+                                               : std::filesystem::path(args.scenes_dir);
   const std::filesystem::path scene =
       args.scene.empty() ? scenes_dir / "yumi_bar.json" : std::filesystem::path(args.scene);
 
@@ -41,7 +45,8 @@ void run_serve(const ServeArgs& args) {
   std::unique_ptr<RobotLink> link;
   if (args.robot != "none") {
     const Scene description = load_scene(scene);
-    if (!description.robot) throw InputError(scene.string(), "robot", "a robot for --robot " + args.robot);
+    if (!description.robot)
+      throw InputError(scene.string(), "robot", "a robot for --robot " + args.robot);
     LinkConfig config;
     parse(args.robot, &config.kind);  // checked by the option
     config.sim_initial_joints = description.robot->reference_joints;
@@ -64,18 +69,26 @@ void run_serve(const ServeArgs& args) {
 
 void add_serve_command(CLI::App& app) {
   auto args = std::make_shared<ServeArgs>();
-  CLI::App* cmd = app.add_subcommand("serve", "Browser GUI: drag targets, sketch centre-lines, watch the robot follow");
+  CLI::App* cmd =
+      app.add_subcommand("serve",
+                         "Browser GUI: drag targets, sketch centre-lines, watch the robot follow");
   cmd->add_option("scene", args->scene, "Scene JSON (default: scenes/yumi_bar.json)");
-  cmd->add_option("--host", args->host, "Address to listen on; anything but loopback exposes the robot")
+  cmd->add_option("--host", args->host,
+                  "Address to listen on; anything but loopback exposes the robot")
       ->capture_default_str();
   cmd->add_option("--port", args->port, "TCP port; 0 picks a free one")
-      ->check(CLI::Range(0, 65535))->capture_default_str();
+      ->check(CLI::Range(0, 65535))
+      ->capture_default_str();
   cmd->add_option("--robot", args->robot, "Robot link following the optimizer (starts disarmed)")
-      ->check(CLI::IsMember({"none", "sim", "egm"}))->capture_default_str();
-  cmd->add_option("--web-root", args->web_root, "Directory with index.html (default: the repository's web/)");
-  cmd->add_option("--scenes-dir", args->scenes_dir, "Scenes offered for switching (default: scenes/)");
+      ->check(CLI::IsMember({"none", "sim", "egm"}))
+      ->capture_default_str();
+  cmd->add_option("--web-root", args->web_root,
+                  "Directory with index.html (default: the repository's web/)");
+  cmd->add_option("--scenes-dir", args->scenes_dir,
+                  "Scenes offered for switching (default: scenes/)");
   cmd->add_option("--rate", args->rate, "State messages per second to each page")
-      ->check(CLI::Range(1.0, 120.0))->capture_default_str();
+      ->check(CLI::Range(1.0, 120.0))
+      ->capture_default_str();
   cmd->callback([args] { run_serve(*args); });
 }
 

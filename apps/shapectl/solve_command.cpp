@@ -31,7 +31,8 @@ struct SolveArgs {
 };
 
 // The targets the file asks for, checked against this object (InputError naming the file).
-ShapeTargets resolve_targets(const TargetsInput& in, const std::string& file, GrippedObject& object) {
+ShapeTargets resolve_targets(const TargetsInput& in, const std::string& file,
+                             GrippedObject& object) {
   if (in.centerline.empty()) {
     check_targets(in.targets, object.node_count(), file);
     return in.targets;
@@ -39,10 +40,13 @@ ShapeTargets resolve_targets(const TargetsInput& in, const std::string& file, Gr
   const auto axis = find_bar_axis(object.mesh());
   if (!axis)
     throw InputError(file, "centerline", "an object that is bar-like (length ≥ 3 × thickness)",
-                     "a " + std::to_string(object.mesh().node_count()) + "-node object that is not");
+                     "a " + std::to_string(object.mesh().node_count()) +
+                         "-node object that is not");
   check_centerline(*axis, in.centerline, file);
-  ShapeTargets targets = centerline_targets(object.mesh(), *axis, in.centerline, object.reference_positions());
-  check_targets(targets, object.node_count(), file);  // the bar's offsets may still reach past the bound
+  ShapeTargets targets =
+      centerline_targets(object.mesh(), *axis, in.centerline, object.reference_positions());
+  check_targets(targets, object.node_count(),
+                file);  // the bar's offsets may still reach past the bound
   return targets;
 }
 
@@ -56,10 +60,13 @@ void run_solve(const SolveArgs& args) {
 
   OptimizerKind kind;
   GradientMethod gradient;
-  if (!parse(args.optimizer, &kind)) throw InputError("--optimizer", "", "one of the optimizer names", args.optimizer);
-  if (!parse(args.gradient, &gradient)) throw InputError("--gradient", "", "one of the gradient names", args.gradient);
+  if (!parse(args.optimizer, &kind))
+    throw InputError("--optimizer", "", "one of the optimizer names", args.optimizer);
+  if (!parse(args.gradient, &gradient))
+    throw InputError("--gradient", "", "one of the gradient names", args.gradient);
   auto optimizer = make_optimizer(kind, gradient);
-  const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
+  const Evaluation start =
+      objective.evaluate(object.reference_joints(), object.reference_positions());
   if (!start.statics.converged())
     throw SolverFailure("statics at the reference joints: " + start.statics.reason);
   const OptimizeResult result =
@@ -76,20 +83,26 @@ void run_solve(const SolveArgs& args) {
   out["error_max"] = best.error.max;
   out["objective"] = best.objective;
   // +inf without collision spheres: nothing to report (JSON has no infinity).
-  if (best.min_clearance != std::numeric_limits<double>::infinity()) out["min_clearance"] = best.min_clearance;
+  if (best.min_clearance != std::numeric_limits<double>::infinity())
+    out["min_clearance"] = best.min_clearance;
   nlohmann::json violations = nlohmann::json::array();
   const KinematicsState state = forward_kinematics(object.robot(), best.joints);
   for (const auto& v : limit_violations(object.robot(), state.joints))
-    violations.push_back({{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
+    violations.push_back(
+        {{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
   out["positions"] = positions_json(best.positions);
   out["targets"] = targets_json(objective.targets());
   for (const auto& h : result.history)
-    out["history"].push_back({{"iteration", h.iteration}, {"time", h.time}, {"error_mean", h.error_mean},
+    out["history"].push_back({{"iteration", h.iteration},
+                              {"time", h.time},
+                              {"error_mean", h.error_mean},
                               {"objective", h.objective}});
   const ObjectiveTiming t = objective.timing();
-  out["timing"] = {{"statics_solves", t.statics_solves}, {"statics_seconds", t.statics_seconds},
-                   {"gradient_evaluations", t.gradient_evaluations}, {"gradient_seconds", t.gradient_seconds}};
+  out["timing"] = {{"statics_solves", t.statics_solves},
+                   {"statics_seconds", t.statics_seconds},
+                   {"gradient_evaluations", t.gradient_evaluations},
+                   {"gradient_seconds", t.gradient_seconds}};
   require_finite(out, "solve", result.reason);
   // With --vtu both files or neither.
   std::vector<FileContent> files = {{args.out, to_pretty_json(out)}};
@@ -97,7 +110,8 @@ void run_solve(const SolveArgs& args) {
     std::vector<std::array<int, 4>> tets;
     for (const auto& t : object.mesh().tets()) tets.push_back(t.nodes);
     const Positions rest = scene.world_rest_positions();
-    files.push_back({args.vtu, vtu_text(best.positions, tets, {{"displacement", best.positions - rest}})});
+    files.push_back(
+        {args.vtu, vtu_text(best.positions, tets, {{"displacement", best.positions - rest}})});
   }
   write_files_atomically(files);
   std::cerr << "solve: " << result.reason << "; mean error " << best.error.mean * 1e3 << " mm, max "
@@ -108,16 +122,20 @@ void run_solve(const SolveArgs& args) {
 
 void add_solve_command(CLI::App& app) {
   auto args = std::make_shared<SolveArgs>();
-  auto* cmd = app.add_subcommand("solve", "Find joint angles that give the object the target shape");
+  auto* cmd =
+      app.add_subcommand("solve", "Find joint angles that give the object the target shape");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
   cmd->add_option("--targets", args->targets, "TARGETS.json")->required();
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
-  cmd->add_option("--vtu", args->vtu, "also write the deformed mesh at the best joints as VTU (ParaView)");
+  cmd->add_option("--vtu", args->vtu,
+                  "also write the deformed mesh at the best joints as VTU (ParaView)");
   cmd->add_option("--optimizer", args->optimizer, "gauss-newton (default) or lbfgs")
       ->check(CLI::IsMember(optimizer_names()));
-  cmd->add_option("--gradient", args->gradient, "sensitivity (default), adjoint or finite-difference")
+  cmd->add_option("--gradient", args->gradient,
+                  "sensitivity (default), adjoint or finite-difference")
       ->check(CLI::IsMember(gradient_names()));
-  cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")->check(CLI::Range(1, 100000));
+  cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")
+      ->check(CLI::Range(1, 100000));
   cmd->add_option("--max-seconds", args->max_seconds, "time limit")->check(CLI::PositiveNumber);
   cmd->callback([args] { run_solve(*args); });
 }

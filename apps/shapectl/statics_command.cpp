@@ -67,7 +67,8 @@ void run_statics(const StaticsArgs& args) {
   Eigen::VectorXd joints = object.reference_joints();
   if (!args.joints.empty()) joints = load_joints_file(args.joints, object.robot(), joints);
   const ObjectState state = object.solve_from(joints, x);
-  write_outputs(args, state.statics(), object.mesh(), rest, state.positions(), robot_json(scene, joints));
+  write_outputs(args, state.statics(), object.mesh(), rest, state.positions(),
+                robot_json(scene, joints));
 }
 
 }  // namespace
@@ -76,7 +77,8 @@ void add_statics_command(CLI::App& app) {
   auto args = std::make_shared<StaticsArgs>();
   auto* cmd = app.add_subcommand("statics", "Solve the object's static equilibrium");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
-  cmd->add_option("--joints", args->joints, "JOINTS.json {\"joints\": {name: rad}} (default: the reference joints)");
+  cmd->add_option("--joints", args->joints,
+                  "JOINTS.json {\"joints\": {name: rad}} (default: the reference joints)");
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
   cmd->add_option("--vtu", args->vtu, "also write the deformed mesh as VTU (ParaView)");
   cmd->callback([args] { run_statics(*args); });

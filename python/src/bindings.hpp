@@ -18,12 +18,12 @@
 #include <nlohmann/json.hpp>
 
 #include <shapectl/control/targets_file.hpp>
+#include <shapectl/io/input_error.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/joint_limits.hpp>
 #include <shapectl/robot/robot_model.hpp>
-#include <shapectl/sim/gripped_object.hpp>
-#include <shapectl/io/input_error.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
+#include <shapectl/sim/gripped_object.hpp>
 
 namespace shapectl::python {
 

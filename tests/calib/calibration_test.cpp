@@ -22,8 +22,9 @@ struct SyntheticStudy {
   std::vector<Eigen::VectorXd> poses;
 
   SyntheticStudy() {
-    truth.material = material_from_youngs(1.8 * PhysicalParameters::of(model).youngs_modulus,
-                                          PhysicalParameters::of(model).poisson_ratio, model.material.density);
+    truth.material =
+        material_from_youngs(1.8 * PhysicalParameters::of(model).youngs_modulus,
+                             PhysicalParameters::of(model).poisson_ratio, model.material.density);
     truth.grips[0].offset = Eigen::Translation3d(0.004 * Vec3(1, 1, -1).normalized()) *
                             Eigen::AngleAxisd(3 * M_PI / 180, Vec3(0, 1, 1).normalized());
     const Eigen::VectorXd reference = model.robot->reference_joints;
@@ -61,7 +62,8 @@ void expect_truth_recovered(const SyntheticStudy& study, const CalibrationResult
     const Eigen::Isometry3d& truth = study.truth.grips[g].offset;
     const Eigen::Isometry3d& fitted = r.fitted.grip_offsets[g];
     EXPECT_LT((fitted.translation() - truth.translation()).norm(), 0.0005) << "grip " << g;
-    EXPECT_LT(Eigen::AngleAxisd(fitted.linear() * truth.linear().transpose()).angle(), 0.5 * M_PI / 180)
+    EXPECT_LT(Eigen::AngleAxisd(fitted.linear() * truth.linear().transpose()).angle(),
+              0.5 * M_PI / 180)
         << "grip " << g;
   }
   // Residuals at the noise level: χ² per degree of freedom near 1, far below the start.
@@ -98,7 +100,8 @@ TEST(Calibration, StiffnessAndDensityFromShapeAloneAreReportedUnidentifiable) {
   SimulatedCamera camera;
   camera.marker_nodes = spread_nodes(study.model.object_mesh->node_count(), 15, 7);
   const Observations observations = study.observe(camera, 13);
-  const CalibrationResult r = calibrate(study.model, observations, parse_fit_selection("youngs_modulus,density"));
+  const CalibrationResult r =
+      calibrate(study.model, observations, parse_fit_selection("youngs_modulus,density"));
   ASSERT_EQ(r.unidentified.size(), 1u);
   EXPECT_EQ(r.unidentified[0].held, "density");
   ASSERT_EQ(r.unidentified[0].combination.size(), 2u);  // youngs_modulus and density together

@@ -22,8 +22,9 @@ namespace {
 // 4 mm / 3° off at each grip.
 Scene world_of(const Scene& model) {
   Scene world = model;
-  world.material = material_from_youngs(1.5 * youngs_modulus_of(model.material), poisson_ratio_of(model.material),
-                                        0.8 * model.material.density);
+  world.material =
+      material_from_youngs(1.5 * youngs_modulus_of(model.material),
+                           poisson_ratio_of(model.material), 0.8 * model.material.density);
   world.grips[0].offset = Eigen::Translation3d(0.004 * Vec3(0, 1, -1).normalized()) *
                           Eigen::AngleAxisd(3 * M_PI / 180, Vec3(0, 0, 1));
   world.grips[1].offset = Eigen::Translation3d(0.004 * Vec3(1, 0, 1).normalized()) *
@@ -33,7 +34,8 @@ Scene world_of(const Scene& model) {
 
 double true_error(const ShapeTargets& targets, const Positions& world) {
   double sum = 0;
-  for (int k = 0; k < targets.size(); ++k) sum += (world.segment<3>(3 * targets.nodes[k]) - targets.positions[k]).norm();
+  for (int k = 0; k < targets.size(); ++k)
+    sum += (world.segment<3>(3 * targets.nodes[k]) - targets.positions[k]).norm();
   return sum / targets.size();
 }
 
@@ -41,7 +43,8 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
   const Scene model_scene = load_scene(test::source_path("scenes/yumi_bar.json"));
   const GrippedObject model(model_scene), world(world_of(model_scene));
   ReducedObjective objective(model);
-  const Evaluation reference = objective.evaluate(model.reference_joints(), model.reference_positions());
+  const Evaluation reference =
+      objective.evaluate(model.reference_joints(), model.reference_positions());
 
   // Targets: the model's own shape at other joints (reachable by the model), 12 nodes, each
   // carrying a tracked marker.
@@ -54,7 +57,9 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
   std::vector<int> nodes(model.node_count());
   std::iota(nodes.begin(), nodes.end(), 0);
   std::shuffle(nodes.begin(), nodes.end(), rng);
-  for (int k = 0; k < 12; ++k) targets.nodes.push_back(nodes[k]), targets.positions.push_back(at_goal.positions.segment<3>(3 * nodes[k]));
+  for (int k = 0; k < 12; ++k)
+    targets.nodes.push_back(nodes[k]),
+        targets.positions.push_back(at_goal.positions.segment<3>(3 * nodes[k]));
   SimulatedCamera camera;
   camera.marker_nodes = targets.nodes;
   camera.sigma = 0.0003;
@@ -73,7 +78,8 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
   // Closed loop: observe the world at the joints reached, correct the targets, optimize on.
   ModelErrorFeedback feedback(model_scene.object_mesh);
   for (int round = 0; round < 12; ++round) {
-    const ObservationFrame frame = camera.observe(world.mesh(), truth.positions(), result.best.joints, rng);
+    const ObservationFrame frame =
+        camera.observe(world.mesh(), truth.positions(), result.best.joints, rng);
     std::vector<std::pair<int, Vec3>> observed;
     for (const ObservedMarker& m : frame.markers) observed.emplace_back(m.node, m.position);
     feedback.observe(observed, result.best.positions);
@@ -102,7 +108,8 @@ TEST(ClosedLoop, TheControllerWithFeedbackOnReachesTheTargetsOnTheObservedBar) {
   ShapeTargets targets;
   std::mt19937 rng(9);
   for (int node = 0; node < world.node_count(); node += 37)
-    targets.nodes.push_back(node), targets.positions.push_back(at_goal.positions().segment<3>(3 * node));
+    targets.nodes.push_back(node),
+        targets.positions.push_back(at_goal.positions().segment<3>(3 * node));
   SimulatedCamera camera;
   camera.marker_nodes = targets.nodes;
 
@@ -111,13 +118,15 @@ TEST(ClosedLoop, TheControllerWithFeedbackOnReachesTheTargetsOnTheObservedBar) {
   ObjectState truth = equilibrium_along_path(world, first->joints);
   std::shared_ptr<const ControllerSnapshot> s;
   for (int observation = 0; observation < 15; ++observation) {
-    for (int k = 0; k < 10; ++k) controller.step_once();  // the optimizer's iterations between frames
+    for (int k = 0; k < 10; ++k)
+      controller.step_once();  // the optimizer's iterations between frames
     s = controller.snapshot();
     ASSERT_TRUE(s->safe);
     truth = world.solve_from(s->joints, truth.positions());
     ASSERT_TRUE(truth.statics().converged()) << truth.statics().reason;
     const ObservationFrame frame = camera.observe(world.mesh(), truth.positions(), s->joints, rng);
-    ShapeObservation o{.joints = s->joints};
+    ShapeObservation o;
+    o.joints = s->joints;
     for (const ObservedMarker& m : frame.markers) o.markers.emplace_back(m.node, m.position);
     controller.observe(o);
   }
@@ -125,34 +134,47 @@ TEST(ClosedLoop, TheControllerWithFeedbackOnReachesTheTargetsOnTheObservedBar) {
   s = controller.snapshot();
   EXPECT_TRUE(s->feedback);
   EXPECT_EQ(s->observations, 15u);
-  EXPECT_GT(s->model_error, 2e-3);       // the model is wrong by millimetres...
-  EXPECT_LT(s->observed_error, 1e-3);    // ...and the observed bar is at the targets anyway
+  EXPECT_GT(s->model_error, 2e-3);     // the model is wrong by millimetres...
+  EXPECT_LT(s->observed_error, 1e-3);  // ...and the observed bar is at the targets anyway
   EXPECT_LT(true_error(targets, truth.positions()), 1e-3);
-  EXPECT_EQ(s->targets.positions[0], targets.positions[0]);  // the user's targets, not the aimed ones
+  EXPECT_EQ(s->targets.positions[0],
+            targets.positions[0]);  // the user's targets, not the aimed ones
 }
 
 TEST(ClosedLoop, ABadObservationIsRefusedAndChangesNothing) {
   Controller controller(load_scene(test::source_path("scenes/yumi_bar.json")));
   const auto before = controller.snapshot();
-  EXPECT_THROW(controller.observe({.joints = before->joints, .markers = {{100000, Vec3::Zero()}}}), InputError);
-  EXPECT_THROW(controller.observe({.joints = before->joints, .markers = {{0, Vec3(NAN, 0, 0)}}}), InputError);
-  EXPECT_THROW(controller.observe({.joints = Eigen::VectorXd::Zero(3), .markers = {{0, Vec3::Zero()}}}), InputError);
-  EXPECT_THROW(controller.observe({.joints = before->joints, .markers = {}}), InputError);
+  EXPECT_THROW(controller.observe(
+                   {.joints = before->joints, .markers = {{100000, Vec3::Zero()}}, .time = 0}),
+               InputError);
+  EXPECT_THROW(controller.observe(
+                   {.joints = before->joints, .markers = {{0, Vec3(NAN, 0, 0)}}, .time = 0}),
+               InputError);
+  EXPECT_THROW(controller.observe(
+                   {.joints = Eigen::VectorXd::Zero(3), .markers = {{0, Vec3::Zero()}}, .time = 0}),
+               InputError);
+  EXPECT_THROW(controller.observe({.joints = before->joints, .markers = {}, .time = 0}),
+               InputError);
   controller.step_once();
   EXPECT_EQ(controller.snapshot()->observations, 0u);
 }
 
 TEST(ModelErrorFeedback, UnobservedNodesTakeTheirNeighboursEstimateAndCorrectionsAreClamped) {
   const Scene scene = load_scene(test::source_path("scenes/yumi_bar.json"));
-  ModelErrorFeedback feedback(scene.object_mesh, {.gain = 1, .max_correction = 0.01, .neighbours = 1});
+  ModelErrorFeedback feedback(scene.object_mesh,
+                              {.gain = 1, .max_correction = 0.01, .neighbours = 1});
   const Positions predicted = scene.world_rest_positions();
   const Vec3 shift(0.002, 0, -0.001);
-  feedback.observe({{0, predicted.segment<3>(0) + shift}, {5, predicted.segment<3>(15) + Vec3(1, 0, 0)}}, predicted);
+  feedback.observe({{0, predicted.segment<3>(0) + shift},
+                    {5, predicted.segment<3>(15) + Vec3(1, 0, 0)}},
+                   predicted);
   EXPECT_LT((feedback.estimate(0) - shift).norm(), 1e-15);
   EXPECT_NEAR(feedback.estimate(5).norm(), 0.01, 1e-15);  // a 1 m "error" clamped to 1 cm
   // Node 1 is next to node 0 at rest: it takes node 0's estimate (one neighbour).
-  const double d0 = (scene.object_mesh->rest_positions()[1] - scene.object_mesh->rest_positions()[0]).norm();
-  const double d5 = (scene.object_mesh->rest_positions()[1] - scene.object_mesh->rest_positions()[5]).norm();
+  const double d0 =
+      (scene.object_mesh->rest_positions()[1] - scene.object_mesh->rest_positions()[0]).norm();
+  const double d5 =
+      (scene.object_mesh->rest_positions()[1] - scene.object_mesh->rest_positions()[5]).norm();
   ASSERT_LT(d0, d5);
   EXPECT_LT((feedback.estimate(1) - shift).norm(), 1e-15);
   const ShapeTargets t = feedback.corrected({{1}, {Vec3(1, 2, 3)}});

@@ -13,7 +13,8 @@ Scene offset_scene() {
   Scene scene = test::two_arm_scene({12, 2, 2});
   for (auto& ee : scene.robot->end_effectors) ee.tcp_link = Vec3(0.01, -0.004, 0.006);
   scene.grips[0].offset.translation() = Vec3(0.002, -0.001, 0.003);
-  scene.grips[0].offset.linear() = Eigen::AngleAxisd(0.04, Vec3(1, 2, -1).normalized()).toRotationMatrix();
+  scene.grips[0].offset.linear() =
+      Eigen::AngleAxisd(0.04, Vec3(1, 2, -1).normalized()).toRotationMatrix();
   scene.grips[1].offset.translation() = Vec3(-0.003, 0.002, 0.0);
   scene.statics.relative_tolerance = 1e-12;
   return scene;
@@ -28,7 +29,10 @@ Positions equilibrium(const Scene& scene, const Eigen::VectorXd& joints, const P
 
 TEST(ParameterSensitivity, EveryFittableParameterMatchesCentralDifferences) {
   const Scene scene = offset_scene();
-  const FitSelection all{.youngs_modulus = true, .poisson_ratio = true, .density = true, .grip_offsets = true};
+  const FitSelection all{.youngs_modulus = true,
+                         .poisson_ratio = true,
+                         .density = true,
+                         .grip_offsets = true};
   const ParameterSpace space(scene, all);
   ASSERT_EQ(space.size(), 3 + 12);
   const PhysicalParameters p = PhysicalParameters::of(scene);
@@ -38,7 +42,8 @@ TEST(ParameterSensitivity, EveryFittableParameterMatchesCentralDifferences) {
   joints += Eigen::VectorXd::LinSpaced(joints.size(), -0.08, 0.1);
   ObjectState state = object.solve_from(joints, object.reference_positions());
   ASSERT_TRUE(state.statics().converged()) << state.statics().reason;
-  const Eigen::MatrixXd dx_dz = object.force_response(state, space.force_derivatives(object, state, p));
+  const Eigen::MatrixXd dx_dz =
+      object.force_response(state, space.force_derivatives(object, state, p));
 
   // Column by column, each coordinate stepped in units of its scale: a small column is checked
   // against its own size, not hidden by a large one.
@@ -49,8 +54,10 @@ TEST(ParameterSensitivity, EveryFittableParameterMatchesCentralDifferences) {
       dz[k] = c.scale * u[0];
       return equilibrium(space.advanced(p, dz).applied_to(scene), joints, state.positions());
     };
-    const Eigen::MatrixXd numeric = test::central_difference_jacobian(moved, Eigen::VectorXd::Zero(1), 1e-4);
-    EXPECT_TRUE(test::derivative_matches(dx_dz.col(k) * c.scale, numeric, 1e-5, c.name, 1e-6 * c.scale));
+    const Eigen::MatrixXd numeric =
+        test::central_difference_jacobian(moved, Eigen::VectorXd::Zero(1), 1e-4);
+    EXPECT_TRUE(
+        test::derivative_matches(dx_dz.col(k) * c.scale, numeric, 1e-5, c.name, 1e-6 * c.scale));
   }
 }
 

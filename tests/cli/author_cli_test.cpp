@@ -46,17 +46,21 @@ std::vector<Primitive> primitives() {
 Eigen::Isometry3d pose(const Primitive& p) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   T.translation() = p.xyz;
-  T.linear() = (Eigen::AngleAxisd(p.rpy.z(), Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(p.rpy.y(), Eigen::Vector3d::UnitY()) *
-                Eigen::AngleAxisd(p.rpy.x(), Eigen::Vector3d::UnitX())).toRotationMatrix();
+  T.linear() = (Eigen::AngleAxisd(p.rpy.z(), Eigen::Vector3d::UnitZ()) *
+                Eigen::AngleAxisd(p.rpy.y(), Eigen::Vector3d::UnitY()) *
+                Eigen::AngleAxisd(p.rpy.x(), Eigen::Vector3d::UnitX()))
+                   .toRotationMatrix();
   return T;
 }
 
 std::string geometry(const Primitive& p) {
   std::ostringstream g;
   g.precision(17);
-  g << "<collision><origin xyz='" << p.xyz.transpose() << "' rpy='" << p.rpy.transpose() << "'/><geometry>";
+  g << "<collision><origin xyz='" << p.xyz.transpose() << "' rpy='" << p.rpy.transpose()
+    << "'/><geometry>";
   if (p.kind == "box") g << "<box size='" << p.size.transpose() << "'/>";
-  if (p.kind == "cylinder") g << "<cylinder radius='" << p.radius << "' length='" << p.length << "'/>";
+  if (p.kind == "cylinder")
+    g << "<cylinder radius='" << p.radius << "' length='" << p.length << "'/>";
   if (p.kind == "sphere") g << "<sphere radius='" << p.radius << "'/>";
   if (p.kind == "mesh") g << "<mesh filename='package://two_arms/meshes/hand.obj'/>";
   g << "</geometry></collision>";
@@ -67,21 +71,29 @@ std::string geometry(const Primitive& p) {
 std::string urdf() {
   std::map<std::string, std::string> links;
   for (const auto& p : primitives()) links[p.link] += geometry(p);
-  links["r_link3"] += "<collision><origin xyz='0.17 0 0'/><geometry><mesh filename='package://two_arms/meshes/missing.stl'/></geometry></collision>";
-  auto link = [&](const std::string& name) { return "<link name='" + name + "'>" + links[name] + "</link>"; };
-  auto joint = [](const std::string& name, const std::string& parent, const std::string& child, const std::string& xyz,
-                  const std::string& axis, const std::string& limit) {
-    return "<joint name='" + name + "' type='revolute'><parent link='" + parent + "'/><child link='" + child +
-           "'/><origin xyz='" + xyz + "'/><axis xyz='" + axis + "'/><limit lower='-" + limit + "' upper='" + limit +
+  links["r_link3"] +=
+      "<collision><origin xyz='0.17 0 0'/><geometry><mesh "
+      "filename='package://two_arms/meshes/missing.stl'/></geometry></collision>";
+  auto link = [&](const std::string& name) {
+    return "<link name='" + name + "'>" + links[name] + "</link>";
+  };
+  auto joint = [](const std::string& name, const std::string& parent, const std::string& child,
+                  const std::string& xyz, const std::string& axis, const std::string& limit) {
+    return "<joint name='" + name + "' type='revolute'><parent link='" + parent +
+           "'/><child link='" + child + "'/><origin xyz='" + xyz + "'/><axis xyz='" + axis +
+           "'/><limit lower='-" + limit + "' upper='" + limit +
            "' velocity='2' effort='1'/></joint>";
   };
   std::string xml = "<robot name='two_arms'>" + link("base");
   for (const std::string s : {"l", "r"}) {
-    xml += joint(s + "1", "base", s + "_link1", s == "l" ? "0 0.15 0" : "0 -0.15 0", "0 0 1", "2") + link(s + "_link1");
+    xml += joint(s + "1", "base", s + "_link1", s == "l" ? "0 0.15 0" : "0 -0.15 0", "0 0 1", "2") +
+           link(s + "_link1");
     xml += joint(s + "2", s + "_link1", s + "_link2", "0 0 0.1", "0 1 0", "2") + link(s + "_link2");
-    xml += joint(s + "3", s + "_link2", s + "_link3", "0.25 0 0", "0 1 0", "2.5") + link(s + "_link3");
-    xml += "<joint name='" + s + "_tool_joint' type='fixed'><parent link='" + s + "_link3'/><child link='" + s +
-           "_tool'/><origin xyz='0.2 0 0'/></joint>" + link(s + "_tool");
+    xml +=
+        joint(s + "3", s + "_link2", s + "_link3", "0.25 0 0", "0 1 0", "2.5") + link(s + "_link3");
+    xml += "<joint name='" + s + "_tool_joint' type='fixed'><parent link='" + s +
+           "_link3'/><child link='" + s + "_tool'/><origin xyz='0.2 0 0'/></joint>" +
+           link(s + "_tool");
   }
   return xml + "</robot>";
 }
@@ -124,8 +136,12 @@ struct Authored {
 };
 
 std::vector<std::string> author_args(const Authored& a) {
-  return {"author", a.urdf.string(), "--mesh", a.mesh.string(), "--end-effectors", "left=l_tool,right=r_tool",
-          "--package-path", (a.dir.path() / "pkg").string(), "--out", a.scene.string(), "--report", a.report.string()};
+  return {"author",          a.urdf.string(),
+          "--mesh",          a.mesh.string(),
+          "--end-effectors", "left=l_tool,right=r_tool",
+          "--package-path",  (a.dir.path() / "pkg").string(),
+          "--out",           a.scene.string(),
+          "--report",        a.report.string()};
 }
 
 void write_inputs(Authored& a) {
@@ -158,16 +174,18 @@ TEST(AuthorCli, ProposedSceneHoldsTheObjectAndSolvesWithinLimitsAndCollisionFree
 
   // Checked independently: kinematics at the reference joints with the written spheres ...
   const Json scene = read_json(a.scene);
-  const auto joints_file = a.dir.write("ref.json", Json{{"joints", scene["robot"]["reference_joints"]}}.dump());
+  const auto joints_file =
+      a.dir.write("ref.json", Json{{"joints", scene["robot"]["reference_joints"]}}.dump());
   const auto kinematics_out = a.dir.path() / "kin.json";
-  const auto kin = run_cli({"kinematics", a.urdf.string(), "--joints", joints_file.string(), "--spheres",
-                            a.spheres.string(), "--out", kinematics_out.string()});
+  const auto kin = run_cli({"kinematics", a.urdf.string(), "--joints", joints_file.string(),
+                            "--spheres", a.spheres.string(), "--out", kinematics_out.string()});
   ASSERT_EQ(kin.exit_code, 0) << kin.err;
   const Json kinematics = read_json(kinematics_out);
   EXPECT_TRUE(kinematics["limit_violations"].empty());
   EXPECT_GT(kinematics["min_clearance"].get<double>(), 0);
 
-  // ... statics at the reference: converged, each tool within a few mm of its gripped nodes' centre.
+  // ... statics at the reference: converged, each tool within a few mm of its gripped nodes'
+  // centre.
   const auto statics_out = a.dir.path() / "statics.json";
   const auto statics = run_cli({"statics", a.scene.string(), "--out", statics_out.string()});
   ASSERT_EQ(statics.exit_code, 0) << statics.err;
@@ -180,7 +198,8 @@ TEST(AuthorCli, ProposedSceneHoldsTheObjectAndSolvesWithinLimitsAndCollisionFree
       centre += Eigen::Vector3d(p[0], p[1], p[2]) / static_cast<double>(grip["nodes"].size());
     }
     const auto tool = equilibrium["tools"][grip["end_effector"].get<std::string>()]["position"];
-    EXPECT_LT((centre - Eigen::Vector3d(tool[0], tool[1], tool[2])).norm(), 5e-3) << grip["end_effector"];
+    EXPECT_LT((centre - Eigen::Vector3d(tool[0], tool[1], tool[2])).norm(), 5e-3)
+        << grip["end_effector"];
   }
 
   // ... and solve reaches targets taken from the shape at other joints.
@@ -190,13 +209,18 @@ TEST(AuthorCli, ProposedSceneHoldsTheObjectAndSolvesWithinLimitsAndCollisionFree
   moved["l3"] = moved["l3"].get<double>() + 0.05;
   const auto moved_file = a.dir.write("moved.json", Json{{"joints", moved}}.dump());
   const auto goal_out = a.dir.path() / "goal.json";
-  ASSERT_EQ(run_cli({"statics", a.scene.string(), "--joints", moved_file.string(), "--out", goal_out.string()}).exit_code, 0);
+  ASSERT_EQ(run_cli({"statics", a.scene.string(), "--joints", moved_file.string(), "--out",
+                     goal_out.string()})
+                .exit_code,
+            0);
   const Json goal = read_json(goal_out);
   Json targets = Json::array();
-  for (std::size_t i = 0; i < goal["positions"].size(); i += 7) targets.push_back({{"node", i}, {"position", goal["positions"][i]}});
+  for (std::size_t i = 0; i < goal["positions"].size(); i += 7)
+    targets.push_back({{"node", i}, {"position", goal["positions"][i]}});
   const auto targets_file = a.dir.write("targets.json", Json{{"targets", targets}}.dump());
   const auto solve_out = a.dir.path() / "solve.json";
-  const auto solve = run_cli({"solve", a.scene.string(), "--targets", targets_file.string(), "--out", solve_out.string()});
+  const auto solve = run_cli(
+      {"solve", a.scene.string(), "--targets", targets_file.string(), "--out", solve_out.string()});
   ASSERT_EQ(solve.exit_code, 0) << solve.err;
   const Json solved = read_json(solve_out);
   EXPECT_LT(solved["error_mean"].get<double>(), 1e-3);
@@ -217,7 +241,8 @@ TEST(AuthorCli, GeneratedSpheresCoverSampledPointsOfEveryCollisionPrimitive) {
     const auto& list = spheres["spheres"][p.link];
     for (int k = 0; k < 500; ++k) {
       Eigen::Vector3d local;
-      if (p.kind == "box" || p.kind == "mesh") local = Eigen::Vector3d(u(rng), u(rng), u(rng)).cwiseProduct(p.size);
+      if (p.kind == "box" || p.kind == "mesh")
+        local = Eigen::Vector3d(u(rng), u(rng), u(rng)).cwiseProduct(p.size);
       if (p.kind == "cylinder") {
         const double angle = 2 * M_PI * u(rng), r = p.radius * std::sqrt(u(rng) + 0.5);
         local = Eigen::Vector3d(r * std::cos(angle), r * std::sin(angle), p.length * u(rng));
@@ -238,7 +263,8 @@ TEST(AuthorCli, GeneratedSpheresCoverSampledPointsOfEveryCollisionPrimitive) {
   // Adjacent links are ignored pairs.
   bool shoulder = false;
   for (const auto& pair : spheres["ignore_pairs"])
-    shoulder = shoulder || (pair[0] == "l_link1" && pair[1] == "l_link2") || (pair[0] == "l_link2" && pair[1] == "l_link1");
+    shoulder = shoulder || (pair[0] == "l_link1" && pair[1] == "l_link2") ||
+               (pair[0] == "l_link2" && pair[1] == "l_link1");
   EXPECT_TRUE(shoulder) << spheres["ignore_pairs"];
 }
 
@@ -263,12 +289,15 @@ TEST(AuthorCli, BadInputIsExitOneNamingTheFieldAndLeavesAnExistingSceneAlone) {
     std::string expected;
   };
   const std::vector<Case> cases{
-      {{"--end-effectors", "left=l_tool,right=nothing"}, "--end-effectors: expected NAME=LINK or LINK with a link of arms.urdf, got right=nothing"},
+      {{"--end-effectors", "left=l_tool,right=nothing"},
+       "--end-effectors: expected NAME=LINK or LINK with a link of arms.urdf, got right=nothing"},
       {{"--mesh", (a.dir.path() / "absent.obj").string()}, "absent.obj"},
       {{"--object-pose", "2,0,0.1"}, "--object-pose: "},
       {{"--object-pose", "0.3,0,zero"}, "--object-pose: expected X,Y,Z or X,Y,Z,ROLL,PITCH,YAW"},
-      {{"--grip-region", "left=1,1,1,2,2,2"}, "--grip-region: expected a grip region for end effector 'left'"},
-      {{"--tool-offset", "middle=0,0,0"}, "--tool-offset: expected the name of one of --end-effectors"},
+      {{"--grip-region", "left=1,1,1,2,2,2"},
+       "--grip-region: expected a grip region for end effector 'left'"},
+      {{"--tool-offset", "middle=0,0,0"},
+       "--tool-offset: expected the name of one of --end-effectors"},
   };
   for (const auto& c : cases) {
     std::vector<std::string> args = author_args(a);

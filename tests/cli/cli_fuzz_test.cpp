@@ -5,9 +5,9 @@
 // complete, finite "converged": false result when Newton fails: exit 2).
 #include <gtest/gtest.h>
 
-#include <nlohmann/json.hpp>
 #include <cmath>
 #include <iostream>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "io/text_mutator.hpp"
@@ -40,10 +40,37 @@ std::string small_yumi_scene() {
   return json.dump(1);
 }
 
-const test::TextMutator kMutator({"{", "[", "]", "}", ",", ":", "\"", "1e999", "-1e308", "1e-400", "1e300",
-                                  "1e155", "-1e300", "-0", "0", "-1", "NaN", "null", "true", "\"x\"", "[]", "{}",
-                                  "[1000, 1000, 1000]", "[0, 0, 0]", "1e-13", "2147483648", "\xff", "\xc3",
-                                  "<link name=\"a\xfe\"/>", "<joint name=\"j\" type=\"floating\">", "nan"});
+const test::TextMutator kMutator({"{",
+                                  "[",
+                                  "]",
+                                  "}",
+                                  ",",
+                                  ":",
+                                  "\"",
+                                  "1e999",
+                                  "-1e308",
+                                  "1e-400",
+                                  "1e300",
+                                  "1e155",
+                                  "-1e300",
+                                  "-0",
+                                  "0",
+                                  "-1",
+                                  "NaN",
+                                  "null",
+                                  "true",
+                                  "\"x\"",
+                                  "[]",
+                                  "{}",
+                                  "[1000, 1000, 1000]",
+                                  "[0, 0, 0]",
+                                  "1e-13",
+                                  "2147483648",
+                                  "\xff",
+                                  "\xc3",
+                                  "<link name=\"a\xfe\"/>",
+                                  "<joint name=\"j\" type=\"floating\">",
+                                  "nan"});
 
 TEST(CliFuzz, MutatedInputsExitCleanlyAndNeverDamageAnExistingResult) {
   const test::TempDir dir;
@@ -51,7 +78,8 @@ TEST(CliFuzz, MutatedInputsExitCleanlyAndNeverDamageAnExistingResult) {
   const std::string joints = R"({"joints": {"yumi_joint_1_l": -0.05, "yumi_joint_2_r": -0.12}})";
   const std::string targets =
       R"({"targets": [{"node": 3, "position": [0.39, 0.02, 0.26]}, {"node": 40, "position": [0.4, -0.1, 0.27]}]})";
-  const std::string centerline = R"({"centerline": [[0.39, 0.16, 0.255], [0.395, 0, 0.27], [0.39, -0.16, 0.255]]})";
+  const std::string centerline =
+      R"({"centerline": [[0.39, 0.16, 0.255], [0.395, 0, 0.27], [0.39, -0.16, 0.255]]})";
   const std::string urdf = test::two_arm_urdf();
   const std::string arm_joints = R"({"joints": {"l1": 0.3, "r2": -0.4}})";
   const std::string spheres =
@@ -75,24 +103,33 @@ TEST(CliFuzz, MutatedInputsExitCleanlyAndNeverDamageAnExistingResult) {
     std::string command;
     if (kind <= 1) {
       command = "statics";
-      args = {"statics", file("scene.json", scene, target == 0), "--joints", file("joints.json", joints, target == 1)};
+      args = {"statics", file("scene.json", scene, target == 0), "--joints",
+              file("joints.json", joints, target == 1)};
     } else if (kind <= 3) {
       command = "solve";
       const int which = static_cast<int>(rng() % 3);
-      args = {"solve", file("scene.json", scene, which == 0), "--targets",
-              file("targets.json", kind == 2 ? targets : centerline, which != 0), "--max-iterations", "2",
-              "--max-seconds", "2", "--optimizer", run % 4 < 2 ? "gauss-newton" : "lbfgs"};
+      args = {"solve",
+              file("scene.json", scene, which == 0),
+              "--targets",
+              file("targets.json", kind == 2 ? targets : centerline, which != 0),
+              "--max-iterations",
+              "2",
+              "--max-seconds",
+              "2",
+              "--optimizer",
+              run % 4 < 2 ? "gauss-newton" : "lbfgs"};
     } else {
       command = "kinematics";
       const int which = static_cast<int>(rng() % 3);
-      args = {"kinematics", file("arm.urdf", urdf, which == 0), "--joints", file("arm_joints.json", arm_joints, which == 1),
-              "--spheres", file("spheres.json", spheres, which == 2)};
+      args = {"kinematics", file("arm.urdf", urdf, which == 0),
+              "--joints",   file("arm_joints.json", arm_joints, which == 1),
+              "--spheres",  file("spheres.json", spheres, which == 2)};
     }
     args.insert(args.end(), {"--out", out.string()});
     dir.write("out.json", previous);
     const int code = run_with_timeout(args, log);
-    const std::string what = "run " + std::to_string(run) + " (" + command + "): exit " + std::to_string(code) +
-                             "\n" + test::read_text(log).substr(0, 600);
+    const std::string what = "run " + std::to_string(run) + " (" + command + "): exit " +
+                             std::to_string(code) + "\n" + test::read_text(log).substr(0, 600);
     ASSERT_TRUE(code == 0 || code == 1 || code == 2) << what;
     ++exits[code];
     const std::string written = test::read_text(out);
@@ -111,7 +148,8 @@ TEST(CliFuzz, MutatedInputsExitCleanlyAndNeverDamageAnExistingResult) {
   }
   // The mutations reach both the parsers and the computations behind them (most are refused:
   // the formats are checked strictly).
-  std::cout << "exit 0: " << exits[0] << ", exit 1: " << exits[1] << ", exit 2: " << exits[2] << "\n";
+  std::cout << "exit 0: " << exits[0] << ", exit 1: " << exits[1] << ", exit 2: " << exits[2]
+            << "\n";
   EXPECT_GE(exits[0], kRuns / 40);
   EXPECT_GT(exits[1], kRuns / 4);
 }

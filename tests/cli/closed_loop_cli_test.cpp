@@ -22,7 +22,8 @@ using test::TempDir;
 
 const std::filesystem::path kBar = test::source_path("scenes/yumi_bar.json");
 
-std::vector<nlohmann::json> log_events(const std::filesystem::path& file, const std::string& event) {
+std::vector<nlohmann::json> log_events(const std::filesystem::path& file,
+                                       const std::string& event) {
   std::vector<nlohmann::json> out;
   std::ifstream in(file);
   for (std::string line; std::getline(in, line);) {
@@ -38,8 +39,9 @@ class ClosedLoopCli : public ::testing::Test {
     // The world: 1.5× stiffer, 0.8× as dense, each grip 4 mm off (and turned 3°).
     const Scene model = load_scene(kBar);
     Scene world = model;
-    world.material = material_from_youngs(1.5 * youngs_modulus_of(model.material), poisson_ratio_of(model.material),
-                                          0.8 * model.material.density);
+    world.material =
+        material_from_youngs(1.5 * youngs_modulus_of(model.material),
+                             poisson_ratio_of(model.material), 0.8 * model.material.density);
     world.grips[0].offset = Eigen::Translation3d(0.004 * Vec3(0, 1, -1).normalized()) *
                             Eigen::AngleAxisd(3 * M_PI / 180, Vec3::UnitZ());
     world.grips[1].offset = Eigen::Translation3d(0.004 * Vec3(1, 0, 1).normalized()) *
@@ -54,8 +56,8 @@ class ClosedLoopCli : public ::testing::Test {
     for (int node = 0; node < model.object_mesh->node_count(); node += 37)
       targets.push_back({{"node", node}, {"position", vec3_json(arch.segment<3>(3 * node))}});
     targets_file = dir.write("targets.json", nlohmann::json{{"targets", targets}}.dump());
-    args = {"run", kBar.string(), "--targets", targets_file.string(), "--robot", "sim", "--arm", "--world",
-            world_file.string(), "--until-settled", "--timeout", "60"};
+    args = {"run",   kBar.string(), "--targets",         targets_file.string(), "--robot",   "sim",
+            "--arm", "--world",     world_file.string(), "--until-settled",     "--timeout", "60"};
   }
 
   nlohmann::json run(std::vector<std::string> extra) {
@@ -97,26 +99,31 @@ TEST_F(ClosedLoopCli, FeedbackBringsTheWorldToTargetsTheOpenLoopMisses) {
   const double T = link["period"].get<double>();
   std::vector<nlohmann::json> ticks;
   for (const auto& c : log_events(log, "command")) {
-    if (!ticks.empty() && c["t"].get<double>() - ticks.back()["t"].get<double>() < 0.5 * T) ticks.back() = c;
+    if (!ticks.empty() && c["t"].get<double>() - ticks.back()["t"].get<double>() < 0.5 * T)
+      ticks.back() = c;
     else ticks.push_back(c);
   }
   ASSERT_GT(ticks.size(), 100u);
   const auto q = [&](std::size_t k, std::size_t j) { return ticks[k]["joints"][j].get<double>(); };
-  const auto gap = [&](std::size_t k) { return ticks[k]["t"].get<double>() - ticks[k - 1]["t"].get<double>(); };
+  const auto gap = [&](std::size_t k) {
+    return ticks[k]["t"].get<double>() - ticks[k - 1]["t"].get<double>();
+  };
   for (std::size_t k = 1; k < ticks.size(); ++k)
     for (std::size_t j = 0; j < link["velocity"].size(); ++j) {
       const double step = q(k, j) - q(k - 1, j);
-      ASSERT_LE(std::abs(step), link["velocity"][j].get<double>() * T * (1 + 1e-9) + 1e-12) << "tick " << k << ", joint " << j;
+      ASSERT_LE(std::abs(step), link["velocity"][j].get<double>() * T * (1 + 1e-9) + 1e-12)
+          << "tick " << k << ", joint " << j;
       if (k < 2 || gap(k) > 1.5 * T || gap(k - 1) > 1.5 * T) continue;
       const double before = q(k - 1, j) - q(k - 2, j);
-      ASSERT_LE(std::abs(step - before), link["acceleration"][j].get<double>() * T * T * (1 + 1e-9) + 1e-12)
+      ASSERT_LE(std::abs(step - before),
+                link["acceleration"][j].get<double>() * T * T * (1 + 1e-9) + 1e-12)
           << "tick " << k << ", joint " << j;
     }
 }
 
 TEST_F(ClosedLoopCli, AWorldNeedsTheSimulatedRobotAndTheModelsMesh) {
-  auto r = run_cli({"run", kBar.string(), "--targets", targets_file.string(), "--robot", "egm", "--world",
-                    (dir.path() / "world.json").string()});
+  auto r = run_cli({"run", kBar.string(), "--targets", targets_file.string(), "--robot", "egm",
+                    "--world", (dir.path() / "world.json").string()});
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("--world"), std::string::npos) << r.err;
   r = run_cli({"run", kBar.string(), "--targets", targets_file.string(), "--world",

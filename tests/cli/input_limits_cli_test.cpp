@@ -19,14 +19,16 @@ std::string deep_json(const std::string& key) {
 void expect_bad_input(const std::vector<std::string>& args, const std::string& message) {
   const auto run = run_cli(args);
   EXPECT_EQ(run.exit_code, 1) << run.err;
-  EXPECT_NE(run.err.find(message), std::string::npos) << "stderr: " << run.err << "\nexpected: " << message;
+  EXPECT_NE(run.err.find(message), std::string::npos)
+      << "stderr: " << run.err << "\nexpected: " << message;
 }
 
 TEST(InputLimitsCli, DeeplyNestedSceneTargetsAndJointsExitOne) {
   const TempDir dir;
   const std::string out = (dir.path() / "r.json").string();
   const auto scene = dir.write("scene.json", deep_json("object"));
-  expect_bad_input({"statics", scene.string(), "--out", out}, scene.string() + ":1: JSON nested deeper than 64 levels");
+  expect_bad_input({"statics", scene.string(), "--out", out},
+                   scene.string() + ":1: JSON nested deeper than 64 levels");
   const auto joints = dir.write("joints.json", deep_json("joints"));
   expect_bad_input({"statics", kBar, "--joints", joints.string(), "--out", out},
                    joints.string() + ":1: JSON nested deeper than 64 levels");
@@ -46,8 +48,10 @@ TEST(InputLimitsCli, FifoSceneExitsOneWithoutWaiting) {
 
 TEST(InputLimitsCli, DuplicateKeyInJointsExitsOne) {
   const TempDir dir;
-  const auto joints = dir.write("joints.json", R"({"joints": {"yumi_joint_1_l": 0.1, "yumi_joint_1_l": 0.2}})");
-  expect_bad_input({"statics", kBar, "--joints", joints.string(), "--out", (dir.path() / "r.json").string()},
+  const auto joints =
+      dir.write("joints.json", R"({"joints": {"yumi_joint_1_l": 0.1, "yumi_joint_1_l": 0.2}})");
+  expect_bad_input({"statics", kBar, "--joints", joints.string(), "--out",
+                    (dir.path() / "r.json").string()},
                    joints.string() + ": joints.yumi_joint_1_l: duplicate key");
 }
 

@@ -33,7 +33,8 @@ const char* const kArmUrdf = R"(<?xml version="1.0"?>
 void expect_error(const std::vector<std::string>& args, const std::string& message) {
   const test::CliRun run = run_cli(args);
   EXPECT_EQ(run.exit_code, 1) << run.err;
-  EXPECT_NE(run.err.find(message), std::string::npos) << "stderr: " << run.err << "\nexpected: " << message;
+  EXPECT_NE(run.err.find(message), std::string::npos)
+      << "stderr: " << run.err << "\nexpected: " << message;
 }
 
 TEST(KinematicsCli, WritesLinkPosesClearancesAndLimitViolations) {
@@ -68,9 +69,12 @@ TEST(KinematicsCli, MissingMeshesAreSkippedWithAWarning) {
   const auto urdf = dir.write("arm.urdf", kArmUrdf);
   const auto joints = dir.write("joints.json", R"({"joints": {"shoulder": 1.5707963267948966}})");
   const auto out = dir.path() / "out.json";
-  const test::CliRun run = run_cli({"kinematics", urdf.string(), "--joints", joints.string(), "--out", out.string()});
+  const test::CliRun run =
+      run_cli({"kinematics", urdf.string(), "--joints", joints.string(), "--out", out.string()});
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_NE(run.err.find("warning: " + urdf.string() + ": 1 mesh geometries skipped"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("warning: " + urdf.string() + ": 1 mesh geometries skipped"),
+            std::string::npos)
+      << run.err;
   EXPECT_NE(run.err.find("package://arm_description/meshes/upper.stl"), std::string::npos);
   const auto json = nlohmann::json::parse(test::read_text(out));
   const auto& rotation = json["links"]["upper"]["rotation"];
@@ -88,9 +92,11 @@ TEST(KinematicsCli, MissingFilesAreNamed) {
   const std::string out = (dir.path() / "out.json").string();
   expect_error({"kinematics", (dir.path() / "nope.urdf").string(), "--out", out},
                (dir.path() / "nope.urdf").string() + ": cannot open file");
-  expect_error({"kinematics", urdf.string(), "--joints", (dir.path() / "j.json").string(), "--out", out},
+  expect_error({"kinematics", urdf.string(), "--joints", (dir.path() / "j.json").string(), "--out",
+                out},
                (dir.path() / "j.json").string() + ": cannot open file");
-  expect_error({"kinematics", urdf.string(), "--spheres", (dir.path() / "s.json").string(), "--out", out},
+  expect_error({"kinematics", urdf.string(), "--spheres", (dir.path() / "s.json").string(), "--out",
+                out},
                (dir.path() / "s.json").string() + ": cannot open file");
 }
 
@@ -98,7 +104,8 @@ TEST(KinematicsCli, UrdfErrorsNameTheFileAndTheElement) {
   const TempDir dir;
   const std::string out = (dir.path() / "out.json").string();
   const auto broken = dir.write("broken.urdf", "<robot name=\"x\"><link name=\"a\"></robot>");
-  expect_error({"kinematics", broken.string(), "--out", out}, broken.string() + ": not a valid URDF");
+  expect_error({"kinematics", broken.string(), "--out", out},
+               broken.string() + ": not a valid URDF");
 
   std::string bad_limit = kArmUrdf;
   bad_limit.replace(bad_limit.find("lower=\"-1\""), 10, "lower=\"2.1\"");
@@ -121,7 +128,8 @@ TEST(KinematicsCli, KinematicLoopsAreRejected) {
   </joint>
 </robot>)");
   const auto loop = dir.write("loop.urdf", two_parents);
-  expect_error({"kinematics", loop.string(), "--out", out}, "(kinematic loop; URDF must be a tree)");
+  expect_error({"kinematics", loop.string(), "--out", out},
+               "(kinematic loop; URDF must be a tree)");
   expect_error({"kinematics", loop.string(), "--out", out}, "already has parent joint");
 
   std::string detached_cycle = kArmUrdf;
@@ -130,7 +138,8 @@ TEST(KinematicsCli, KinematicLoopsAreRejected) {
   <joint name="qp" type="fixed"><parent link="q"/><child link="p"/></joint>
 </robot>)");
   const auto cycle = dir.write("cycle.urdf", detached_cycle);
-  expect_error({"kinematics", cycle.string(), "--out", out}, "not reachable from the root link 'base'");
+  expect_error({"kinematics", cycle.string(), "--out", out},
+               "not reachable from the root link 'base'");
 }
 
 TEST(KinematicsCli, JointFileErrorsNameTheFileAndTheJoint) {
@@ -154,7 +163,8 @@ TEST(KinematicsCli, SphereFileErrorsNameTheFileAndTheLink) {
   const auto spheres = dir.write("spheres.json", R"({"spheres": {"yumi_link_9_l": []}})");
   expect_error({"kinematics", kYumi, "--spheres", spheres.string(), "--out", out},
                spheres.string() + ": spheres.yumi_link_9_l: unknown link 'yumi_link_9_l'");
-  const auto ignore = dir.write("ignore.json", R"({"spheres": {}, "ignore_pairs": [["yumi_body"]]})");
+  const auto ignore =
+      dir.write("ignore.json", R"({"spheres": {}, "ignore_pairs": [["yumi_body"]]})");
   expect_error({"kinematics", kYumi, "--spheres", ignore.string(), "--out", out},
                ignore.string() + ": ignore_pairs[0]: expected a pair of link names");
 }
@@ -184,7 +194,8 @@ TEST(KinematicsCli, OutThatIsADirectoryIsNamed) {
   const TempDir dir;
   dir.write("out.json/keep.txt", "kept");
   const auto out = dir.path() / "out.json";
-  expect_error({"kinematics", kYumi, "--out", out.string()}, out.string() + ": cannot write: it is a directory");
+  expect_error({"kinematics", kYumi, "--out", out.string()},
+               out.string() + ": cannot write: it is a directory");
   EXPECT_EQ(test::read_text(out / "keep.txt"), "kept");
 }
 

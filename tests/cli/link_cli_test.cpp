@@ -24,13 +24,15 @@ std::filesystem::path small_yumi_scene(const TempDir& dir) {
 }
 
 std::filesystem::path lift_targets(const TempDir& dir) {
-  return dir.write("targets.json", R"({"centerline": [[0.39047, -0.15, 0.28], [0.39047, 0.15, 0.28]]})");
+  return dir.write("targets.json",
+                   R"({"centerline": [[0.39047, -0.15, 0.28], [0.39047, 0.15, 0.28]]})");
 }
 
 // A CLI process running in the background; stdout goes to a file.
 class Background {
  public:
-  Background(const std::vector<std::string>& args, std::filesystem::path out) : out_(std::move(out)) {
+  Background(const std::vector<std::string>& args, std::filesystem::path out)
+      : out_(std::move(out)) {
     pid_ = test::start_process(test::cli_command(args), out_, "/dev/null");
   }
   // Asks it to stop (SIGTERM) and returns its exit code and output.
@@ -58,8 +60,9 @@ int free_port_pair_base() {
 TEST(RunCli, SimRobotSettlesAndTheLogReplaysWithinTheLimits) {
   TempDir dir;
   const auto log = dir.path() / "session.jsonl";
-  const auto run = run_cli({"run", small_yumi_scene(dir).string(), "--targets", lift_targets(dir).string(),
-                            "--arm", "--until-settled", "--timeout", "60", "--log", log.string()});
+  const auto run =
+      run_cli({"run", small_yumi_scene(dir).string(), "--targets", lift_targets(dir).string(),
+               "--arm", "--until-settled", "--timeout", "60", "--log", log.string()});
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto result = nlohmann::json::parse(run.out);
   EXPECT_TRUE(result["settled"].get<bool>());
@@ -85,10 +88,10 @@ TEST(RunCli, EgmRobotThroughEgmSimSettlesWithinTheLimits) {
                   std::to_string(port + 1), "--scene", scene.string(), "--duration", "120"},
                  dir.path() / "sim.json");
   const auto log = dir.path() / "egm.jsonl";
-  const auto run = run_cli({"run", scene.string(), "--targets", lift_targets(dir).string(), "--robot", "egm",
-                            "--egm-address", "127.0.0.1", "--egm-left-port", std::to_string(port),
-                            "--egm-right-port", std::to_string(port + 1), "--arm", "--until-settled",
-                            "--timeout", "60", "--log", log.string()});
+  const auto run = run_cli({"run", scene.string(), "--targets", lift_targets(dir).string(),
+                            "--robot", "egm", "--egm-address", "127.0.0.1", "--egm-left-port",
+                            std::to_string(port), "--egm-right-port", std::to_string(port + 1),
+                            "--arm", "--until-settled", "--timeout", "60", "--log", log.string()});
   const auto [sim_exit, sim_out] = sim.finish();
   ASSERT_EQ(run.exit_code, 0) << run.err << run.out;
   const auto result = nlohmann::json::parse(run.out);
@@ -114,12 +117,13 @@ TEST(RunCli, EgmRobotThroughEgmSimSettlesWithinTheLimits) {
 TEST(RunCli, EgmWithoutARobotCannotArm) {
   TempDir dir;
   const int port = free_port_pair_base();
-  const auto run = run_cli({"run", small_yumi_scene(dir).string(), "--targets", lift_targets(dir).string(),
-                            "--robot", "egm", "--egm-address", "127.0.0.1", "--egm-left-port",
-                            std::to_string(port), "--egm-right-port", std::to_string(port + 1), "--arm",
-                            "--until-settled"});
+  const auto run = run_cli(
+      {"run", small_yumi_scene(dir).string(), "--targets", lift_targets(dir).string(), "--robot",
+       "egm", "--egm-address", "127.0.0.1", "--egm-left-port", std::to_string(port),
+       "--egm-right-port", std::to_string(port + 1), "--arm", "--until-settled"});
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_NE(run.err.find("cannot arm the robot link: left: no feedback"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("cannot arm the robot link: left: no feedback"), std::string::npos)
+      << run.err;
 }
 
 TEST(RunCli, BadLinkSettingsAreBadInput) {
@@ -128,23 +132,30 @@ TEST(RunCli, BadLinkSettingsAreBadInput) {
   const auto targets = lift_targets(dir).string();
   auto run = run_cli({"run", scene, "--targets", targets, "--max-velocity", "-1"});
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.err.find("link: max_velocity: expected a positive number, got -1"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("link: max_velocity: expected a positive number, got -1"),
+            std::string::npos)
+      << run.err;
 
   run = run_cli({"run", scene, "--targets", (dir.path() / "none.json").string()});
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("none.json"), std::string::npos) << run.err;
 
-  run = run_cli({"run", test::source_path("scenes/foam_bar_clamped.json").string(), "--targets", targets});
+  run = run_cli(
+      {"run", test::source_path("scenes/foam_bar_clamped.json").string(), "--targets", targets});
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("run needs a scene with a robot"), std::string::npos) << run.err;
 }
 
 TEST(ReplayCli, AViolatedLimitIsReportedWithItsLine) {
   TempDir dir;
-  const auto log = dir.write("bad.jsonl",
-      R"({"t":0,"event":"link","kind":"sim","joint_names":["a"],"channels":[{"name":"robot","joints":[0]}],"period":0.004,"lower":[-1],"upper":[1],"velocity":[0.5],"acceleration":[1]})" "\n"
-      R"({"t":0.004,"event":"command","channel":"robot","seq":1,"joints":[0.0],"measured":[0.0]})" "\n"
-      R"({"t":0.008,"event":"command","channel":"robot","seq":2,"joints":[0.1],"measured":[0.0]})" "\n");
+  const auto log = dir.write(
+      "bad.jsonl",
+      R"({"t":0,"event":"link","kind":"sim","joint_names":["a"],"channels":[{"name":"robot","joints":[0]}],"period":0.004,"lower":[-1],"upper":[1],"velocity":[0.5],"acceleration":[1]})"
+      "\n"
+      R"({"t":0.004,"event":"command","channel":"robot","seq":1,"joints":[0.0],"measured":[0.0]})"
+      "\n"
+      R"({"t":0.008,"event":"command","channel":"robot","seq":2,"joints":[0.1],"measured":[0.0]})"
+      "\n");
   const auto run = run_cli({"replay", log.string()});
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.err.find("bad.jsonl:3: robot joint 0: step"), std::string::npos) << run.err;
@@ -152,7 +163,8 @@ TEST(ReplayCli, AViolatedLimitIsReportedWithItsLine) {
 
 TEST(ReplayCli, AMalformedLogIsBadInputNamingTheLine) {
   TempDir dir;
-  const auto log = dir.write("m.jsonl", "{\"t\":0,\"event\":\"a\"}\n[1,2]\n{\"t\":1,\"event\":\"b\"}\n");
+  const auto log =
+      dir.write("m.jsonl", "{\"t\":0,\"event\":\"a\"}\n[1,2]\n{\"t\":1,\"event\":\"b\"}\n");
   const auto run = run_cli({"replay", log.string()});
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("m.jsonl:2:"), std::string::npos) << run.err;

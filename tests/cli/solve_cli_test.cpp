@@ -25,22 +25,26 @@ nlohmann::json run_json(const std::vector<std::string>& args, const std::filesys
 TEST(SolveCli, ReachesTargetsTakenFromAnotherConfiguration) {
   TempDir dir;
   // The shape at other joint angles (read back from `statics --joints`)...
-  const auto reference = run_json({"statics", kBar, "--out", (dir.path() / "ref.json").string()}, dir.path() / "ref.json");
+  const auto reference = run_json({"statics", kBar, "--out", (dir.path() / "ref.json").string()},
+                                  dir.path() / "ref.json");
   nlohmann::json joints = reference["joints"];
   joints["yumi_joint_1_l"] = joints["yumi_joint_1_l"].get<double>() + 0.12;
   joints["yumi_joint_2_r"] = joints["yumi_joint_2_r"].get<double>() - 0.1;
   joints["yumi_joint_6_l"] = joints["yumi_joint_6_l"].get<double>() + 0.2;
   const auto joints_file = dir.write("joints.json", nlohmann::json{{"joints", joints}}.dump());
   const auto goal = run_json({"statics", kBar, "--joints", joints_file.string(), "--out",
-                              (dir.path() / "goal.json").string()}, dir.path() / "goal.json");
+                              (dir.path() / "goal.json").string()},
+                             dir.path() / "goal.json");
   ASSERT_TRUE(goal["converged"].get<bool>());
   EXPECT_EQ(goal["tools"].size(), 2u);
   // ... gives targets for every 17th node.
   nlohmann::json targets = nlohmann::json::array();
-  for (int i = 0; i < 425; i += 17) targets.push_back({{"node", i}, {"position", goal["positions"][i]}});
+  for (int i = 0; i < 425; i += 17)
+    targets.push_back({{"node", i}, {"position", goal["positions"][i]}});
   const auto targets_file = dir.write("targets.json", nlohmann::json{{"targets", targets}}.dump());
   const auto out = dir.path() / "solve.json";
-  const auto result = run_json({"solve", kBar, "--targets", targets_file.string(), "--out", out.string()}, out);
+  const auto result =
+      run_json({"solve", kBar, "--targets", targets_file.string(), "--out", out.string()}, out);
   EXPECT_LT(result["error_mean"].get<double>(), 1e-3);
   EXPECT_GE(result["min_clearance"].get<double>(), 0.0);
   EXPECT_TRUE(result["limit_violations"].empty());
@@ -54,7 +58,8 @@ TEST(SolveCli, ReachesTargetsTakenFromAnotherConfiguration) {
 
 TEST(SolveCli, ASolveResultIsAcceptedAsJointsByStatics) {
   TempDir dir;
-  const auto reference = run_json({"statics", kBar, "--out", (dir.path() / "ref.json").string()}, dir.path() / "ref.json");
+  const auto reference = run_json({"statics", kBar, "--out", (dir.path() / "ref.json").string()},
+                                  dir.path() / "ref.json");
   nlohmann::json targets = nlohmann::json::array();
   for (int i = 0; i < 425; i += 53) {
     nlohmann::json p = reference["positions"][i];
@@ -64,8 +69,9 @@ TEST(SolveCli, ASolveResultIsAcceptedAsJointsByStatics) {
   const auto targets_file = dir.write("targets.json", nlohmann::json{{"targets", targets}}.dump());
   const auto solved = dir.path() / "solve.json";
   const auto vtu = dir.path() / "solve.vtu";
-  const auto result = run_json({"solve", kBar, "--targets", targets_file.string(), "--out", solved.string(),
-                                "--vtu", vtu.string()}, solved);
+  const auto result = run_json({"solve", kBar, "--targets", targets_file.string(), "--out",
+                                solved.string(), "--vtu", vtu.string()},
+                               solved);
   // solve --vtu: the deformed mesh at the best joints, the result's positions exactly.
   const std::string vtu_text = test::read_text(vtu);
   EXPECT_NE(vtu_text.find("<VTKFile type=\"UnstructuredGrid\""), std::string::npos);
@@ -74,7 +80,8 @@ TEST(SolveCli, ASolveResultIsAcceptedAsJointsByStatics) {
   {
     const std::size_t points = vtu_text.find("<Points>");
     ASSERT_NE(points, std::string::npos);
-    std::istringstream in(vtu_text.substr(vtu_text.find('>', vtu_text.find("<DataArray", points)) + 1));
+    std::istringstream in(
+        vtu_text.substr(vtu_text.find('>', vtu_text.find("<DataArray", points)) + 1));
     double x = 0, y = 0, z = 0;
     in >> x >> y >> z;
     EXPECT_EQ(x, result["positions"][0][0].get<double>());
@@ -82,7 +89,8 @@ TEST(SolveCli, ASolveResultIsAcceptedAsJointsByStatics) {
   }
   // Its joints reproduce its shape.
   const auto again = run_json({"statics", kBar, "--joints", solved.string(), "--out",
-                               (dir.path() / "again.json").string()}, dir.path() / "again.json");
+                               (dir.path() / "again.json").string()},
+                              dir.path() / "again.json");
   ASSERT_TRUE(again["converged"].get<bool>());
   EXPECT_EQ(again["joints"], result["joints"]);
   double largest = 0;
@@ -93,7 +101,8 @@ TEST(SolveCli, ASolveResultIsAcceptedAsJointsByStatics) {
   EXPECT_LT(largest, 1e-6);
   // A hand-written joints file keeps its typo check.
   const auto typo = dir.write("typo.json", R"({"joints": {}, "jionts": {}})");
-  const auto bad = run_cli({"statics", kBar, "--joints", typo.string(), "--out", (dir.path() / "x.json").string()});
+  const auto bad = run_cli(
+      {"statics", kBar, "--joints", typo.string(), "--out", (dir.path() / "x.json").string()});
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find("jionts"), std::string::npos) << bad.err;
 }
@@ -109,23 +118,29 @@ TEST(SolveCli, CentreLineIsFollowedOnTheBar) {
   const auto targets = dir.write("line.json", nlohmann::json{{"centerline", line}}.dump());
   const auto out = dir.path() / "solve.json";
   const auto result = run_json({"solve", kBar, "--targets", targets.string(), "--out", out.string(),
-                                "--max-iterations", "30"}, out);
-  EXPECT_LT(result["error_mean"].get<double>(), result["history"][0]["error_mean"].get<double>() / 3);
+                                "--max-iterations", "30"},
+                               out);
+  EXPECT_LT(result["error_mean"].get<double>(),
+            result["history"][0]["error_mean"].get<double>() / 3);
   EXPECT_GE(result["targets"].size(), 10u);
 }
 
 TEST(SolveCli, BadTargetsAreBadInput) {
   TempDir dir;
   const std::vector<std::pair<std::string, std::string>> cases = {
-      {R"({"targets": [{"node": 425, "position": [0, 0, 0]}]})", "targets[0].node: expected a whole number from 0 to 424"},
+      {R"({"targets": [{"node": 425, "position": [0, 0, 0]}]})",
+       "targets[0].node: expected a whole number from 0 to 424"},
       {R"({"targets": []})", "targets: expected a non-empty list of targets"},
-      {R"({"targets": [{"node": 1, "position": [0, 0]}]})", "targets[0].position: expected an array of 3 numbers"},
-      {R"({"centerline": [[0, 0, 0]]})", "centerline: expected a polyline of at least 2 distinct points"},
+      {R"({"targets": [{"node": 1, "position": [0, 0]}]})",
+       "targets[0].position: expected an array of 3 numbers"},
+      {R"({"centerline": [[0, 0, 0]]})",
+       "centerline: expected a polyline of at least 2 distinct points"},
       {R"({"target": []})", "target: unknown key"},
   };
   for (const auto& [text, message] : cases) {
     const auto file = dir.write("bad.json", text);
-    const auto run = run_cli({"solve", kBar, "--targets", file.string(), "--out", (dir.path() / "r.json").string()});
+    const auto run = run_cli(
+        {"solve", kBar, "--targets", file.string(), "--out", (dir.path() / "r.json").string()});
     EXPECT_EQ(run.exit_code, 1) << text;
     EXPECT_NE(run.err.find("bad.json: " + message), std::string::npos) << run.err;
   }
@@ -134,22 +149,28 @@ TEST(SolveCli, BadTargetsAreBadInput) {
 TEST(SolveCli, CentreLineOnAnObjectThatIsNotBarLikeIsBadInput) {
   TempDir dir;
   const auto file = dir.write("line.json", R"({"centerline": [[0.3, 0, 0.3], [0.4, 0, 0.3]]})");
-  const auto run = run_cli({"solve", kFrame, "--targets", file.string(), "--out", (dir.path() / "r.json").string()});
+  const auto run = run_cli(
+      {"solve", kFrame, "--targets", file.string(), "--out", (dir.path() / "r.json").string()});
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.err.find("line.json: centerline: expected an object that is bar-like"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("line.json: centerline: expected an object that is bar-like"),
+            std::string::npos)
+      << run.err;
 }
 
 // Issue 10: a centre-line of points within 1e-12 m gave NaN targets and exit 0 with nulls.
 TEST(SolveCli, DegenerateCentreLineIsBadInputNamingTheCentreLine) {
   TempDir dir;
   const auto out = dir.write("r.json", "precious");
-  for (const std::string line : {R"({"centerline": [[0.39, 0, 0.25], [0.39, 1e-13, 0.25], [0.39, 0, 0.2500000000001]]})",
-                                 R"({"centerline": [[0.39, 0, 0.25], [0.39, 0.00001, 0.25]]})"}) {
+  for (const std::string line :
+       {R"({"centerline": [[0.39, 0, 0.25], [0.39, 1e-13, 0.25], [0.39, 0, 0.2500000000001]]})",
+        R"({"centerline": [[0.39, 0, 0.25], [0.39, 0.00001, 0.25]]})"}) {
     const auto file = dir.write("line.json", line);
     const auto run = run_cli({"solve", kBar, "--targets", file.string(), "--out", out.string()});
     EXPECT_EQ(run.exit_code, 1) << run.err;
-    EXPECT_NE(run.err.find("line.json: centerline: expected a polyline of at least 2 distinct points"),
-              std::string::npos) << run.err;
+    EXPECT_NE(run.err.find(
+                  "line.json: centerline: expected a polyline of at least 2 distinct points"),
+              std::string::npos)
+        << run.err;
     EXPECT_EQ(test::read_text(out), "precious");
   }
 }
@@ -159,13 +180,17 @@ TEST(SolveCli, AbsurdTargetsAreRefusedWithoutCrashOrNull) {
   TempDir dir;
   const auto out = dir.write("r.json", "precious");
   for (const std::string optimizer : {"gauss-newton", "lbfgs"})
-    for (const std::string position : {"[1e155, 0, 0.2]", "[0.4, -1e300, 0.2]", "[0.4, 0, 1000.5]"}) {
-      const auto file = dir.write("t.json", R"({"targets": [{"node": 3, "position": [0.4, 0, 0.25]}, {"node": 7, "position": )" +
-                                                position + "}]}");
-      const auto run = run_cli({"solve", kBar, "--targets", file.string(), "--out", out.string(), "--optimizer",
-                                optimizer, "--max-iterations", "3"});
+    for (const std::string position :
+         {"[1e155, 0, 0.2]", "[0.4, -1e300, 0.2]", "[0.4, 0, 1000.5]"}) {
+      const auto file = dir.write(
+          "t.json",
+          R"({"targets": [{"node": 3, "position": [0.4, 0, 0.25]}, {"node": 7, "position": )" +
+              position + "}]}");
+      const auto run = run_cli({"solve", kBar, "--targets", file.string(), "--out", out.string(),
+                                "--optimizer", optimizer, "--max-iterations", "3"});
       EXPECT_EQ(run.exit_code, 1) << run.err;
-      EXPECT_NE(run.err.find("t.json: targets[1].position: expected a"), std::string::npos) << run.err;
+      EXPECT_NE(run.err.find("t.json: targets[1].position: expected a"), std::string::npos)
+          << run.err;
       EXPECT_NE(run.err.find("1000 m"), std::string::npos) << run.err;
       EXPECT_EQ(test::read_text(out), "precious");
     }
@@ -174,9 +199,11 @@ TEST(SolveCli, AbsurdTargetsAreRefusedWithoutCrashOrNull) {
 TEST(StaticsCli, UnknownJointInJointsFileIsNamed) {
   TempDir dir;
   const auto file = dir.write("j.json", R"({"joints": {"yumi_joint_9_l": 0.1}})");
-  const auto run = run_cli({"statics", kBar, "--joints", file.string(), "--out", (dir.path() / "r.json").string()});
+  const auto run = run_cli(
+      {"statics", kBar, "--joints", file.string(), "--out", (dir.path() / "r.json").string()});
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.err.find("j.json: joints.yumi_joint_9_l: not an active joint"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("j.json: joints.yumi_joint_9_l: not an active joint"), std::string::npos)
+      << run.err;
 }
 
 }  // namespace

@@ -26,7 +26,8 @@ const char* kBarScene = R"({
 // A single tet (nodes 1..4) in MSH 2.2; `element` is the $Elements body line.
 std::string msh22(const std::string& element, const std::string& count = "1") {
   return "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n4\n1 0 0 0\n2 0.1 0 0\n3 0 0.1 0\n"
-         "4 0 0 0.1\n$EndNodes\n$Elements\n" + count + "\n" + element + "\n$EndElements\n";
+         "4 0 0 0.1\n$EndNodes\n$Elements\n" +
+         count + "\n" + element + "\n$EndElements\n";
 }
 
 std::string scene_with_mesh(const std::string& mesh_file) {
@@ -39,7 +40,8 @@ TEST(StaticsCli, WritesAConvergedResultInMeshOrder) {
   const auto scene = dir.write("bar.json", kBarScene);
   const auto out = dir.path() / "result.json";
   const auto vtu = dir.path() / "bar.vtu";
-  const auto run = run_cli({"statics", scene.string(), "--out", out.string(), "--vtu", vtu.string()});
+  const auto run =
+      run_cli({"statics", scene.string(), "--out", out.string(), "--vtu", vtu.string()});
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto result = nlohmann::json::parse(test::read_text(out));
   EXPECT_TRUE(result["converged"].get<bool>());
@@ -121,13 +123,16 @@ TEST(StaticsCli, UnknownKeyIsNamedWithTheKnownOnes) {
 TEST(StaticsCli, NonFiniteAndUnphysicalNumbersAreRejected) {
   TempDir dir;
   for (const auto& [from, to, where] :
-       {std::tuple<std::string, std::string, std::string>{"\"density\": 40", "\"density\": 0, \"mu\": 1", "object.material.mu"},
+       {std::tuple<std::string, std::string, std::string>{"\"density\": 40",
+                                                          "\"density\": 0, \"mu\": 1",
+                                                          "object.material.mu"},
         {"\"density\": 40", "\"density\": -1", "object.material.density"},
         {"[8, 2, 2]", "[8, 0, 2]", "object.mesh.box.cells[1]"}}) {
     std::string text = kBarScene;
     text.replace(text.find(from), from.size(), to);
     const auto scene = dir.write("bad.json", text);
-    const auto run = run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
+    const auto run =
+        run_cli({"statics", scene.string(), "--out", (dir.path() / "r.json").string()});
     EXPECT_EQ(run.exit_code, 1) << to;
     EXPECT_NE(run.err.find("bad.json: " + where + ": "), std::string::npos) << run.err;
   }
@@ -149,7 +154,8 @@ TEST(StaticsCli, UnheldObjectIsASolverFailure) {
   const auto out = dir.path() / "r.json";
   const auto run = run_cli({"statics", scene.string(), "--out", out.string()});
   EXPECT_EQ(run.exit_code, 2) << run.err;
-  EXPECT_NE(run.err.find("singular system: nothing holds the object"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("singular system: nothing holds the object"), std::string::npos)
+      << run.err;
   const auto result = nlohmann::json::parse(test::read_text(out));
   EXPECT_FALSE(result["converged"].get<bool>());
 }
@@ -204,7 +210,8 @@ TEST(StaticsCli, VtuIntoAMissingFolderLeavesOutUntouched) {
   const std::string precious = "precious\n\x01\xff";
   const auto out = dir.write("r.json", precious);
   const auto vtu = dir.path() / "missing" / "bar.vtu";
-  const auto run = run_cli({"statics", scene.string(), "--out", out.string(), "--vtu", vtu.string()});
+  const auto run =
+      run_cli({"statics", scene.string(), "--out", out.string(), "--vtu", vtu.string()});
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_NE(run.err.find(vtu.string() + ": cannot write: directory '" + vtu.parent_path().string() +
                          "' does not exist"),
@@ -221,7 +228,8 @@ TEST(StaticsCli, OutThatIsADirectoryIsNamed) {
   const auto out = dir.path() / "r.json";
   const auto run = run_cli({"statics", scene.string(), "--out", out.string()});
   EXPECT_EQ(run.exit_code, 1) << run.err;
-  EXPECT_NE(run.err.find(out.string() + ": cannot write: it is a directory"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(out.string() + ": cannot write: it is a directory"), std::string::npos)
+      << run.err;
   EXPECT_EQ(test::read_text(out / "keep.txt"), "kept");
   EXPECT_EQ(entries(dir.path()), 2);
 }
@@ -229,7 +237,8 @@ TEST(StaticsCli, OutThatIsADirectoryIsNamed) {
 TEST(StaticsCli, MissingSceneLeavesAnExistingResultIntact) {
   TempDir dir;
   const auto out = dir.write("r.json", "precious");
-  const auto run = run_cli({"statics", (dir.path() / "missing.json").string(), "--out", out.string()});
+  const auto run =
+      run_cli({"statics", (dir.path() / "missing.json").string(), "--out", out.string()});
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_EQ(test::read_text(out), "precious");
 }

@@ -34,7 +34,9 @@ TEST(Controller, FollowsTargetsSetFromAnotherThread) {
   controller.start();
   std::thread editor([&] { controller.set_targets(targets); });
   editor.join();
-  const auto s = wait_until(controller, [](const ControllerSnapshot& s) { return s.error.mean < 1e-3 && !s.targets.empty(); }, 30);
+  const auto s = wait_until(
+      controller,
+      [](const ControllerSnapshot& s) { return s.error.mean < 1e-3 && !s.targets.empty(); }, 30);
   EXPECT_LT(s->error.mean, 1e-3);
   EXPECT_TRUE(s->safe);
   EXPECT_GT(s->iterations, 0u);
@@ -69,10 +71,12 @@ TEST(Controller, PauseAndJogMoveTheRobotWithoutTheOptimizer) {
   EXPECT_EQ(s->iterations, 0u);
   // The object followed: its gripped left end moved.
   const int node = controller.scene().grips[0].nodes[0];
-  EXPECT_GT((s->positions - controller.scene().world_rest_positions()).segment<3>(3 * node).norm(), 0.01);
+  EXPECT_GT((s->positions - controller.scene().world_rest_positions()).segment<3>(3 * node).norm(),
+            0.01);
   controller.reset();
   controller.step_once();
-  EXPECT_NEAR((controller.snapshot()->joints - controller.scene().robot->reference_joints).norm(), 0, 1e-12);
+  EXPECT_NEAR((controller.snapshot()->joints - controller.scene().robot->reference_joints).norm(),
+              0, 1e-12);
 }
 
 TEST(Centerline, StraightSketchAlongTheBarTargetsItsCentreNodes) {
@@ -100,11 +104,11 @@ TEST(Centerline, DegenerateSketchesAreRefusedNamingTheCentreLine) {
   ASSERT_TRUE(axis.has_value());
   const Vec3 a = axis->center;
   const std::vector<std::vector<Vec3>> bad = {
-      {a, a + Vec3(1e-13, 0, 0), a + Vec3(0, 1e-13, 0)},   // points within 1e-12 m: one point
-      {a, a + Vec3(1e-5, 0, 0)},                           // 10 µm: far below the bar's scale
-      {a, a + Vec3(1e155, 0, 0)},                          // absurd and
+      {a, a + Vec3(1e-13, 0, 0), a + Vec3(0, 1e-13, 0)},  // points within 1e-12 m: one point
+      {a, a + Vec3(1e-5, 0, 0)},                          // 10 µm: far below the bar's scale
+      {a, a + Vec3(1e155, 0, 0)},                         // absurd and
       {a, a - Vec3(0, 0, 1e300)},
-      {a, Vec3(0, NAN, 0)},                                // non-finite points
+      {a, Vec3(0, NAN, 0)},  // non-finite points
       {a}};
   for (const auto& sketch : bad) {
     try {

@@ -28,12 +28,14 @@ void expect_round_trip(std::initializer_list<E> values) {
 }
 
 TEST(Names, EveryStatusAndKindRoundTrips) {
-  expect_round_trip({ControllerStatus::Idle, ControllerStatus::Optimizing, ControllerStatus::Converged,
-                     ControllerStatus::Stuck, ControllerStatus::OutOfTime, ControllerStatus::Paused});
+  expect_round_trip({ControllerStatus::Idle, ControllerStatus::Optimizing,
+                     ControllerStatus::Converged, ControllerStatus::Stuck,
+                     ControllerStatus::OutOfTime, ControllerStatus::Paused});
   expect_round_trip({Termination::Converged, Termination::IterationLimit, Termination::TimeLimit,
                      Termination::Stuck, Termination::Failed});
   expect_round_trip({OptimizerKind::GaussNewton, OptimizerKind::Lbfgs});
-  expect_round_trip({GradientMethod::Sensitivity, GradientMethod::Adjoint, GradientMethod::FiniteDifference});
+  expect_round_trip(
+      {GradientMethod::Sensitivity, GradientMethod::Adjoint, GradientMethod::FiniteDifference});
   EXPECT_EQ(optimizer_names().size(), 2u);
   EXPECT_EQ(gradient_names().size(), 3u);
 }
@@ -43,8 +45,9 @@ TEST(Names, TheWebClientKnowsEveryControllerStatus) {
   ASSERT_TRUE(in) << "web/js/protocol.js missing";
   std::stringstream text;
   text << in.rdbuf();
-  for (ControllerStatus s : {ControllerStatus::Idle, ControllerStatus::Optimizing, ControllerStatus::Converged,
-                             ControllerStatus::Stuck, ControllerStatus::OutOfTime, ControllerStatus::Paused})
+  for (ControllerStatus s :
+       {ControllerStatus::Idle, ControllerStatus::Optimizing, ControllerStatus::Converged,
+        ControllerStatus::Stuck, ControllerStatus::OutOfTime, ControllerStatus::Paused})
     EXPECT_NE(text.str().find("'" + std::string(to_string(s)) + "'"), std::string::npos)
         << to_string(s) << " is not in web/js/protocol.js";
 }

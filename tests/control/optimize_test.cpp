@@ -56,7 +56,8 @@ TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
     ASSERT_TRUE(at_goal.statics.converged());
     objective = objective.with_targets(targets_from_shape(at_goal.positions, 10 + seed * 5, rng));
 
-    const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
+    const Evaluation start =
+        objective.evaluate(object.reference_joints(), object.reference_positions());
     ASSERT_GT(start.error.mean, 3e-3) << "the targets should be a real change";
     auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
     const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 200});
@@ -91,7 +92,8 @@ TEST_P(OptimizeTest, UnreachableTargetsGiveAnHonestBestEffort) {
   t.nodes = {0, 10, 20};
   t.positions = {Vec3(5, 5, 5), Vec3(5, 5, 6), Vec3(-5, 5, 5)};
   objective = objective.with_targets(t);
-  const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
+  const Evaluation start =
+      objective.evaluate(object.reference_joints(), object.reference_positions());
   auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
   const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 60});
   EXPECT_TRUE(result.best.safe());
@@ -114,7 +116,8 @@ TEST_P(OptimizeTest, NonFiniteObjectiveNeitherCrashesNorConverges) {
     t.nodes = {0, 10, 20};
     t.positions = {Vec3(1000, 0, 0), Vec3(0, -1000, 0), Vec3(0, 0, 1000)};
     objective = objective.with_targets(t);
-    const Evaluation start = objective.evaluate(object.reference_joints(), object.reference_positions());
+    const Evaluation start =
+        objective.evaluate(object.reference_joints(), object.reference_positions());
     ASSERT_TRUE(start.statics.converged());
     ASSERT_FALSE(std::isfinite(start.objective)) << "the test needs a non-finite objective";
     for (const GradientMethod method : {GradientMethod::Sensitivity, GradientMethod::Adjoint}) {
@@ -149,16 +152,18 @@ TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
     GrippedObject fresh_object(scene);
     ReducedObjective fresh(fresh_object);
     fresh = fresh.with_targets(targets);
-    const Evaluation start = fresh.evaluate(fresh_object.reference_joints(), fresh_object.reference_positions());
+    const Evaluation start =
+        fresh.evaluate(fresh_object.reference_joints(), fresh_object.reference_positions());
     const ObjectiveTiming before = fresh.timing();
     auto work = [&] {
       const ObjectiveTiming& now = fresh.timing();
-      return static_cast<double>(now.statics_solves - before.statics_solves + now.gradient_evaluations -
-                                 before.gradient_evaluations);
+      return static_cast<double>(now.statics_solves - before.statics_solves +
+                                 now.gradient_evaluations - before.gradient_evaluations);
     };
     auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
     const OptimizeResult result =
-        optimize(fresh, *optimizer, start, {.max_iterations = 1000, .max_seconds = max_seconds, .clock = work});
+        optimize(fresh, *optimizer, start,
+                 {.max_iterations = 1000, .max_seconds = max_seconds, .clock = work});
     *work_done = work();
     return result;
   };
@@ -178,7 +183,8 @@ TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
 INSTANTIATE_TEST_SUITE_P(BothOptimizers, OptimizeTest,
                          ::testing::Values(OptimizerKind::GaussNewton, OptimizerKind::Lbfgs),
                          [](const auto& info) {
-                           return info.param == OptimizerKind::GaussNewton ? "GaussNewton" : "Lbfgs";
+                           return info.param == OptimizerKind::GaussNewton ? "GaussNewton"
+                                                                           : "Lbfgs";
                          });
 
 }  // namespace
@@ -196,7 +202,8 @@ class YumiBar : public ::testing::Test {
 TEST_F(YumiBar, ReachableTargetsAreReachedOverSeveralSeeds) {
   GrippedObject object(scene);
   ReducedObjective objective(object);
-  const Evaluation reference = objective.evaluate(object.reference_joints(), object.reference_positions());
+  const Evaluation reference =
+      objective.evaluate(object.reference_joints(), object.reference_positions());
   ASSERT_TRUE(reference.safe());
   int tried = 0;
   for (unsigned seed = 1; tried < 3; ++seed) {

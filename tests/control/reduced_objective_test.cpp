@@ -102,7 +102,8 @@ TEST(ReducedObjective, ConfirmStableRejectsAStateWhoseHessianIsIndefinite) {
     const Vec3 p = squeezed.positions.segment<3>(3 * i);
     squeezed.positions.segment<3>(3 * i) = p - 0.1 * axis.dot(p - centre) * axis;
   }
-  squeezed.state = std::make_shared<ObjectState>(object.make_state(held.joints, squeezed.positions));
+  squeezed.state =
+      std::make_shared<ObjectState>(object.make_state(held.joints, squeezed.positions));
   EXPECT_FALSE(objective.confirm_stable(squeezed));
   EXPECT_EQ(squeezed.statics.status, StaticsStatus::Unstable);
   EXPECT_FALSE(std::isfinite(squeezed.objective));
@@ -118,7 +119,8 @@ TEST(ReducedObjective, AbsurdTargetsAreRefusedNamingTheTargetAndChangeNothing) {
   objective = objective.with_targets(good);
   const std::vector<std::pair<ShapeTargets, std::string>> bad = {
       {{{0, 5}, {Vec3(0, 0, 0), Vec3(1e155, 0, 0)}},
-       "targets: targets[1].position: expected a finite point within 1000 m of the origin, got [1e+155, 0, 0]"},
+       "targets: targets[1].position: expected a finite point within 1000 m of the origin, got "
+       "[1e+155, 0, 0]"},
       {{{0}, {Vec3(0, -1e300, 0)}}, "targets[0].position: expected a finite point within 1000 m"},
       {{{0}, {Vec3(0, 0, NAN)}}, "targets[0].position: expected a finite point"},
       {{{0}, {Vec3(1000.5, 0, 0)}}, "targets[0].position: expected a finite point within 1000 m"},

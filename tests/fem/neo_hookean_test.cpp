@@ -18,7 +18,8 @@ const Material kFoam{.mu = 1e4, .kappa = 5e4, .density = 30};
 
 Positions affine(const TetMesh& mesh, const Mat3& A, const Vec3& b) {
   Positions x(3 * mesh.node_count());
-  for (int i = 0; i < mesh.node_count(); ++i) x.segment<3>(3 * i) = A * mesh.rest_positions()[i] + b;
+  for (int i = 0; i < mesh.node_count(); ++i)
+    x.segment<3>(3 * i) = A * mesh.rest_positions()[i] + b;
   return x;
 }
 
@@ -90,7 +91,8 @@ TEST(NeoHookean, EnergyIsInvariantUnderRotation) {
   const Positions x = test::perturbed(mesh.rest_vector(), 0.003, rng);
   const Mat3 R = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
   Positions y = x;
-  for (int i = 0; i < mesh.node_count(); ++i) y.segment<3>(3 * i) = R * x.segment<3>(3 * i) + Vec3(1, 2, 3);
+  for (int i = 0; i < mesh.node_count(); ++i)
+    y.segment<3>(3 * i) = R * x.segment<3>(3 * i) + Vec3(1, 2, 3);
   const double e = term.value(x);
   EXPECT_GT(e, 0);
   EXPECT_NEAR(term.value(y), e, 1e-10 * e);
@@ -115,8 +117,10 @@ TEST(NeoHookean, ProjectedHessianIsPositiveSemidefiniteAndTrueOneIsNot) {
   const Eigen::MatrixXd H = test::dense_hessian(term, x, false);
   const Eigen::MatrixXd P = test::dense_hessian(term, x, true);
   const double scale = H.cwiseAbs().maxCoeff();
-  EXPECT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff(), -1e-6 * scale);
-  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(P).eigenvalues().minCoeff(), -1e-9 * scale);
+  EXPECT_LT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(H).eigenvalues().minCoeff(),
+            -1e-6 * scale);
+  EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(P).eigenvalues().minCoeff(),
+            -1e-9 * scale);
 }
 
 TEST(NeoHookean, SmallStrainMatchesLinearElasticity) {

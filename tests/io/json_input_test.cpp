@@ -20,7 +20,8 @@ using test::TempDir;
 std::string error_of(const std::function<void()>& f) { return test::input_error_of(f); }
 
 std::string nested(int depth) {
-  return std::string(static_cast<std::size_t>(depth), '[') + std::string(static_cast<std::size_t>(depth), ']');
+  return std::string(static_cast<std::size_t>(depth), '[') +
+         std::string(static_cast<std::size_t>(depth), ']');
 }
 
 TEST(JsonInput, DeeplyNestedTextIsRefusedBeforeParsing) {
@@ -41,12 +42,18 @@ TEST(JsonInput, DeeplyNestedFileIsAnInputErrorNamingIt) {
 }
 
 TEST(JsonInput, DuplicateKeysAreErrorsNamingPathAndKey) {
-  EXPECT_EQ(error_of([] { parse_json_text(R"({"object": {"material": {"density": 40, "density": 4}}})", "s.json"); }),
+  EXPECT_EQ(error_of([] {
+              parse_json_text(R"({"object": {"material": {"density": 40, "density": 4}}})",
+                              "s.json");
+            }),
             "s.json: object.material.density: duplicate key (each key may appear once)");
-  EXPECT_EQ(error_of([] { parse_json_text(R"({"grips": [{"a": 1}, {"b": [1, {"c": 1, "c": 2}]}]})", "s.json"); }),
+  EXPECT_EQ(error_of([] {
+              parse_json_text(R"({"grips": [{"a": 1}, {"b": [1, {"c": 1, "c": 2}]}]})", "s.json");
+            }),
             "s.json: grips[1].b[1].c: duplicate key (each key may appear once)");
   // The same key in different objects is fine.
-  EXPECT_NO_THROW(parse_json_text(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})", "s.json"));
+  EXPECT_NO_THROW(
+      parse_json_text(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})", "s.json"));
 }
 
 TEST(JsonInput, HugeUnknownKeyIsEchoedBounded) {
@@ -57,14 +64,18 @@ TEST(JsonInput, HugeUnknownKeyIsEchoedBounded) {
 }
 
 TEST(JsonInput, HugeValueIsShownBounded) {
-  const JsonInput json(parse_json_text("{\"a\": [\"" + std::string(5'000'000, 'v') + "\", 1]}", "s.json"), "s.json");
+  const JsonInput json(parse_json_text("{\"a\": [\"" + std::string(5'000'000, 'v') + "\", 1]}",
+                                       "s.json"),
+                       "s.json");
   const std::string message = error_of([&] { json.at("a").number(); });
-  EXPECT_EQ(message.rfind("s.json: a: expected a number, got [\"vvv", 0), 0u) << message.substr(0, 200);
+  EXPECT_EQ(message.rfind("s.json: a: expected a number, got [\"vvv", 0), 0u)
+      << message.substr(0, 200);
   EXPECT_LT(message.size(), 120u);
 }
 
 TEST(JsonInput, ParseErrorWithHugeTokenIsBounded) {
-  const std::string message = error_of([] { parse_json_text("[\"" + std::string(3'000'000, 'x'), "s.json"); });
+  const std::string message =
+      error_of([] { parse_json_text("[\"" + std::string(3'000'000, 'x'), "s.json"); });
   EXPECT_EQ(message.rfind("s.json:1: invalid JSON (", 0), 0u) << message.substr(0, 200);
   EXPECT_LT(message.size(), 300u);
 }
@@ -76,14 +87,16 @@ TEST(JsonInput, OversizeTextAndFilesAreRefusedNamingTheLimit) {
   const auto file = dir.write("targets.json", "[" + std::string(max_json_file_bytes, ' ') + "]");
   EXPECT_EQ(error_of([&] { JsonInput::load(file); }),
             file.string() + ": larger than the " + std::to_string(max_json_file_bytes) +
-                " byte limit for JSON files (" + std::to_string(max_json_file_bytes + 2) + " bytes)");
+                " byte limit for JSON files (" + std::to_string(max_json_file_bytes + 2) +
+                " bytes)");
 }
 
 TEST(InputFile, FifoIsRefusedWithoutWaitingForAWriter) {
   const TempDir dir;
   const auto fifo = dir.path() / "scene.json";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
-  EXPECT_EQ(error_of([&] { JsonInput::load(fifo); }), fifo.string() + ": not a regular file (a FIFO)");
+  EXPECT_EQ(error_of([&] { JsonInput::load(fifo); }),
+            fifo.string() + ": not a regular file (a FIFO)");
   EXPECT_EQ(error_of([&] { read_input_file(dir.path(), 100, "mesh"); }),
             dir.path().string() + ": not a regular file (a directory)");
   EXPECT_EQ(error_of([&] { read_input_file("/dev/zero", 100, "mesh"); }),

@@ -41,7 +41,8 @@ class TextMutator {
   }
 
   // Start and length of a digit run (a number's mantissa) near a random spot, or length 0.
-  static std::pair<std::size_t, std::size_t> number_near(const std::string& text, std::mt19937& rng) {
+  static std::pair<std::size_t, std::size_t> number_near(const std::string& text,
+                                                         std::mt19937& rng) {
     std::size_t at = text.find_first_of("0123456789", position(text, rng));
     if (at == std::string::npos) return {0, 0};
     std::size_t end = text.find_first_not_of("0123456789.eE+-", at);
@@ -75,8 +76,7 @@ class TextMutator {
       }
       case 4:  // insert a token
         return text.insert(position(text, rng), token);
-      case 5:
-        return replace_number(std::move(text), rng);
+      case 5: return replace_number(std::move(text), rng);
       case 6: {  // deep nesting of the token's first character, closed or not
         const std::string open(50 + rng() % 3000, token.empty() ? '[' : token[0]);
         return text.insert(position(text, rng), open);
@@ -85,7 +85,8 @@ class TextMutator {
         const std::size_t at = text.rfind('\n', position(text, rng));
         const std::size_t from = at == std::string::npos ? 0 : at + 1;
         const std::size_t to = text.find('\n', from);
-        const std::string line = text.substr(from, to == std::string::npos ? std::string::npos : to - from + 1);
+        const std::string line =
+            text.substr(from, to == std::string::npos ? std::string::npos : to - from + 1);
         std::string repeated;
         for (std::size_t k = 0, n = 2 + rng() % 200; k < n; ++k) repeated += line;
         return text.insert(from, repeated);
@@ -123,7 +124,8 @@ inline FuzzCounts fuzz_parser(const std::vector<std::string>& seeds, const TextM
         watched = now_case;
         since = std::chrono::steady_clock::now();
       } else if (std::chrono::steady_clock::now() - since > std::chrono::seconds(60)) {
-        std::fprintf(stderr, "fuzz case %d (seed %u) hangs: still running after 60 s\n", watched, seed);
+        std::fprintf(stderr, "fuzz case %d (seed %u) hangs: still running after 60 s\n", watched,
+                     seed);
         std::abort();
       }
     }

@@ -9,8 +9,8 @@
 namespace shapectl {
 namespace {
 
-using test::TempDir;
 using test::read_text;
+using test::TempDir;
 
 // Two tets sharing the face (1, 2, 3).
 Positions two_tet_positions() {

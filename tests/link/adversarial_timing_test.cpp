@@ -69,7 +69,7 @@ struct Scenario {
     // The arms' poses before any command reaches them (set by hand).
     hand = std::vector<Eigen::VectorXd>(2, Eigen::Vector2d(0.3, -0.2));
     if (unit() < 0.3) hand[0][1] = -(hard + 0.05), start_outside = true;  // beyond the limit
-    if (unit() < 0.3) hand[1][0] = hard - 0.04;                            // in the margin
+    if (unit() < 0.3) hand[1][0] = hard - 0.04;                           // in the margin
 
     // The network's plan: stalls, then per datagram jitter, duplicates, reordering.
     std::vector<std::pair<double, double>> stalls;
@@ -84,7 +84,7 @@ struct Scenario {
     const int ticks = static_cast<int>(duration / T);
     for (int k = 1; k <= ticks; ++k)
       for (int c = 0; c < 2; ++c) {
-        Datagram d{k * T + 1e-4 + unit() * 3e-4, c, controller, static_cast<std::uint32_t>(k),
+        Datagram d{k * T + 1e-4 + unit() * 3e-4,      c, controller, static_cast<std::uint32_t>(k),
                    static_cast<std::uint32_t>(k * 4), k, {}};
         if (const double until = stalled_until(d.deliver); until > 0)
           d.deliver = until + 1e-6 * (k % 97);  // the burst, in order, within 0.1 ms
@@ -96,7 +96,12 @@ struct Scenario {
           queue.push_back(dup);
         }
         if (unit() < 0.03) {  // a second sender, newer sequence numbers, a pose of its own
-          Datagram x{d.deliver + unit() * T, c, intruder, d.seqno + 3, d.tm + 12, -1,
+          Datagram x{d.deliver + unit() * T,
+                     c,
+                     intruder,
+                     d.seqno + 3,
+                     d.tm + 12,
+                     -1,
                      Eigen::Vector2d(1.5 * unit() - 0.75, 1.5 * unit() - 0.75)};
           queue.push_back(x);
         }
@@ -119,7 +124,8 @@ struct Scenario {
     };
     auto leave_until = [&](double t) {
       for (int c = 0; c < 2; ++c)
-        for (auto& q = pending[static_cast<std::size_t>(c)]; !q.empty() && q.front().at <= t; q.pop_front())
+        for (auto& q = pending[static_cast<std::size_t>(c)]; !q.empty() && q.front().at <= t;
+             q.pop_front())
           leave(c, q.front());
     };
 
@@ -151,7 +157,8 @@ struct Scenario {
       FeedbackFilter& f = filters[static_cast<std::size_t>(d.channel)];
       if (!s.connected(d.channel)) f.forget_sequence();
       if (f.accept(d.sender, d.seqno, d.tm) != FeedbackVerdict::accepted) continue;
-      const FeedbackStep step = s.on_feedback(d.channel, measured, "", d.deliver, f.controller_time());
+      const FeedbackStep step =
+          s.on_feedback(d.channel, measured, "", d.deliver, f.controller_time());
       if (!step.send) continue;
       Pending p{step.send_at, s.command(d.channel), step.advanced};
       auto& q = pending[static_cast<std::size_t>(d.channel)];
@@ -167,13 +174,15 @@ struct Scenario {
     const auto it = delivered.find(c);
     if (it == delivered.end()) return hand[static_cast<std::size_t>(c)];
     const auto& d = it->second;
-    auto after = std::lower_bound(d.begin(), d.end(), t, [](const Delivered& e, double x) { return e.t < x; });
+    auto after = std::lower_bound(d.begin(), d.end(), t,
+                                  [](const Delivered& e, double x) { return e.t < x; });
     return after == d.begin() ? hand[static_cast<std::size_t>(c)] : std::prev(after)->q;
   }
   // Whether a reply reached the controller in the cycle before tick m.
   bool fresh(int c, int m) const {
     const auto& d = delivered.at(c);
-    auto it = std::lower_bound(d.begin(), d.end(), (m - 1) * T, [](const Delivered& e, double x) { return e.t < x; });
+    auto it = std::lower_bound(d.begin(), d.end(), (m - 1) * T,
+                               [](const Delivered& e, double x) { return e.t < x; });
     return it != d.end() && it->t < m * T;
   }
 
@@ -195,7 +204,8 @@ struct Scenario {
 
 // The command in effect at `t` on our side (the first one before it).
 Eigen::VectorXd at(const std::vector<Sent>& s, double t) {
-  auto it = std::upper_bound(s.begin(), s.end(), t, [](double x, const Sent& e) { return x < e.t; });
+  auto it =
+      std::upper_bound(s.begin(), s.end(), t, [](double x, const Sent& e) { return x < e.t; });
   return it == s.begin() ? s.front().q : std::prev(it)->q;
 }
 

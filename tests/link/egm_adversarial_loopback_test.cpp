@@ -56,7 +56,9 @@ struct Controller {
     f.motors_on = f.egm_running = f.rapid_running = true;
     return std::string(codec.encode_robot(f));
   }
-  void send(int c, const std::string& bytes) { sockets[static_cast<std::size_t>(c)].send_to(bytes, to[c]); }
+  void send(int c, const std::string& bytes) {
+    sockets[static_cast<std::size_t>(c)].send_to(bytes, to[c]);
+  }
   // Every reply waiting on arm `c`, waiting up to `seconds` for the first `want`.
   std::vector<ArmJoints> replies(int c, std::size_t want, double wait) {
     std::vector<ArmJoints> got;
@@ -138,7 +140,8 @@ TEST(EgmAdversarial, ABurstAfterAStallAdvancesNoFasterThanTheClock) {
   const double duration = seconds(burst_sent, burst_answered);
   const double bound = v_max * (duration + T) + 1e-9;
   for (const ArmJoints& q : replies)
-    EXPECT_LE((q - replies.front()).cwiseAbs().maxCoeff(), bound) << "burst took " << duration << " s";
+    EXPECT_LE((q - replies.front()).cwiseAbs().maxCoeff(), bound)
+        << "burst took " << duration << " s";
   // The first one restarts from rest after the stall: at most a·T² from the held pose.
   EXPECT_LE((replies.front() - before_stall).cwiseAbs().maxCoeff(), 4.0 * T * T + 1e-12);
   // And motion goes on afterwards: the test was not vacuous.

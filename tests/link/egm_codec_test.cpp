@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
-#include <cstring>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <random>
 
@@ -18,7 +18,10 @@ constexpr double deg = std::numbers::pi / 180;
 std::string from_hex(const std::string& hex) {
   std::string bytes;
   for (std::size_t i = 0; i + 1 < hex.size();) {
-    if (hex[i] == ' ' || hex[i] == '\n') { ++i; continue; }
+    if (hex[i] == ' ' || hex[i] == '\n') {
+      ++i;
+      continue;
+    }
     bytes.push_back(static_cast<char>(std::stoi(hex.substr(i, 2), nullptr, 16)));
     i += 2;
   }

@@ -42,7 +42,8 @@ struct Loopback {
       : robot(test::yumi_arms()),
         log(std::make_shared<SessionLog>(log_file)),
         link(fast_config(), robot, {}, log),
-        sim({.left_port = link.port(0), .right_port = link.port(1),
+        sim({.left_port = link.port(0),
+             .right_port = link.port(1),
              .left_initial = chain(0, -130, 135, 30, 0, 40, 0),
              .right_initial = chain(0, -130, -135, 30, 0, 40, 0)}) {
     link.start();
@@ -102,7 +103,8 @@ TEST(EgmLoopback, ArmedMotionKeepsTheLimitsAndConvergesAndAWatchdogStopsIt) {
     lb.sim.set_paused(true);
     const auto paused_at = std::chrono::steady_clock::now();
     ASSERT_TRUE(wait_until([&] { return !lb.link.status().armed; }, 1));
-    const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - paused_at).count();
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - paused_at).count();
     EXPECT_LT(took, 0.1 + 0.1);  // watchdog + scheduling slack on a busy machine
     const LinkStatus lost = lb.link.status();
     EXPECT_FALSE(lost.connected);
@@ -160,9 +162,9 @@ TEST(EgmLoopback, BadDatagramsAreCountedAndIgnored) {
   valid.motors_on = valid.egm_running = valid.rapid_running = true;
   const std::string message(codec.encode_robot(valid));
   std::vector<std::string> bad = {
-      std::string(4000, 'x'),           // oversized
-      message.substr(0, 20),            // truncated
-      std::string("\x0a\xff\xff\xff"),  // malformed length
+      std::string(4000, 'x'),                          // oversized
+      message.substr(0, 20),                           // truncated
+      std::string("\x0a\xff\xff\xff"),                 // malformed length
       std::string(codec.encode_sensor(EgmCommand{})),  // wrong message type
   };
   for (int k = 0; k < 40; ++k) {  // random bytes

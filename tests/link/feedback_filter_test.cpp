@@ -36,7 +36,7 @@ TEST(FeedbackFilter, ReorderingIsNotLossButAMissingNumberIs) {
   FeedbackFilter f;
   f.accept(controller, 1, 4);
   EXPECT_EQ(f.accept(controller, 3, 12), V::accepted);
-  EXPECT_EQ(f.counts().lost, 1u);  // 2 missing so far
+  EXPECT_EQ(f.counts().lost, 1u);                   // 2 missing so far
   EXPECT_EQ(f.accept(controller, 2, 8), V::stale);  // it was only late
   EXPECT_EQ(f.counts().lost, 0u);
   EXPECT_EQ(f.accept(controller, 2, 8), V::stale);  // and a duplicate of it changes nothing

@@ -70,7 +70,8 @@ TEST(LinkSupervisor, UnsafeTargetsDisarmWithTheirReason) {
   const std::vector<Case> cases = {
       {Eigen::Vector2d(NAN, 0), true, "target for j0 is not finite"},
       {Eigen::Vector2d(INFINITY, 0), true, "target for j0 is not finite"},
-      {Eigen::Vector2d(0.5, 0.5), false, "optimizer marked the target unsafe (collision or limits)"},
+      {Eigen::Vector2d(0.5, 0.5), false,
+       "optimizer marked the target unsafe (collision or limits)"},
       {Eigen::Vector2d(0.5, 2.5), true, "target for j1 (2.5 rad) is outside its limits [-2, 2]"},
       {Eigen::Vector3d(0, 0, 0), true, "target has 3 joints, expected 2"},
   };
@@ -183,7 +184,8 @@ TEST(LinkSupervisor, MeasuredBeyondTheHardLimitsGetsNoCommandAndCannotBeArmed) {
   }
   std::string why;
   EXPECT_FALSE(f.s.arm(f.t, &why));
-  EXPECT_EQ(why, "b: j1 measured at -2.05 rad, outside its limits [-2, 2]: move it inside by hand first");
+  EXPECT_EQ(
+      why, "b: j1 measured at -2.05 rad, outside its limits [-2, 2]: move it inside by hand first");
   // Armed, then the robot reports a pose beyond the limits: disarmed, no command.
   f.robot = Eigen::Vector2d(0.3, -0.2);
   for (int k = 0; k < 10; ++k) f.tick();

@@ -11,7 +11,9 @@ namespace {
 constexpr double dt = 0.004;
 constexpr double slack = 1e-12;
 
-Eigen::VectorXd vec(double a, double b, double c) { return (Eigen::VectorXd(3) << a, b, c).finished(); }
+Eigen::VectorXd vec(double a, double b, double c) {
+  return (Eigen::VectorXd(3) << a, b, c).finished();
+}
 
 GovernorLimits three_joint_limits() {
   return {vec(-1.0, -2.0, -0.5), vec(1.0, 0.5, 3.0), vec(0.5, 1.0, 0.2), vec(1.0, 4.0, 0.5)};

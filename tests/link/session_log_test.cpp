@@ -24,7 +24,8 @@ TEST(SessionLog, EveryLineIsOnDiskAsSoonAsItIsWritten) {
 
 TEST(SessionLog, ALineCutShortByACrashIsSkipped) {
   test::TempDir dir;
-  const auto file = dir.write("s.jsonl", "{\"t\":0,\"event\":\"a\"}\n{\"t\":1,\"event\":\"b\",\"jo");
+  const auto file =
+      dir.write("s.jsonl", "{\"t\":0,\"event\":\"a\"}\n{\"t\":1,\"event\":\"b\",\"jo");
   int truncated = 0;
   const auto events = read_session_log(file, &truncated);
   ASSERT_EQ(events.size(), 1u);
@@ -33,7 +34,8 @@ TEST(SessionLog, ALineCutShortByACrashIsSkipped) {
 
 TEST(SessionLog, ABadLineInTheMiddleNamesItsLine) {
   test::TempDir dir;
-  const auto file = dir.write("s.jsonl", "{\"t\":0,\"event\":\"a\"}\nnot json\n{\"t\":1,\"event\":\"b\"}\n");
+  const auto file =
+      dir.write("s.jsonl", "{\"t\":0,\"event\":\"a\"}\nnot json\n{\"t\":1,\"event\":\"b\"}\n");
   try {
     read_session_log(file);
     FAIL();

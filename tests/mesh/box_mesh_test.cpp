@@ -58,13 +58,21 @@ TEST(BoxMesh, RejectsBadSizeAndCells) {
     }
     return std::string("no error");
   };
-  EXPECT_EQ(message([] { make_box_mesh({0.1, 0, 0.1}, {1, 1, 1}); }),
+  EXPECT_EQ(message([] {
+              make_box_mesh({0.1, 0, 0.1}, {1, 1, 1});
+            }),
             "box mesh: size.y: expected a positive finite length, got 0");
-  EXPECT_EQ(message([&] { make_box_mesh({inf, 1, 1}, {1, 1, 1}); }),
+  EXPECT_EQ(message([&] {
+              make_box_mesh({inf, 1, 1}, {1, 1, 1});
+            }),
             "box mesh: size.x: expected a positive finite length, got inf");
-  EXPECT_EQ(message([] { make_box_mesh({1, 1, std::nan("")}, {1, 1, 1}); }),
+  EXPECT_EQ(message([] {
+              make_box_mesh({1, 1, std::nan("")}, {1, 1, 1});
+            }),
             "box mesh: size.z: expected a positive finite length, got nan");
-  EXPECT_EQ(message([] { make_box_mesh({1, 1, 1}, {1, 1, 0}); }),
+  EXPECT_EQ(message([] {
+              make_box_mesh({1, 1, 1}, {1, 1, 0});
+            }),
             "box mesh: cells.z: expected at least 1 cell, got 0");
 }
 

@@ -22,7 +22,9 @@ TEST(LoadMesh, DispatchesByExtensionIgnoringCase) {
   dir.write("tet.ele", "1 4 0\n0 0 1 2 3\n");
   EXPECT_EQ(load_mesh(dir.path() / "tet.ele").tet_count(), 1);
   EXPECT_EQ(load_mesh(dir.path() / "tet.node").tet_count(), 1);
-  const auto obj = dir.write("tet.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
+  const auto obj =
+      dir.write("tet.obj",
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n");
   EXPECT_NEAR(load_mesh(obj, {.max_radius_edge_ratio = 0}).total_volume(), 1.0 / 6, 1e-15);
 }
 
@@ -34,8 +36,9 @@ TEST(LoadMesh, UnknownExtensionNamesTheSupportedOnes) {
     FAIL() << "no error";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()),
-              file.string() + ": unknown mesh format '.vtk' (supported: .msh, .node/.ele, and "
-                              "surfaces .obj, .stl, .off)");
+              file.string() +
+                  ": unknown mesh format '.vtk' (supported: .msh, .node/.ele, and "
+                  "surfaces .obj, .stl, .off)");
   }
 }
 

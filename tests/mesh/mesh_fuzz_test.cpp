@@ -26,7 +26,8 @@ std::string msh22() {
   std::ostringstream s;
   s.precision(17);
   s << "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n" << box().node_count() << "\n";
-  for (int i = 0; i < box().node_count(); ++i) s << i + 1 << " " << box().rest_positions()[i].transpose() << "\n";
+  for (int i = 0; i < box().node_count(); ++i)
+    s << i + 1 << " " << box().rest_positions()[i].transpose() << "\n";
   s << "$EndNodes\n$Elements\n" << box().tet_count() << "\n";
   for (int e = 0; e < box().tet_count(); ++e) {
     s << e + 1 << " 4 2 0 1";
@@ -40,7 +41,8 @@ std::string msh41() {
   std::ostringstream s;
   s.precision(17);
   const int n = box().node_count(), m = box().tet_count();
-  s << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 " << n << " 1 " << n << "\n3 1 0 " << n << "\n";
+  s << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 " << n << " 1 " << n << "\n3 1 0 " << n
+    << "\n";
   for (int i = 0; i < n; ++i) s << i + 1 << "\n";
   for (int i = 0; i < n; ++i) s << box().rest_positions()[i].transpose() << "\n";
   s << "$EndNodes\n$Elements\n1 " << m << " 1 " << m << "\n3 1 4 " << m << "\n";
@@ -56,7 +58,8 @@ std::string tetgen_node() {
   std::ostringstream s;
   s.precision(17);
   s << box().node_count() << " 3 0 0\n";
-  for (int i = 0; i < box().node_count(); ++i) s << i << " " << box().rest_positions()[i].transpose() << "\n";
+  for (int i = 0; i < box().node_count(); ++i)
+    s << i << " " << box().rest_positions()[i].transpose() << "\n";
   return s.str();
 }
 
@@ -74,7 +77,8 @@ std::string tetgen_ele() {
 std::string obj() {
   std::ostringstream s;
   for (const auto& x : box().rest_positions()) s << "v " << x.transpose() << "\n";
-  for (const auto& t : box().surface_triangles()) s << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
+  for (const auto& t : box().surface_triangles())
+    s << "f " << t[0] + 1 << " " << t[1] + 1 << " " << t[2] + 1 << "\n";
   return s.str();
 }
 
@@ -108,7 +112,8 @@ std::string binary_stl() {
     const float normal[3] = {0, 0, 0};
     put(normal, 12);
     for (int v : t) {
-      const float x[3] = {float(box().rest_positions()[v].x()), float(box().rest_positions()[v].y()),
+      const float x[3] = {float(box().rest_positions()[v].x()),
+                          float(box().rest_positions()[v].y()),
                           float(box().rest_positions()[v].z())};
       put(x, 12);
     }
@@ -118,16 +123,42 @@ std::string binary_stl() {
   return s;
 }
 
-const test::TextMutator kMeshMutator({"nan", "inf", "-inf", "1e999", "-1e308", "1e-400", "-1", "0",
-                                      "999999999", "2147483648", "99999999999999999999", "x",
-                                      "\n", " ", "$Nodes\n", "$EndNodes\n", "$Elements\n",
-                                      "$EndElements\n", "$Foo\n", "4.1", "v 0 0 0\n", "f 1 1 1\n",
-                                      "f -99 1 2\n", "3 0 1\n", "facet\n", "vertex 1 2 3\n",
-                                      "endfacet\n", "# comment\n", "+", "1/2/3", "\0"});
+const test::TextMutator kMeshMutator({"nan",
+                                      "inf",
+                                      "-inf",
+                                      "1e999",
+                                      "-1e308",
+                                      "1e-400",
+                                      "-1",
+                                      "0",
+                                      "999999999",
+                                      "2147483648",
+                                      "99999999999999999999",
+                                      "x",
+                                      "\n",
+                                      " ",
+                                      "$Nodes\n",
+                                      "$EndNodes\n",
+                                      "$Elements\n",
+                                      "$EndElements\n",
+                                      "$Foo\n",
+                                      "4.1",
+                                      "v 0 0 0\n",
+                                      "f 1 1 1\n",
+                                      "f -99 1 2\n",
+                                      "3 0 1\n",
+                                      "facet\n",
+                                      "vertex 1 2 3\n",
+                                      "endfacet\n",
+                                      "# comment\n",
+                                      "+",
+                                      "1/2/3",
+                                      "\0"});
 
 // `cases` mutations of `seed`, each written as `name` and loaded.
-test::FuzzCounts fuzz_format(const std::string& name, const std::string& seed, int cases, unsigned rng_seed,
-                             const std::string& companion_name = "", const std::string& companion = "",
+test::FuzzCounts fuzz_format(const std::string& name, const std::string& seed, int cases,
+                             unsigned rng_seed, const std::string& companion_name = "",
+                             const std::string& companion = "",
                              const SurfaceMeshOptions& options = {.max_radius_edge_ratio = 0}) {
   const test::TempDir dir;
   if (!companion_name.empty()) dir.write(companion_name, companion);
@@ -144,9 +175,13 @@ TEST(MeshFuzz, ValidSeedsLoad) {
   EXPECT_EQ(load_mesh(dir.write("b.msh", msh41())).tet_count(), 12);
   dir.write("c.node", tetgen_node());
   EXPECT_EQ(load_mesh(dir.write("c.ele", tetgen_ele())).tet_count(), 12);
-  for (const auto& [name, text] : {std::pair<std::string, std::string>{"d.obj", obj()}, {"e.off", off()},
-                                   {"f.stl", ascii_stl()}, {"g.stl", binary_stl()}})
-    EXPECT_NEAR(load_mesh(dir.write(name, text), {.max_radius_edge_ratio = 0}).total_volume(), 0.002, 1e-9) << name;
+  for (const auto& [name, text] : {std::pair<std::string, std::string>{"d.obj", obj()},
+                                   {"e.off", off()},
+                                   {"f.stl", ascii_stl()},
+                                   {"g.stl", binary_stl()}})
+    EXPECT_NEAR(load_mesh(dir.write(name, text), {.max_radius_edge_ratio = 0}).total_volume(),
+                0.002, 1e-9)
+        << name;
 }
 
 TEST(MeshFuzz, MutatedVolumeMeshesLoadOrAreInputErrors) {
@@ -162,8 +197,10 @@ TEST(MeshFuzz, MutatedVolumeMeshesLoadOrAreInputErrors) {
 }
 
 TEST(MeshFuzz, MutatedSurfacesLoadOrAreInputErrors) {
-  for (const auto& [name, seed] : {std::pair<std::string, std::string>{"s.obj", obj()}, {"s.off", off()},
-                                   {"s.stl", ascii_stl()}, {"b.stl", binary_stl()}}) {
+  for (const auto& [name, seed] : {std::pair<std::string, std::string>{"s.obj", obj()},
+                                   {"s.off", off()},
+                                   {"s.stl", ascii_stl()},
+                                   {"b.stl", binary_stl()}}) {
     const test::FuzzCounts counts = fuzz_format(name, seed, 300, 11, "", "");
     EXPECT_GT(counts.refused, 100) << name;
     EXPECT_GT(counts.parsed, 10) << name;
@@ -173,7 +210,8 @@ TEST(MeshFuzz, MutatedSurfacesLoadOrAreInputErrors) {
 TEST(MeshFuzz, MutatedSurfacesRefinedByTetGenLoadOrAreInputErrors) {
   // Quality and volume refinement on whatever survives reading: bounded by the tet budget.
   const test::FuzzCounts counts =
-      fuzz_format("r.obj", obj(), 300, 13, "", "", {.max_radius_edge_ratio = 1.2, .max_tet_volume = 1e-5});
+      fuzz_format("r.obj", obj(), 300, 13, "", "",
+                  {.max_radius_edge_ratio = 1.2, .max_tet_volume = 1e-5});
   EXPECT_GT(counts.refused, 50);
   EXPECT_GT(counts.parsed, 10);
 }

@@ -72,7 +72,6 @@ std::string msh41() {
   return s;
 }
 
-
 std::string replaced(std::string text, const std::string& from, const std::string& to);
 
 // The surface block of msh41() marked parametric, with (u, v) after each x y z.
@@ -172,10 +171,10 @@ TEST(MshReader, WrongElementCountIn41IsReported) {
   TempDir dir;
   const std::string text = replaced(msh41(), "$Elements\n2 7 1 7\n", "$Elements\n2 8 1 7\n");
   const auto file = dir.write("count.msh", text);
-  EXPECT_EQ(error_of(file), file.string() + ":" + std::to_string(line_of(text, std::string("7") + tet_nodes(5))) +
-                                ": the $Elements header on line " +
-                                std::to_string(line_of(text, "2 8 1 7")) +
-                                " says 8 elements, its blocks hold 7");
+  EXPECT_EQ(error_of(file),
+            file.string() + ":" + std::to_string(line_of(text, std::string("7") + tet_nodes(5))) +
+                ": the $Elements header on line " + std::to_string(line_of(text, "2 8 1 7")) +
+                " says 8 elements, its blocks hold 7");
 }
 
 TEST(MshReader, UnknownNodeTagNamesElementAndLine) {
@@ -189,10 +188,12 @@ TEST(MshReader, UnknownNodeTagNamesElementAndLine) {
 
 TEST(MshReader, MalformedElementLineIsReported) {
   TempDir dir;
-  std::string text = replaced(msh41(), std::string("4") + tet_nodes(2) + "\n", std::string("4") + tet_nodes(2) + " 65\n");
+  std::string text = replaced(msh41(), std::string("4") + tet_nodes(2) + "\n",
+                              std::string("4") + tet_nodes(2) + " 65\n");
   auto file = dir.write("long.msh", text);
-  EXPECT_EQ(error_of(file), file.string() + ":" + std::to_string(line_of(text, std::string("4") + tet_nodes(2))) +
-                                ": element 4: expected 5 values (element tag, 4 node tags), found 6");
+  EXPECT_EQ(error_of(file),
+            file.string() + ":" + std::to_string(line_of(text, std::string("4") + tet_nodes(2))) +
+                ": element 4: expected 5 values (element tag, 4 node tags), found 6");
   text = replaced(msh22(), "2 1 2 0 1", "2 1 9 0 1");
   file = dir.write("tags.msh", text);
   EXPECT_EQ(error_of(file), file.string() + ":" + std::to_string(line_of(text, "2 1 9")) +
@@ -250,7 +251,8 @@ TEST(MshReader, BinaryAndUnsupportedVersionsAreRefused) {
 TEST(MshReader, SurfaceOnlyMeshHasNoTetrahedra) {
   TempDir dir;
   std::string text = msh22();
-  text = text.substr(0, text.find("$Elements")) + "$Elements\n1\n1 2 2 0 1 100 93 86\n$EndElements\n";
+  text =
+      text.substr(0, text.find("$Elements")) + "$Elements\n1\n1 2 2 0 1 100 93 86\n$EndElements\n";
   const auto file = dir.write("surface.msh", text);
   EXPECT_EQ(error_of(file), file.string() +
                                 ": no linear tetrahedra (element type 4); mesh the volume in 3D "

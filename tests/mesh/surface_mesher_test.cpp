@@ -33,10 +33,10 @@ std::string vertex_lines(const std::string& prefix) {
 // OBJ with quads in several index forms, texture/normal lines and comments.
 std::string cube_obj() {
   std::string s = "# cube\no cube\n" + vertex_lines("v ") + "vt 0 0\nvn 0 0 1\ns off\n";
-  s += "f 1/1/1 3/1/1 4/1/1 2/1/1\n";      // v/vt/vn
-  s += "f 5//1 6//1 8//1 7//1\n";          // v//vn
-  s += "f -8 -7 -3 -4\n";                  // negative: 1 2 6 5
-  s += "f 3 7 8\nf 3 8 4\n";               // a quad as two triangles
+  s += "f 1/1/1 3/1/1 4/1/1 2/1/1\n";  // v/vt/vn
+  s += "f 5//1 6//1 8//1 7//1\n";      // v//vn
+  s += "f -8 -7 -3 -4\n";              // negative: 1 2 6 5
+  s += "f 3 7 8\nf 3 8 4\n";           // a quad as two triangles
   s += "f 1 5 7 3\nf 2 4 8 6\n";
   return s;
 }
@@ -64,7 +64,8 @@ std::string cube_ascii_stl() {
   s << "solid cube\n";
   for (const auto& t : cube_triangles()) {
     s << "  facet normal 0 0 0\n    outer loop\n";
-    for (int v : t) s << "      vertex " << corner(v).x() << " " << corner(v).y() << " " << corner(v).z() << "\n";
+    for (int v : t)
+      s << "      vertex " << corner(v).x() << " " << corner(v).y() << " " << corner(v).z() << "\n";
     s << "    endloop\n  endfacet\n";
   }
   s << "endsolid cube\n";
@@ -125,8 +126,8 @@ TEST(SurfaceMesher, TetrahedralizesOffAndStlCubes) {
   expect_meshed_cube(mesh_surface(off), read_surface(off));
   // STL lists triangles only: vertices come in order of first use.
   const std::vector<int> first_use = {0, 2, 3, 1, 4, 5, 7, 6};
-  for (const auto& stl : {dir.write("cube.stl", cube_ascii_stl()),
-                          dir.write("binary.STL", cube_binary_stl())}) {
+  for (const auto& stl :
+       {dir.write("cube.stl", cube_ascii_stl()), dir.write("binary.STL", cube_binary_stl())}) {
     const TriangleSurface surface = read_surface(stl);
     ASSERT_EQ(surface.vertices.size(), 8u);
     for (int i = 0; i < 8; ++i) EXPECT_EQ(surface.vertices[i], corner(first_use[i]));
@@ -178,7 +179,8 @@ TEST(SurfaceMesher, SelfIntersectingSurfaceIsRefusedWithTetgensReason) {
 TEST(SurfaceMesher, BadSurfaceFilesNameFileAndLine) {
   TempDir dir;
   auto file = dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n");
-  EXPECT_EQ(error_of(file), file.string() + ":3: face: vertex index 3 out of range (2 vertices so far)");
+  EXPECT_EQ(error_of(file),
+            file.string() + ":3: face: vertex index 3 out of range (2 vertices so far)");
   file = dir.write("word.obj", "v 0 zero 0\n");
   EXPECT_EQ(error_of(file), file.string() + ":1: expected a number for y, got 'zero'");
   file = dir.write("twice.obj", "v 0 0 0\nv 1 0 0\nv 0 0 0\nf 1 2 3\n");
@@ -187,8 +189,9 @@ TEST(SurfaceMesher, BadSurfaceFilesNameFileAndLine) {
   EXPECT_EQ(error_of(file), file.string() + ": no faces");
   file = dir.write("short.off", "OFF\n8 6 12\n0 0 0\n");
   EXPECT_EQ(error_of(file), file.string() + ":3: file ends early: expected vertex 1 of 8");
-  file = dir.write("facet.stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
-                                "vertex 1 0 0\nendloop\nendfacet\nendsolid\n");
+  file = dir.write("facet.stl",
+                   "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\n"
+                   "vertex 1 0 0\nendloop\nendfacet\nendsolid\n");
   EXPECT_EQ(error_of(file), file.string() + ":7: facet: expected 3 vertices, found 2");
   file = dir.write("junk.stl", "not an stl");
   EXPECT_EQ(error_of(file), file.string() +
@@ -197,7 +200,8 @@ TEST(SurfaceMesher, BadSurfaceFilesNameFileAndLine) {
   file = dir.write("cube.ply", "ply\n");
   EXPECT_EQ(error_of(file),
             file.string() + ": unknown surface format '.ply' (supported: .obj, .stl, .off)");
-  EXPECT_EQ(error_of(dir.path() / "absent.obj"), (dir.path() / "absent.obj").string() + ": file not found");
+  EXPECT_EQ(error_of(dir.path() / "absent.obj"),
+            (dir.path() / "absent.obj").string() + ": file not found");
 }
 
 TEST(SurfaceMesher, BadOptionsAreRefused) {

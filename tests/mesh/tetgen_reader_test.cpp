@@ -110,12 +110,12 @@ TEST(TetgenReader, BadNodeFilesAreReported) {
   TempDir dir;
   dir.write("box.ele", ele_text(0));
   auto file = dir.write("box.node", "2 3 0 0\n0 0 0 0\n2 1 0 0\n");
-  EXPECT_EQ(error_of(file), file.string() +
-                                ":3: point 2: expected point 1 (points are numbered consecutively)");
-  file = dir.write("box.node", "2 3 0 0\n0 0 0 0\n1 1 0\n");
   EXPECT_EQ(error_of(file),
-            file.string() + ":3: point 1: expected 4 values (number, x, y, z, 0 attributes, 0 "
-                            "markers), found 3");
+            file.string() + ":3: point 2: expected point 1 (points are numbered consecutively)");
+  file = dir.write("box.node", "2 3 0 0\n0 0 0 0\n1 1 0\n");
+  EXPECT_EQ(error_of(file), file.string() +
+                                ":3: point 1: expected 4 values (number, x, y, z, 0 attributes, 0 "
+                                "markers), found 3");
   file = dir.write("box.node", "2 3 0 0\n0 0 0 0\n1 1 0 1e999\n");
   EXPECT_EQ(error_of(file), file.string() + ":3: point 1: z is not a finite number: '1e999'");
   file = dir.write("box.node", "3 3 0 0\n0 0 0 0\n1 1 0 0\n");

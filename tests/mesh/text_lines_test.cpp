@@ -70,7 +70,9 @@ TEST(TextLines, ErrorsNameTheFileAndLine) {
 }
 
 TEST(TextLines, ShownTokensAreShortAndPrintable) {
-  EXPECT_EQ(shown("a\x01" "b"), "a?b");
+  EXPECT_EQ(shown("a\x01"
+                  "b"),
+            "a?b");
   EXPECT_EQ(shown(std::string(41, 'x')), std::string(40, 'x') + "...");
 }
 

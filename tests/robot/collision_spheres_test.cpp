@@ -31,11 +31,16 @@ const char* const kChainUrdf = R"(<robot name="chain">
     <origin xyz="0 0.5 0"/><axis xyz="0 0 1"/><limit lower="-3" upper="3" velocity="1" effort="1"/></joint>
 </robot>)";
 
-int pairs_between(const RobotModel& robot, const CollisionModel& model, const char* a, const char* b) {
+int pairs_between(const RobotModel& robot, const CollisionModel& model, const char* a,
+                  const char* b) {
   int count = 0;
   for (const auto& [i, j] : model.pairs()) {
-    const std::string x = robot.links()[static_cast<std::size_t>(model.spheres()[static_cast<std::size_t>(i)].link)].name;
-    const std::string y = robot.links()[static_cast<std::size_t>(model.spheres()[static_cast<std::size_t>(j)].link)].name;
+    const std::string x =
+        robot.links()[static_cast<std::size_t>(model.spheres()[static_cast<std::size_t>(i)].link)]
+            .name;
+    const std::string y =
+        robot.links()[static_cast<std::size_t>(model.spheres()[static_cast<std::size_t>(j)].link)]
+            .name;
     count += (x == a && y == b) || (x == b && y == a);
   }
   return count;
@@ -74,7 +79,8 @@ TEST(CollisionModel, ClearanceIsCentreDistanceMinusRadii) {
   // Swing the arm towards `other` until the spheres overlap by 0.1 (+ margin 0.05).
   const double reach = 0.6;
   const double angle = std::acos((reach * reach + 0.25 - 0.2 * 0.2) / (2 * reach * 0.5));
-  const KinematicsState close = forward_kinematics(robot, Eigen::Vector4d(M_PI / 2 - angle, 0, 0, 0));
+  const KinematicsState close =
+      forward_kinematics(robot, Eigen::Vector4d(M_PI / 2 - angle, 0, 0, 0));
   EXPECT_NEAR(model.min_clearance(close), -0.1, 1e-9);
   EXPECT_NEAR(model.value(robot, close), 2.0 * std::pow(0.15, 3), 1e-12);
 }
@@ -88,10 +94,12 @@ std::vector<Eigen::VectorXd> colliding_configurations(const RobotModel& robot,
   while (static_cast<int>(out.size()) < count) {
     Eigen::VectorXd theta(robot.active_count());
     for (int i = 0; i < theta.size(); ++i)
-      theta[i] = std::uniform_real_distribution<double>(robot.lower_limits()[i], robot.upper_limits()[i])(rng);
+      theta[i] = std::uniform_real_distribution<double>(robot.lower_limits()[i],
+                                                        robot.upper_limits()[i])(rng);
     const KinematicsState state = forward_kinematics(robot, theta);
     bool near_kink = false;
-    for (const auto& pair : model.closest_pairs(state, static_cast<std::size_t>(model.pair_count())))
+    for (const auto& pair :
+         model.closest_pairs(state, static_cast<std::size_t>(model.pair_count())))
       near_kink = near_kink || std::abs(pair.clearance + model.margin()) < 1e-4;
     if (!near_kink && model.value(robot, state) > 0) out.push_back(theta);
   }
@@ -100,7 +108,8 @@ std::vector<Eigen::VectorXd> colliding_configurations(const RobotModel& robot,
 
 TEST(CollisionModel, BarrierGradientMatchesCentralDifferences) {
   const RobotModel robot = RobotModel::load_urdf_file(kYumiDir + "yumi.urdf");
-  const CollisionModel model = CollisionModel::load_json_file(robot, kYumiDir + "yumi_spheres.json");
+  const CollisionModel model =
+      CollisionModel::load_json_file(robot, kYumiDir + "yumi_spheres.json");
   const auto barrier = [&](const Eigen::VectorXd& t) {
     return model.value(robot, forward_kinematics(robot, t));
   };
@@ -115,7 +124,8 @@ TEST(CollisionModel, BarrierGradientMatchesCentralDifferences) {
 
 TEST(CollisionModel, ResidualsSquareToTheBarrierAndTheirJacobianMatchesCentralDifferences) {
   const RobotModel robot = RobotModel::load_urdf_file(kYumiDir + "yumi.urdf");
-  const CollisionModel model = CollisionModel::load_json_file(robot, kYumiDir + "yumi_spheres.json");
+  const CollisionModel model =
+      CollisionModel::load_json_file(robot, kYumiDir + "yumi_spheres.json");
   const auto residuals = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
     Eigen::VectorXd r;
     model.residuals(robot, forward_kinematics(robot, t), r);
@@ -152,8 +162,9 @@ TEST(CollisionModel, JsonNamesTheFileAndTheElement) {
                "spheres.fore[0].radius: expected a positive number, got -1");
   expect_error(R"({"spheres": {}, "ignore_pairs": [["fore", "wrist"]]})",
                "ignore_pairs[0][1]: unknown link 'wrist' (not in chain.urdf)");
-  expect_error(R"({"spheres": {}, "margins": 1})",
-               "margins: unknown key; known: description, margin, stiffness, spheres, ignore_pairs");
+  expect_error(
+      R"({"spheres": {}, "margins": 1})",
+      "margins: unknown key; known: description, margin, stiffness, spheres, ignore_pairs");
 }
 
 }  // namespace

@@ -11,13 +11,16 @@
 namespace shapectl {
 namespace {
 
-RobotModel two_arms() { return RobotModel::from_urdf_string(test::two_arm_urdf(), "two_arms.urdf"); }
+RobotModel two_arms() {
+  return RobotModel::from_urdf_string(test::two_arm_urdf(), "two_arms.urdf");
+}
 
 // Spheres along each forearm; with `tips` also one on each tool point.
 CollisionModel arm_spheres(const RobotModel& model, double margin, bool tips = false) {
   std::vector<CollisionSphere> spheres;
   for (const char* link : {"l_link3", "r_link3"}) {
-    for (double x : {0.05, 0.1, 0.15}) spheres.push_back({model.link_index(link), Vec3(x, 0, 0), 0.03});
+    for (double x : {0.05, 0.1, 0.15})
+      spheres.push_back({model.link_index(link), Vec3(x, 0, 0), 0.03});
     if (tips) spheres.push_back({model.link_index(link), Vec3(0.2, 0, 0), 0.01});
   }
   return CollisionModel(model, spheres, margin, 1e6);
@@ -26,7 +29,8 @@ CollisionModel arm_spheres(const RobotModel& model, double margin, bool tips = f
 Eigen::VectorXd random_joints(const RobotModel& model, double inset, std::mt19937& rng) {
   const Eigen::VectorXd lo = model.lower_limits(), hi = model.upper_limits();
   Eigen::VectorXd q(model.active_count());
-  for (int i = 0; i < q.size(); ++i) q[i] = std::uniform_real_distribution<double>(lo[i] + inset, hi[i] - inset)(rng);
+  for (int i = 0; i < q.size(); ++i)
+    q[i] = std::uniform_real_distribution<double>(lo[i] + inset, hi[i] - inset)(rng);
   return q;
 }
 
@@ -36,7 +40,9 @@ std::vector<IkGoal> goals_at(const RobotModel& model, const Eigen::VectorXd& q, 
   std::vector<IkGoal> goals;
   for (const char* tool : {"l_tool", "r_tool"}) {
     const int link = model.link_index(tool);
-    IkGoal g{.link = link, .point_link = Vec3(0.01, 0.02, 0), .position_world = s.T_world_link[link] * Vec3(0.01, 0.02, 0)};
+    IkGoal g{.link = link,
+             .point_link = Vec3(0.01, 0.02, 0),
+             .position_world = s.T_world_link[link] * Vec3(0.01, 0.02, 0)};
     if (orientation) g.rotation_world = s.T_world_link[link].linear();
     goals.push_back(g);
   }
@@ -51,14 +57,16 @@ TEST(InverseKinematics, JacobianMatchesCentralDifferences) {
   for (int trial = 0; trial < 5; ++trial) {
     auto goals = goals_at(model, random_joints(model, 0.1, rng), true);
     goals[0].position_world += Vec3(0.05, -0.02, 0.03);
-    goals[1].rotation_world = Eigen::AngleAxisd(0.4, Vec3::UnitX()).toRotationMatrix() * *goals[1].rotation_world;
+    goals[1].rotation_world =
+        Eigen::AngleAxisd(0.4, Vec3::UnitX()).toRotationMatrix() * *goals[1].rotation_world;
     const IkOptions options{.collisions = &spheres};
     const Eigen::VectorXd q = random_joints(model, 0.1, rng);
     Eigen::VectorXd r;
     Eigen::MatrixXd J;
     ik_residuals(model, goals, options, q, r, &J);
     ASSERT_EQ(J.rows(), 24 + spheres.pair_count());
-    ASSERT_GT(J.bottomRows(spheres.pair_count()).cwiseAbs().maxCoeff(), 0) << "no collision row active";
+    ASSERT_GT(J.bottomRows(spheres.pair_count()).cwiseAbs().maxCoeff(), 0)
+        << "no collision row active";
     const auto residuals = [&](const Eigen::VectorXd& joints) -> Eigen::VectorXd {
       Eigen::VectorXd residual;
       ik_residuals(model, goals, options, joints, residual);
@@ -79,7 +87,8 @@ TEST(InverseKinematics, ReachesPositionGoalsTakenFromOtherJoints) {
     EXPECT_EQ(result.status, IkStatus::Converged) << result.reason;
     EXPECT_LE(result.position_error, 1e-4);
     const KinematicsState s = forward_kinematics(model, result.joints);
-    for (const auto& g : goals) EXPECT_LT((s.T_world_link[g.link] * g.point_link - g.position_world).norm(), 1e-4);
+    for (const auto& g : goals)
+      EXPECT_LT((s.T_world_link[g.link] * g.point_link - g.position_world).norm(), 1e-4);
   }
 }
 
@@ -93,7 +102,9 @@ TEST(InverseKinematics, ReachesPoseGoalsWithOrientation) {
     EXPECT_LE(result.orientation_error, 1e-3);
     const KinematicsState s = forward_kinematics(model, result.joints);
     for (const auto& g : goals)
-      EXPECT_LT(Eigen::AngleAxisd(s.T_world_link[g.link].linear() * g.rotation_world->transpose()).angle(), 1e-3);
+      EXPECT_LT(Eigen::AngleAxisd(s.T_world_link[g.link].linear() * g.rotation_world->transpose())
+                    .angle(),
+                1e-3);
   }
 }
 
@@ -109,16 +120,20 @@ TEST(InverseKinematics, GoalBeyondTheJointLimitsIsNotReachedAndJointsStayInside)
   EXPECT_EQ(result.status, IkStatus::NotReached);
   EXPECT_NE(result.reason.find("not reached"), std::string::npos) << result.reason;
   EXPECT_GT(result.position_error, 0.01);
-  EXPECT_TRUE(((result.joints - model.lower_limits()).array() >= 0.05 - 1e-12).all()) << result.joints.transpose();
-  EXPECT_TRUE(((model.upper_limits() - result.joints).array() >= 0.05 - 1e-12).all()) << result.joints.transpose();
+  EXPECT_TRUE(((result.joints - model.lower_limits()).array() >= 0.05 - 1e-12).all())
+      << result.joints.transpose();
+  EXPECT_TRUE(((model.upper_limits() - result.joints).array() >= 0.05 - 1e-12).all())
+      << result.joints.transpose();
 }
 
 TEST(InverseKinematics, GoalsBetweenTheArmsAreReachedClearOfCollision) {
   const RobotModel model = two_arms();
   const CollisionModel spheres = arm_spheres(model, 0.005);
   // Tools 8 cm apart in front of the robot: the arms must lean in without their spheres touching.
-  std::vector<IkGoal> goals{{.link = model.link_index("l_tool"), .position_world = Vec3(0.35, 0.04, 0.1)},
-                            {.link = model.link_index("r_tool"), .position_world = Vec3(0.35, -0.04, 0.1)}};
+  std::vector<IkGoal> goals{{.link = model.link_index("l_tool"),
+                             .position_world = Vec3(0.35, 0.04, 0.1)},
+                            {.link = model.link_index("r_tool"),
+                             .position_world = Vec3(0.35, -0.04, 0.1)}};
   const IkOptions options{.collisions = &spheres};
   const IkResult result = solve_inverse_kinematics(model, goals, Eigen::VectorXd::Zero(6), options);
   EXPECT_EQ(result.status, IkStatus::Converged) << result.reason;
@@ -130,8 +145,10 @@ TEST(InverseKinematics, ToolsAtOnePointCannotBeReachedWithoutCollision) {
   const RobotModel model = two_arms();
   // Spheres on the tool points themselves: both at one point always overlap.
   const CollisionModel spheres = arm_spheres(model, 0.005, true);
-  std::vector<IkGoal> goals{{.link = model.link_index("l_tool"), .position_world = Vec3(0.35, 0, 0.1)},
-                            {.link = model.link_index("r_tool"), .position_world = Vec3(0.35, 0, 0.1)}};
+  std::vector<IkGoal> goals{{.link = model.link_index("l_tool"),
+                             .position_world = Vec3(0.35, 0, 0.1)},
+                            {.link = model.link_index("r_tool"),
+                             .position_world = Vec3(0.35, 0, 0.1)}};
   const IkOptions options{.collisions = &spheres, .restarts = 3};
   const IkResult result = solve_inverse_kinematics(model, goals, Eigen::VectorXd::Zero(6), options);
   EXPECT_NE(result.status, IkStatus::Converged) << result.reason;

@@ -39,7 +39,8 @@ TEST(JointLimits, ZeroInsideTheMarginAndGrowingOutside) {
   EXPECT_NEAR(limits.value(Eigen::Vector3d(0.95, 0.25, 0)), 10 * std::pow(0.05, 3), 1e-15);
   EXPECT_NEAR(limits.value(Eigen::Vector3d(-1.2, 0.25, 0)), 10 * std::pow(0.3, 3), 1e-14);
   // A range narrower than twice the margin pushes from both sides.
-  const JointLimits narrow(Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Constant(1, 0.1), 0.1, 10.0);
+  const JointLimits narrow(Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Constant(1, 0.1),
+                           0.1, 10.0);
   EXPECT_NEAR(narrow.value(Eigen::VectorXd::Constant(1, 0.05)), 2 * 10 * std::pow(0.05, 3), 1e-15);
 }
 
@@ -87,7 +88,8 @@ TEST(JointLimits, ViolationsListJointsOutsideTheirHardLimits) {
     <joint name="j1" type="revolute"><parent link="a"/><child link="b"/>
       <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
     <joint name="j2" type="continuous"><parent link="b"/><child link="c"/></joint>
-  </robot>)", "r.urdf");
+  </robot>)",
+                                                        "r.urdf");
   const auto violations = limit_violations(model, Eigen::Vector2d(1.5, 100));
   ASSERT_EQ(violations.size(), 1u);
   EXPECT_EQ(violations[0].joint, "j1");

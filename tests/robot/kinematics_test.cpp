@@ -110,7 +110,8 @@ TEST(Kinematics, EveryJointTypeMatchesHandComputedPoses) {
   const RobotModel model = test_robot();
   const double half_pi = M_PI / 2;
   // θ = (j1, j2, j3, k1)
-  const KinematicsState state = forward_kinematics(model, Eigen::Vector4d(half_pi, 0.2, half_pi, 0));
+  const KinematicsState state =
+      forward_kinematics(model, Eigen::Vector4d(half_pi, 0.2, half_pi, 0));
   // a = Trans(0,0,0.5)·Rz(90°); b = a·Trans(0.3+0.2,0,0); c = b·Trans(0,0,0.2)·Ry(90°).
   EXPECT_TRUE(position(model, state, "b").isApprox(Vec3(0, 0.5, 0.5), 1e-12));
   EXPECT_TRUE(position(model, state, "c").isApprox(Vec3(0, 0.5, 0.7), 1e-12));
@@ -118,8 +119,9 @@ TEST(Kinematics, EveryJointTypeMatchesHandComputedPoses) {
   EXPECT_TRUE(position(model, state, "tool").isApprox(Vec3(0, 0.6, 0.7), 1e-12));
   Mat3 R_world_tool;
   R_world_tool << 0, -1, 0, 0, 0, 1, -1, 0, 0;
-  EXPECT_TRUE(state.T_world_link[static_cast<std::size_t>(model.link_index("tool"))].linear().isApprox(
-      R_world_tool, 1e-12));
+  EXPECT_TRUE(
+      state.T_world_link[static_cast<std::size_t>(model.link_index("tool"))].linear().isApprox(
+          R_world_tool, 1e-12));
   // Mimic: e turns by 2·j1 + 0.1 about a's z, on top of a's own 90°.
   EXPECT_TRUE(position(model, state, "e_tip")
                   .isApprox(Vec3(0.1 * std::sin(0.1), -0.1 * std::cos(0.1), 0.6), 1e-12));
@@ -128,16 +130,18 @@ TEST(Kinematics, EveryJointTypeMatchesHandComputedPoses) {
 
 TEST(Kinematics, GeneralAxisRotatesAboutThatAxis) {
   const RobotModel model = test_robot();
-  const Mat3 R_origin = (Eigen::AngleAxisd(0.1, Vec3::UnitZ()) * Eigen::AngleAxisd(-0.2, Vec3::UnitY()) *
-                         Eigen::AngleAxisd(0.3, Vec3::UnitX()))
-                            .toRotationMatrix();
+  const Mat3 R_origin =
+      (Eigen::AngleAxisd(0.1, Vec3::UnitZ()) * Eigen::AngleAxisd(-0.2, Vec3::UnitY()) *
+       Eigen::AngleAxisd(0.3, Vec3::UnitX()))
+          .toRotationMatrix();
   // Half a turn about (1,1,0)/√2 maps (0,0,0.4) to (0,0,-0.4) in the joint frame.
   const KinematicsState state = forward_kinematics(model, Eigen::Vector4d(0, 0, 0, M_PI));
   EXPECT_TRUE(position(model, state, "d_tip").isApprox(R_origin * Vec3(0, 0, -0.4), 1e-12));
   // A quarter turn maps it to (0.4/√2)(1,-1,0).
   const KinematicsState quarter = forward_kinematics(model, Eigen::Vector4d(0, 0, 0, M_PI / 2));
-  EXPECT_TRUE(position(model, quarter, "d_tip")
-                  .isApprox(R_origin * Vec3(0.4 / std::sqrt(2.0), -0.4 / std::sqrt(2.0), 0), 1e-12));
+  EXPECT_TRUE(
+      position(model, quarter, "d_tip")
+          .isApprox(R_origin * Vec3(0.4 / std::sqrt(2.0), -0.4 / std::sqrt(2.0), 0), 1e-12));
 }
 
 TEST(Kinematics, InactiveJointsKeepTheirFixedValues) {

@@ -22,13 +22,16 @@ Vec3 uniform_in_box(const Vec3& size, std::mt19937& rng) {
 
 TEST(SphereCover, BoxCoverContainsSampledPointsAndEveryCorner) {
   std::mt19937 rng(7);
-  for (const Vec3& size : {Vec3(0.1, 0.1, 0.1), Vec3(0.3, 0.03, 0.05), Vec3(0.5, 0.4, 0.01), Vec3(2.0, 0.02, 0.02)}) {
+  for (const Vec3& size :
+       {Vec3(0.1, 0.1, 0.1), Vec3(0.3, 0.03, 0.05), Vec3(0.5, 0.4, 0.01), Vec3(2.0, 0.02, 0.02)}) {
     const auto spheres = cover_box(size);
     ASSERT_FALSE(spheres.empty());
     EXPECT_LE(spheres.size(), 64u) << size.transpose();
-    for (int k = 0; k < 2000; ++k) EXPECT_LE(uncovered(spheres, uniform_in_box(size, rng)), 0) << size.transpose();
+    for (int k = 0; k < 2000; ++k)
+      EXPECT_LE(uncovered(spheres, uniform_in_box(size, rng)), 0) << size.transpose();
     for (int c = 0; c < 8; ++c) {
-      const Vec3 corner = 0.5 * Vec3(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1).cwiseProduct(size);
+      const Vec3 corner =
+          0.5 * Vec3(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1).cwiseProduct(size);
       EXPECT_LE(uncovered(spheres, corner), 0) << size.transpose() << " corner " << c;
     }
   }
@@ -44,7 +47,8 @@ TEST(SphereCover, BoxCoverIsTightForAThinBar) {
 TEST(SphereCover, CylinderCoverContainsSampledPointsOfItsRimAndVolume) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0, 1);
-  for (const auto& [radius, length] : {std::pair{0.03, 0.3}, std::pair{0.1, 0.02}, std::pair{0.05, 0.05}}) {
+  for (const auto& [radius, length] :
+       {std::pair{0.03, 0.3}, std::pair{0.1, 0.02}, std::pair{0.05, 0.05}}) {
     const auto spheres = cover_cylinder(radius, length);
     EXPECT_LE(spheres.size(), static_cast<std::size_t>(max_cover_cells_per_axis));
     for (int k = 0; k < 2000; ++k) {
@@ -52,7 +56,8 @@ TEST(SphereCover, CylinderCoverContainsSampledPointsOfItsRimAndVolume) {
       // Half the samples on the rim of an end face, where a cover is most likely to miss.
       const double r = k % 2 ? radius : radius * std::sqrt(u(rng));
       const double z = k % 2 ? (u(rng) < 0.5 ? -0.5 : 0.5) * length : (u(rng) - 0.5) * length;
-      EXPECT_LE(uncovered(spheres, Vec3(r * std::cos(angle), r * std::sin(angle), z)), 0) << radius << " " << length;
+      EXPECT_LE(uncovered(spheres, Vec3(r * std::cos(angle), r * std::sin(angle), z)), 0)
+          << radius << " " << length;
     }
   }
 }
@@ -81,7 +86,8 @@ TEST(SphereCover, ShapeCoverIsPlacedInTheLinkFrame) {
 
 // A closed octahedron with half-axes a: convex, so convex combinations of its vertices are inside.
 void octahedron(const Vec3& a, std::vector<Vec3>& v, std::vector<std::array<int, 3>>& t) {
-  v = {Vec3(a.x(), 0, 0), Vec3(-a.x(), 0, 0), Vec3(0, a.y(), 0), Vec3(0, -a.y(), 0), Vec3(0, 0, a.z()), Vec3(0, 0, -a.z())};
+  v = {Vec3(a.x(), 0, 0),  Vec3(-a.x(), 0, 0), Vec3(0, a.y(), 0),
+       Vec3(0, -a.y(), 0), Vec3(0, 0, a.z()),  Vec3(0, 0, -a.z())};
   t = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
 }
 
@@ -99,7 +105,9 @@ TEST(SphereCover, TriangleMeshCoverContainsItsSurfaceAndInterior) {
     const auto& tri = t[static_cast<std::size_t>(k) % t.size()];
     double b1 = u(rng), b2 = u(rng);
     if (b1 + b2 > 1) b1 = 1 - b1, b2 = 1 - b2;
-    EXPECT_LE(uncovered(spheres, v[tri[0]] + b1 * (v[tri[1]] - v[tri[0]]) + b2 * (v[tri[2]] - v[tri[0]])), 0);
+    EXPECT_LE(uncovered(spheres,
+                        v[tri[0]] + b1 * (v[tri[1]] - v[tri[0]]) + b2 * (v[tri[2]] - v[tri[0]])),
+              0);
     // ... and inside.
     Eigen::Matrix<double, 6, 1> w;
     for (int i = 0; i < 6; ++i) w[i] = -std::log(u(rng) + 1e-300);

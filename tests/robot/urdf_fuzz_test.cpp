@@ -33,12 +33,35 @@ const char* const kArmUrdf = R"(<?xml version="1.0"?>
 </robot>
 )";
 
-const test::TextMutator kUrdfMutator({"<", ">", "/>", "</link>", "</joint>", "<link name=\"x\"/>",
-                                      "<joint name=\"j\" type=\"revolute\">", "\"", "'", "=",
-                                      "nan", "inf", "-inf", "1e999", "-1e308", "1e-400", "0 0 0",
-                                      "<a>", "<!--", "-->", "<![CDATA[", "]]>", "&amp;", "&#0;",
-                                      "<?xml?>", "type=\"floating\"", "<mimic joint=\"elbow\"/>",
-                                      "<parent link=\"tip\"/>", "\xff\xfe"});
+const test::TextMutator kUrdfMutator({"<",
+                                      ">",
+                                      "/>",
+                                      "</link>",
+                                      "</joint>",
+                                      "<link name=\"x\"/>",
+                                      "<joint name=\"j\" type=\"revolute\">",
+                                      "\"",
+                                      "'",
+                                      "=",
+                                      "nan",
+                                      "inf",
+                                      "-inf",
+                                      "1e999",
+                                      "-1e308",
+                                      "1e-400",
+                                      "0 0 0",
+                                      "<a>",
+                                      "<!--",
+                                      "-->",
+                                      "<![CDATA[",
+                                      "]]>",
+                                      "&amp;",
+                                      "&#0;",
+                                      "<?xml?>",
+                                      "type=\"floating\"",
+                                      "<mimic joint=\"elbow\"/>",
+                                      "<parent link=\"tip\"/>",
+                                      "\xff\xfe"});
 
 void load_and_move(const std::string& text) {
   const RobotModel model = RobotModel::from_urdf_string(text, "fuzz.urdf");
@@ -49,7 +72,8 @@ TEST(UrdfFuzz, MutatedUrdfLoadsOrIsAnInputError) {
   const std::string yumi = test::read_text(test::source_path("data/robots/yumi/yumi.urdf"));
   ASSERT_NO_THROW(load_and_move(yumi));
   ASSERT_NO_THROW(load_and_move(kArmUrdf));
-  const test::FuzzCounts counts = test::fuzz_parser({kArmUrdf, kArmUrdf, yumi}, kUrdfMutator, 2400, 5, load_and_move);
+  const test::FuzzCounts counts =
+      test::fuzz_parser({kArmUrdf, kArmUrdf, yumi}, kUrdfMutator, 2400, 5, load_and_move);
   EXPECT_GT(counts.refused, 300);
   EXPECT_GT(counts.parsed, 300);
 }
@@ -58,13 +82,16 @@ TEST(UrdfFuzz, MutatedJointsFilesLoadOrAreInputErrors) {
   const RobotModel model = RobotModel::from_urdf_string(kArmUrdf, "arm.urdf");
   const Eigen::VectorXd defaults = Eigen::VectorXd::Zero(model.active_count());
   const test::TempDir dir;
-  const test::TextMutator mutator({"{", "[", "]", "}", ",", ":", "\"", "1e999", "NaN", "null", "true",
-                                   "\"shoulder\"", "\"finger\": 1", "\"elbow\": 1, \"elbow\": 2", "[]", "{}"});
+  const test::TextMutator mutator({"{", "[", "]", "}", ",", ":", "\"", "1e999", "NaN", "null",
+                                   "true", "\"shoulder\"", "\"finger\": 1",
+                                   "\"elbow\": 1, \"elbow\": 2", "[]", "{}"});
   const std::string seed = R"({"joints": {"shoulder": 0.5, "elbow": 0.05}})";
-  const test::FuzzCounts counts = test::fuzz_parser({seed}, mutator, 1500, 9, [&](const std::string& text) {
-    const Eigen::VectorXd theta = load_joints_file(dir.write("joints.json", text), model, defaults);
-    ASSERT_TRUE(theta.allFinite());
-  });
+  const test::FuzzCounts counts =
+      test::fuzz_parser({seed}, mutator, 1500, 9, [&](const std::string& text) {
+        const Eigen::VectorXd theta =
+            load_joints_file(dir.write("joints.json", text), model, defaults);
+        ASSERT_TRUE(theta.allFinite());
+      });
   EXPECT_GT(counts.refused, 300);
   EXPECT_GT(counts.parsed, 0);  // a tiny seed: most mutations break it
 }

@@ -23,19 +23,24 @@ std::string chain_urdf(int links) {
   for (int i = 1; i < links; ++i) {
     const std::string n = std::to_string(i), p = std::to_string(i - 1);
     xml += "<joint name=\"j" + n + "\" type=\"revolute\"><parent link=\"l" + p +
-           "\"/><child link=\"l" + n + "\"/><origin xyz=\"0.1 0 0\"/><axis xyz=\"0 0 1\"/>"
-           "<limit lower=\"-1\" upper=\"1\" velocity=\"1\" effort=\"1\"/></joint>\n<link name=\"l" + n + "\"/>\n";
+           "\"/><child link=\"l" + n +
+           "\"/><origin xyz=\"0.1 0 0\"/><axis xyz=\"0 0 1\"/>"
+           "<limit lower=\"-1\" upper=\"1\" velocity=\"1\" effort=\"1\"/></joint>\n<link name=\"l" +
+           n + "\"/>\n";
   }
   return xml + "</robot>\n";
 }
 
 TEST(UrdfLimits, LongLinkNameIsReadAndEchoedBounded) {
   const std::string name(30'000, 'n');
-  const RobotModel model = RobotModel::from_urdf_string("<robot name=\"r\"><link name=\"" + name + "\"/></robot>", "r.urdf");
+  const RobotModel model =
+      RobotModel::from_urdf_string("<robot name=\"r\"><link name=\"" + name + "\"/></robot>",
+                                   "r.urdf");
   EXPECT_EQ(model.links()[0].name, name);
   // A joint to an unknown link: urdfdom refuses, the message stays short.
   const std::string bad = "<robot name=\"r\"><link name=\"a\"/><joint name=\"" + name +
-                          "\" type=\"fixed\"><parent link=\"a\"/><child link=\"" + name + "\"/></joint></robot>";
+                          "\" type=\"fixed\"><parent link=\"a\"/><child link=\"" + name +
+                          "\"/></joint></robot>";
   const std::string message = error_of([&] { RobotModel::from_urdf_string(bad, "r.urdf"); });
   EXPECT_EQ(message.rfind("r.urdf", 0), 0u);
   const std::string unknown = error_of([&] { model.link_index(std::string(50'000, 'x')); });
@@ -66,7 +71,8 @@ TEST(UrdfLimits, DeeplyNestedXmlIsRefusedBeforeParsing) {
             "deep.urdf:4: XML elements nested deeper than 100 levels");
   // Self-closing elements, comments and '>' inside attribute values do not nest.
   std::string flat = "<robot name=\"r\"><link name=\"a\"/>";
-  for (int i = 0; i < 500; ++i) flat += "<!-- <x> --><material name=\"m>" + std::to_string(i) + "\"/>";
+  for (int i = 0; i < 500; ++i)
+    flat += "<!-- <x> --><material name=\"m>" + std::to_string(i) + "\"/>";
   EXPECT_NO_THROW(RobotModel::from_urdf_string(flat + "</robot>", "flat.urdf"));
 }
 
@@ -82,9 +88,12 @@ TEST(UrdfLimits, FifoAndOversizeFilesAreRefused) {
   const test::TempDir dir;
   const auto fifo = dir.path() / "robot.urdf";
   ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
-  EXPECT_EQ(error_of([&] { RobotModel::load_urdf_file(fifo); }), fifo.string() + ": not a regular file (a FIFO)");
-  const auto big = dir.write("big.urdf", "<robot name=\"r\"><link name=\"a\"/></robot>" + std::string(16u << 20, ' '));
-  EXPECT_NE(error_of([&] { RobotModel::load_urdf_file(big); }).find("byte limit for URDF files"), std::string::npos);
+  EXPECT_EQ(error_of([&] { RobotModel::load_urdf_file(fifo); }),
+            fifo.string() + ": not a regular file (a FIFO)");
+  const auto big = dir.write("big.urdf", "<robot name=\"r\"><link name=\"a\"/></robot>" +
+                                             std::string(16u << 20, ' '));
+  EXPECT_NE(error_of([&] { RobotModel::load_urdf_file(big); }).find("byte limit for URDF files"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -20,10 +20,11 @@ TEST(HttpRules, ResolvesFilesInsideTheWebRootOnly) {
   const auto root = dir.path() / "web";
 
   EXPECT_EQ(resolve_static_file(root, "/"), std::filesystem::canonical(index));
-  EXPECT_EQ(resolve_static_file(root, "/js/app.js?v=1"), std::filesystem::canonical(root / "js/app.js"));
-  for (const char* bad : {"/../web/index.html", "/js/../index.html", "/.hidden", "/js//app.js",
-                          "/js/app.js%00", "/js\\app.js", "/link.txt", "/missing.js", "/js",
-                          "index.html", ""})
+  EXPECT_EQ(resolve_static_file(root, "/js/app.js?v=1"),
+            std::filesystem::canonical(root / "js/app.js"));
+  for (const char* bad :
+       {"/../web/index.html", "/js/../index.html", "/.hidden", "/js//app.js", "/js/app.js%00",
+        "/js\\app.js", "/link.txt", "/missing.js", "/js", "index.html", ""})
     EXPECT_FALSE(resolve_static_file(root, bad)) << bad;
 }
 
@@ -47,13 +48,29 @@ TEST(HttpRules, HostMustBeLoopbackAnAddressOrTheBoundName) {
 }
 
 TEST(HttpRules, HostMustBeAWellFormedNameQuadOrBracketedIpv6WithAPortInRange) {
-  for (const char* good : {"127.0.0.1", "0.0.0.0:1", "255.255.255.255:65535", "[::1]", "[fe80::1]:8080",
-                           "[::ffff:127.0.0.1]:80", "LOCALHOST:8080"})
+  for (const char* good : {"127.0.0.1", "0.0.0.0:1", "255.255.255.255:65535", "[::1]",
+                           "[fe80::1]:8080", "[::ffff:127.0.0.1]:80", "LOCALHOST:8080"})
     EXPECT_TRUE(host_allowed(good, "127.0.0.1")) << good;
-  for (const char* bad : {"[evil.com]", "[evil.com]:8080", "999.999.999.999", "999.999.999.999:8080",
-                          "256.0.0.1", "1.2.3", "1.2.3.4.5", "01.2.3.4", "127.0.0.1:", "127.0.0.1:0",
-                          "127.0.0.1:65536", "127.0.0.1:80x", "[::1]x", "[::1]:", "[]", "localhost.",
-                          "local_host", "-robot:80", "robot-pc:99999", "a..b"})
+  for (const char* bad : {"[evil.com]",
+                          "[evil.com]:8080",
+                          "999.999.999.999",
+                          "999.999.999.999:8080",
+                          "256.0.0.1",
+                          "1.2.3",
+                          "1.2.3.4.5",
+                          "01.2.3.4",
+                          "127.0.0.1:",
+                          "127.0.0.1:0",
+                          "127.0.0.1:65536",
+                          "127.0.0.1:80x",
+                          "[::1]x",
+                          "[::1]:",
+                          "[]",
+                          "localhost.",
+                          "local_host",
+                          "-robot:80",
+                          "robot-pc:99999",
+                          "a..b"})
     EXPECT_FALSE(host_allowed(bad, "robot-pc")) << bad;
   EXPECT_TRUE(host_allowed("robot-pc:8080", "robot-pc"));
 }

@@ -28,14 +28,17 @@ std::string error_of(const std::string& text) {
 }
 
 TEST(Protocol, DegenerateCentrelineIsRefusedWithItsLength) {
-  EXPECT_NE(error_of(R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,1e-13,0.3],[0.4,2e-13,0.3]]})")
-                .find("points: expected a centre-line at least 1 mm long (its arc length is 2e-13 m)"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of(
+          R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,1e-13,0.3],[0.4,2e-13,0.3]]})")
+          .find("points: expected a centre-line at least 1 mm long (its arc length is 2e-13 m)"),
+      std::string::npos);
   EXPECT_EQ(error_of(R"({"type":"set_centerline","points":[[0.4,0,0.3],[0.4,0.001,0.3]]})"), "");
 }
 
 TEST(Protocol, ParsesSetTargetWithItsId) {
-  const Command c = parse_command(R"({"type":"set_target","id":7,"node":3,"position":[0.1,0.2,0.3]})", context());
+  const Command c =
+      parse_command(R"({"type":"set_target","id":7,"node":3,"position":[0.1,0.2,0.3]})", context());
   EXPECT_EQ(c.type, Command::Type::SetTarget);
   EXPECT_EQ(c.id, 7);
   EXPECT_EQ(c.node, 3);
@@ -44,10 +47,13 @@ TEST(Protocol, ParsesSetTargetWithItsId) {
 
 TEST(Protocol, ParsesSetTargetsCenterlineJointsAndScenes) {
   const Command t = parse_command(
-      R"({"type":"set_targets","targets":[{"node":1,"position":[0,0,0]},{"node":9,"position":[1,2,3]}]})", context());
+      R"({"type":"set_targets","targets":[{"node":1,"position":[0,0,0]},{"node":9,"position":[1,2,3]}]})",
+      context());
   ASSERT_EQ(t.targets.size(), 2);
   EXPECT_EQ(t.targets.nodes[1], 9);
-  const Command l = parse_command(R"({"type":"set_centerline","points":[[0,0,0],[0.1,0,0],[0.2,0.1,0]]})", context());
+  const Command l =
+      parse_command(R"({"type":"set_centerline","points":[[0,0,0],[0.1,0,0],[0.2,0.1,0]]})",
+                    context());
   EXPECT_EQ(l.points.size(), 3u);
   const Command j = parse_command(R"({"type":"set_joint","joint":"j2","value":-1.5})", context());
   EXPECT_EQ(j.joint, 1);
@@ -63,14 +69,18 @@ TEST(Protocol, ErrorsSayWhereWhatWasExpectedAndWhatWasFound) {
             "message: node: expected a whole number from 0 to 9, got 10");
   EXPECT_EQ(error_of(R"({"type":"set_targets","targets":[{"node":1,"position":[0,"x",0]}]})"),
             "message: targets[0].position[1]: expected a number, got \"x\"");
-  EXPECT_EQ(error_of(R"({"type":"set_paused","paused":1})"), "message: paused: expected true or false, got 1");
-  EXPECT_EQ(error_of(R"({"type":"reset","extra":1})"), "message: extra: unknown key; known: type, id");
+  EXPECT_EQ(error_of(R"({"type":"set_paused","paused":1})"),
+            "message: paused: expected true or false, got 1");
+  EXPECT_EQ(error_of(R"({"type":"reset","extra":1})"),
+            "message: extra: unknown key; known: type, id");
   EXPECT_EQ(error_of("{\"type\":"), "message: not valid JSON");
   // A key given twice is an error, never silently the last one (the paused state would flip).
   const std::string twice = error_of(R"({"type":"set_paused","paused":true,"paused":false})");
   EXPECT_NE(twice.find("paused"), std::string::npos) << twice;
   EXPECT_NE(twice.find("duplicate key"), std::string::npos) << twice;
-  EXPECT_NE(error_of(R"({"type":"launch"})").find("message: type: expected one of ping, set_target"), std::string::npos);
+  EXPECT_NE(
+      error_of(R"({"type":"launch"})").find("message: type: expected one of ping, set_target"),
+      std::string::npos);
 }
 
 TEST(Protocol, RejectsOutOfRangeAndNonFiniteNumbers) {
@@ -83,14 +93,18 @@ TEST(Protocol, RejectsOutOfRangeAndNonFiniteNumbers) {
   EXPECT_NE(error_of(R"({"type":"set_joint","joint":2,"value":0})"), "");
   EXPECT_NE(error_of(R"({"type":"set_joints","joints":[0]})"), "");
   EXPECT_NE(error_of(R"({"type":"set_centerline","points":[[0,0,0]]})"), "");
-  EXPECT_NE(error_of(R"({"type":"set_targets","targets":[{"node":1,"position":[0,0,0]},{"node":1,"position":[0,0,0]}]})"), "");
+  EXPECT_NE(
+      error_of(
+          R"({"type":"set_targets","targets":[{"node":1,"position":[0,0,0]},{"node":1,"position":[0,0,0]}]})"),
+      "");
   EXPECT_NE(error_of(R"({"type":"load_scene","scene":"../../etc/passwd"})"), "");
   EXPECT_NE(error_of(R"({"type":"ping","id":{"a":1}})"), "");
   EXPECT_NE(error_of(R"([1,2,3])"), "");
 }
 
 TEST(Protocol, RefusesDeepNestingAndOversizedMessages) {
-  EXPECT_NE(error_of(std::string(100000, '[') + std::string(100000, ']')).find("nested"), std::string::npos);
+  EXPECT_NE(error_of(std::string(100000, '[') + std::string(100000, ']')).find("nested"),
+            std::string::npos);
   const std::string big = R"({"type":"ping","pad":")" + std::string(max_message_bytes, 'x') + "\"}";
   EXPECT_NE(error_of(big).find("bytes"), std::string::npos);
 }

@@ -107,13 +107,16 @@ int connect_loopback(int port) {
 }
 
 // Sends a GET and returns everything received until the server closes, or nullopt on timeout.
-std::optional<std::string> http_get(int port, const std::string& target, std::chrono::seconds limit) {
+std::optional<std::string> http_get(int port, const std::string& target,
+                                    std::chrono::seconds limit) {
   const int fd = connect_loopback(port);
   if (fd < 0) return std::nullopt;
-  const std::string request = "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
+  const std::string request = "GET " + target +
+                              " HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(port) +
                               "\r\nConnection: close\r\n\r\n";
   std::optional<std::string> response;
-  if (send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size())) {
+  if (send(fd, request.data(), request.size(), MSG_NOSIGNAL) ==
+      static_cast<ssize_t>(request.size())) {
     const auto deadline = std::chrono::steady_clock::now() + limit;
     std::string received;
     for (;;) {
@@ -138,8 +141,8 @@ std::optional<std::string> http_get(int port, const std::string& target, std::ch
 class Watcher {
  public:
   explicit Watcher(int port) {
-    beast::get_lowest_layer(ws_).connect(tcp::endpoint(net::ip::address_v4::loopback(),
-                                                       static_cast<unsigned short>(port)));
+    beast::get_lowest_layer(ws_).connect(
+        tcp::endpoint(net::ip::address_v4::loopback(), static_cast<unsigned short>(port)));
     ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws");
   }
   void send(const std::string& text) { ws_.write(net::buffer(text)); }
@@ -183,7 +186,8 @@ std::size_t accept_failures(const std::string& log) {
        at = log.find("accept failed:", at + 1)) {
     ++total;
     const std::size_t end = log.find('\n', at);
-    const std::string line = log.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    const std::string line =
+        log.substr(at, end == std::string::npos ? std::string::npos : end - at);
     const std::size_t open = line.rfind(" (");
     if (open != std::string::npos && line.find(" times more)", open) != std::string::npos)
       total += std::stoull(line.substr(open + 2));
@@ -240,7 +244,8 @@ TEST_F(ServeExhaustion, HalfSentRequestsBeyondTheFileLimitLeaveTheServerServingW
   const int port = server.wait_for_port(60s);
   ASSERT_GT(port, 0) << server.log();
   Watcher page(port);
-  ASSERT_TRUE(page.next("\"type\":\"state\"", 20s)) << "no state before the flood\n" << server.log();
+  ASSERT_TRUE(page.next("\"type\":\"state\"", 20s)) << "no state before the flood\n"
+                                                    << server.log();
   flood_and_check(server, port, page);
 }
 
@@ -252,22 +257,27 @@ TEST_F(ServeExhaustion, AcceptFailingWithTooManyOpenFilesClosesIdleConnectionsIn
   const int port = server.wait_for_port(60s);
   ASSERT_GT(port, 0) << server.log();
   Watcher page(port);
-  ASSERT_TRUE(page.next("\"type\":\"state\"", 20s)) << "no state before the flood\n" << server.log();
-  const auto open_files = std::distance(std::filesystem::directory_iterator("/proc/" + std::to_string(server.pid()) + "/fd"),
+  ASSERT_TRUE(page.next("\"type\":\"state\"", 20s)) << "no state before the flood\n"
+                                                    << server.log();
+  const auto open_files = std::distance(std::filesystem::directory_iterator(
+                                            "/proc/" + std::to_string(server.pid()) + "/fd"),
                                         std::filesystem::directory_iterator{});
   const rlimit lowered{static_cast<rlim_t>(open_files + 2), server_open_file_limit};
   ASSERT_EQ(prlimit(server.pid(), RLIMIT_NOFILE, &lowered, nullptr), 0);
   const auto start = std::chrono::steady_clock::now();
   const std::string log = flood_and_check(server, port, page);
-  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_NE(log.find("accept failed: Too many open files"), std::string::npos)
-      << "the test did not reach descriptor exhaustion:\n" << log.substr(0, 2000);
+      << "the test did not reach descriptor exhaustion:\n"
+      << log.substr(0, 2000);
   // Not spinning, counted rather than timed: each failed accept() either closes one of the
   // flood's connections or pauses 100 ms, so failures ≤ connections + 10/s (+ slack). A server
   // that retried at once would fail hundreds of thousands of times a second.
   const std::size_t failures = accept_failures(log);
   EXPECT_GT(failures, 0u);
-  EXPECT_LE(static_cast<double>(failures), attackers + 2 + 10 * seconds + 50) << log.substr(0, 2000);
+  EXPECT_LE(static_cast<double>(failures), attackers + 2 + 10 * seconds + 50)
+      << log.substr(0, 2000);
 }
 
 }  // namespace

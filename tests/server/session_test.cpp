@@ -40,13 +40,15 @@ TEST_F(SessionTest, SceneMessageDescribesRobotObjectAndScenes) {
 }
 
 TEST_F(SessionTest, SetTargetReachesTheControllerAndTheStateMessage) {
-  const auto r = session.handle(R"({"type":"set_target","id":1,"node":5,"position":[0.4,0.0,0.3]})");
+  const auto r =
+      session.handle(R"({"type":"set_target","id":1,"node":5,"position":[0.4,0.0,0.3]})");
   EXPECT_TRUE(r.ok) << r.text;
   EXPECT_EQ(reply_json(r)["type"], "ok");
   EXPECT_EQ(reply_json(r)["id"], 1);
   // Marked as editing right after the edit (the window is 0.3 s; this takes microseconds).
   EXPECT_TRUE(nlohmann::json::parse(session.state_message(1))["editing"].get<bool>());
-  const auto s = wait_until(session, [](const ControllerSnapshot& s) { return s.targets.size() == 1; });
+  const auto s =
+      wait_until(session, [](const ControllerSnapshot& s) { return s.targets.size() == 1; });
   ASSERT_EQ(s->targets.size(), 1);
   EXPECT_EQ(s->targets.nodes[0], 5);
   session.tick();
@@ -59,9 +61,13 @@ TEST_F(SessionTest, SetTargetReachesTheControllerAndTheStateMessage) {
 TEST_F(SessionTest, ObserveFeedsTheClosedLoopAndBadObservationsChangeNothing) {
   const auto first = session.controller().snapshot();
   nlohmann::json joints = nlohmann::json::object();
-  for (std::size_t j = 0; j < first->joint_names.size(); ++j) joints[first->joint_names[j]] = first->joints[j];
-  const Vec3 seen = first->positions.segment<3>(15) + Vec3(0.002, 0, 0);  // node 5, 2 mm off the model
-  const nlohmann::json frame = {{"joints", joints}, {"markers", {{{"node", 5}, {"position", {seen.x(), seen.y(), seen.z()}}}}}};
+  for (std::size_t j = 0; j < first->joint_names.size(); ++j)
+    joints[first->joint_names[j]] = first->joints[j];
+  const Vec3 seen =
+      first->positions.segment<3>(15) + Vec3(0.002, 0, 0);  // node 5, 2 mm off the model
+  const nlohmann::json frame = {{"joints", joints},
+                                {"markers",
+                                 {{{"node", 5}, {"position", {seen.x(), seen.y(), seen.z()}}}}}};
   auto observe = [&](const nlohmann::json& f) {
     return session.handle(nlohmann::json{{"type", "observe"}, {"frame", f}}.dump());
   };
@@ -80,7 +86,8 @@ TEST_F(SessionTest, ObserveFeedsTheClosedLoopAndBadObservationsChangeNothing) {
   EXPECT_TRUE(session.handle(R"({"type":"set_feedback","on":true})").ok);
   const auto r = observe(frame);
   ASSERT_TRUE(r.ok) << r.text;
-  const auto s = wait_until(session, [](const ControllerSnapshot& s) { return s.observations > 0; });
+  const auto s =
+      wait_until(session, [](const ControllerSnapshot& s) { return s.observations > 0; });
   EXPECT_EQ(s->observations, 1u);  // the bad ones never reached the controller
   session.tick();
   const auto state = nlohmann::json::parse(session.state_message(1));
@@ -111,15 +118,18 @@ TEST_F(SessionTest, SecondSetTargetMovesTheFirstAndRemoveTargetDeletesIt) {
 TEST_F(SessionTest, BadMessagesGetAnErrorReplyAndChangeNothing) {
   EXPECT_TRUE(session.handle(R"({"type":"set_paused","paused":true})").ok);
   EXPECT_TRUE(session.handle(R"({"type":"set_target","node":5,"position":[0.4,0.0,0.3]})").ok);
-  for (const char* bad : {"", "nonsense", R"({"type":"set_target","id":3,"node":100000,"position":[0,0,0]})",
-                          R"({"type":"set_targets","targets":[]}x)", R"({"type":"load_scene","scene":"/etc/passwd"})"}) {
+  for (const char* bad :
+       {"", "nonsense", R"({"type":"set_target","id":3,"node":100000,"position":[0,0,0]})",
+        R"({"type":"set_targets","targets":[]}x)",
+        R"({"type":"load_scene","scene":"/etc/passwd"})"}) {
     const auto r = session.handle(bad);
     EXPECT_FALSE(r.ok) << bad;
     EXPECT_EQ(reply_json(r)["type"], "error");
     EXPECT_FALSE(r.log.empty());
   }
   EXPECT_EQ(reply_json(session.handle(R"({"type":"nope","id":3})"))["id"], 3);
-  const auto s = wait_until(session, [](const ControllerSnapshot& s) { return s.targets.size() == 1; });
+  const auto s =
+      wait_until(session, [](const ControllerSnapshot& s) { return s.targets.size() == 1; });
   EXPECT_EQ(s->targets.size(), 1);
   EXPECT_EQ(s->targets.nodes[0], 5);
 }
@@ -148,7 +158,8 @@ TEST_F(SessionTest, DegenerateCentrelineAndAbsurdTargetsGetAnErrorAndChangeNothi
     EXPECT_EQ(m["targets"][0]["node"], 5);
     EXPECT_TRUE(m["centerline"].empty());
     for (const char* field : {"targets", "centerline", "joints", "links", "error"})
-      EXPECT_EQ(m[field].dump().find("null"), std::string::npos) << field << ": " << m[field].dump();
+      EXPECT_EQ(m[field].dump().find("null"), std::string::npos)
+          << field << ": " << m[field].dump();
   }
 }
 
@@ -158,9 +169,11 @@ TEST_F(SessionTest, JoggingNeedsPauseAndArmingNeedsALink) {
   EXPECT_TRUE(session.handle(R"({"type":"set_paused","paused":true})").ok);
   EXPECT_TRUE(wait_until(session, [](const ControllerSnapshot& s) { return s.paused; })->paused);
   EXPECT_TRUE(session.handle(jog).ok);
-  const auto s = wait_until(session, [](const ControllerSnapshot& s) { return std::abs(s.joints[0]) < 1e-9; });
+  const auto s =
+      wait_until(session, [](const ControllerSnapshot& s) { return std::abs(s.joints[0]) < 1e-9; });
   EXPECT_NEAR(s->joints[0], 0.0, 1e-9);
-  EXPECT_NE(reply_json(session.handle(R"({"type":"arm"})"))["message"].get<std::string>().find("no robot link"),
+  EXPECT_NE(reply_json(session.handle(R"({"type":"arm"})"))["message"].get<std::string>().find(
+                "no robot link"),
             std::string::npos);
 }
 

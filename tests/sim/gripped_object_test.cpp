@@ -21,7 +21,8 @@ TEST(GripSprings, DerivativesMatchCentralDifferences) {
   const Scene scene = test::two_arm_scene();
   GrippedObject object(scene);
   std::mt19937 rng(1);
-  const ObjectState state = object.solve_from(random_joints(object, 0.2, rng), object.reference_positions());
+  const ObjectState state =
+      object.solve_from(random_joints(object, 0.2, rng), object.reference_positions());
   const GripEnergy grip(object.grips(), state.kinematics());
   test::expect_derivatives_match(grip, test::perturbed(state.positions(), 0.002, rng), 1e-6);
 }
@@ -54,7 +55,8 @@ TEST(GrippedObject, ReferenceJointsHoldTheObjectAtItsPlacedShape) {
   Scene scene = test::two_arm_scene();
   scene.gravity = Vec3::Zero();
   GrippedObject object(scene);
-  const ObjectState state = object.solve_from(object.reference_joints(), object.reference_positions());
+  const ObjectState state =
+      object.solve_from(object.reference_joints(), object.reference_positions());
   ASSERT_TRUE(state.statics().converged()) << state.statics().reason;
   EXPECT_LT((state.positions() - object.reference_positions()).cwiseAbs().maxCoeff(), 1e-9);
 }

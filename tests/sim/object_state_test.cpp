@@ -89,7 +89,8 @@ TEST(ObjectState, ChordStepsComeOnlyFromTheStateNamed) {
   // The same solve with and without a chord source: chord steps save factorizations only when
   // a nearby state's factorization is given; none is remembered from earlier calls.
   const GrippedObject object(test::two_arm_scene());
-  const ObjectState start = object.solve_from(object.reference_joints(), object.reference_positions());
+  const ObjectState start =
+      object.solve_from(object.reference_joints(), object.reference_positions());
   ASSERT_TRUE(start.has_factor());
   Eigen::VectorXd theta = object.reference_joints();
   theta.array() += 0.01;

@@ -34,7 +34,9 @@ SparseMatrix equilibrium_hessian(const Scene& scene) {
   return statics.hessian(x);
 }
 
-SparseMatrix bar_hessian() { return equilibrium_hessian(clamped_box({0.32, 0.03, 0.03}, {16, 4, 4})); }
+SparseMatrix bar_hessian() {
+  return equilibrium_hessian(clamped_box({0.32, 0.03, 0.03}, {16, 4, 4}));
+}
 
 int bandwidth(const SparseMatrix& lower, const std::vector<int>& new_index) {
   int b = 0;

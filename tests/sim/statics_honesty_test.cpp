@@ -19,7 +19,8 @@ Scene clamped_bar(double youngs, double density) {
   s.source = "clamped_bar";
   s.object_mesh = std::make_shared<const TetMesh>(make_box_mesh({0.32, 0.03, 0.03}, {8, 2, 2}));
   s.material = material_from_youngs(youngs, 0.3, density);
-  s.fixed = NodeSelection{.box = AlignedBox{Vec3(-0.161, -0.02, -0.02), Vec3(-0.139, 0.02, 0.02)}, .nodes = {}};
+  s.fixed = NodeSelection{.box = AlignedBox{Vec3(-0.161, -0.02, -0.02), Vec3(-0.139, 0.02, 0.02)},
+                          .nodes = {}};
   return s;
 }
 
@@ -61,7 +62,8 @@ GrippedObject held_bar(double youngs) {
 TEST(StaticsHonesty, ExtremeMaterialOfAHeldObjectIsNotCalledUnheld) {
   // 1 mPa foam in 1e4 N/m grips: stiffnesses 16 orders apart, beyond what doubles resolve.
   GrippedObject object = held_bar(1e-3);
-  const ObjectState state = object.solve_from(object.reference_joints(), object.reference_positions());
+  const ObjectState state =
+      object.solve_from(object.reference_joints(), object.reference_positions());
   const StaticsResult& r = state.statics();
   const Positions& x = state.positions();
   ASSERT_EQ(r.status, StaticsStatus::Singular) << r.reason;
@@ -75,9 +77,9 @@ TEST(StaticsHonesty, HeldObjectWithoutGripsStillSaysNothingHoldsIt) {
   Scene scene = test::two_arm_scene({12, 2, 2});
   scene.grips.clear();
   GrippedObject object(scene);
-  const ObjectState state = object.solve_from(object.reference_joints(), object.reference_positions());
+  const ObjectState state =
+      object.solve_from(object.reference_joints(), object.reference_positions());
   const StaticsResult& r = state.statics();
-  const Positions& x = state.positions();
   EXPECT_EQ(r.status, StaticsStatus::Singular);
   EXPECT_NE(r.reason.find("nothing holds"), std::string::npos) << r.reason;
 }

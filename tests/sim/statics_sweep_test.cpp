@@ -22,7 +22,8 @@ Scene clamped_foam_bar(const std::array<int, 3>& cells, double youngs, double de
   s.source = "clamped_foam_bar";
   s.object_mesh = std::make_shared<const TetMesh>(make_box_mesh({0.32, 0.03, 0.03}, cells));
   s.material = material_from_youngs(youngs, 0.3, density);
-  s.fixed = NodeSelection{.box = AlignedBox{Vec3(-0.161, -0.02, -0.02), Vec3(-0.139, 0.02, 0.02)}, .nodes = {}};
+  s.fixed = NodeSelection{.box = AlignedBox{Vec3(-0.161, -0.02, -0.02), Vec3(-0.139, 0.02, 0.02)},
+                          .nodes = {}};
   return s;
 }
 
@@ -63,9 +64,9 @@ TEST(StaticsSweep, CantileverMeshesConvergeForRandomValidMaterials) {
   std::mt19937 rng(2026);
   std::uniform_real_distribution<double> unit(0, 1);
   for (int k = 0; k < 24; ++k) {
-    const std::array<int, 3> cells = k % 3 == 0 ? std::array<int, 3>{8, 1, 1}
-                                   : k % 3 == 1 ? std::array<int, 3>{16, 2, 2}
-                                                : std::array<int, 3>{32, 4, 4};
+    const std::array<int, 3> cells = k % 3 == 0   ? std::array<int, 3>{8, 1, 1}
+                                     : k % 3 == 1 ? std::array<int, 3>{16, 2, 2}
+                                                  : std::array<int, 3>{32, 4, 4};
     const double E = 1e5 * std::pow(100.0, unit(rng)), nu = 0.05 + 0.4 * unit(rng);
     const double rho = std::pow(10.0, 2 * unit(rng));
     Scene scene = clamped_foam_bar(cells, E, rho);
@@ -99,7 +100,8 @@ TEST(StaticsSweep, ClampedFoamBarConvergesAtTheReportedProblemPoints) {
                      "E " + std::to_string(E) + " Pa, density " + std::to_string(r));
   }
   // Stiff at foam density on the fine mesh: 10-900x the tolerance before.
-  for (double E : {1e9, 5e9}) expect_converges(clamped_foam_bar({16, 4, 4}, E, 30), "E " + std::to_string(E));
+  for (double E : {1e9, 5e9})
+    expect_converges(clamped_foam_bar({16, 4, 4}, E, 30), "E " + std::to_string(E));
 }
 
 TEST(StaticsSweep, RoundoffFloorLeavesOrdinaryFoamAtTheWeightTolerance) {
@@ -111,7 +113,8 @@ TEST(StaticsSweep, RoundoffFloorLeavesOrdinaryFoamAtTheWeightTolerance) {
   // coordinates: force / (E x element size).
   const Scene stiff = clamped_foam_bar({16, 4, 4}, 5e9, 0.1);
   ObjectStatics stiff_statics(stiff);
-  EXPECT_GT(stiff_statics.force_tolerance(), stiff.statics.relative_tolerance * stiff_statics.weight());
+  EXPECT_GT(stiff_statics.force_tolerance(),
+            stiff.statics.relative_tolerance * stiff_statics.weight());
   EXPECT_LT(stiff_statics.force_tolerance() / (5e9 * 0.02), 100 * 0.16 * 2.2e-16);
 }
 
@@ -121,10 +124,12 @@ TEST(StaticsSweep, HeldBarConvergesForEveryMaterial) {
       Scene scene = test::two_arm_scene({12, 2, 2});
       scene.material = material_from_youngs(E, 0.3, rho);
       GrippedObject object(scene);
-      const ObjectState state = object.solve_from(object.reference_joints(), object.reference_positions());
+      const ObjectState state =
+          object.solve_from(object.reference_joints(), object.reference_positions());
       const StaticsResult& r = state.statics();
       const Positions& x = state.positions();
-      const std::string what = "held, E " + std::to_string(E) + " Pa, density " + std::to_string(rho);
+      const std::string what =
+          "held, E " + std::to_string(E) + " Pa, density " + std::to_string(rho);
       EXPECT_TRUE(r.converged()) << what << ": " << r.reason;
       EXPECT_TRUE(x.allFinite()) << what;
     }

@@ -29,13 +29,15 @@ TEST(Statics, ClampedBarConvergesSuperlinearly) {
   const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
   ObjectStatics statics(scene);
   Positions x = scene.world_rest_positions();
-  const StaticsResult r = statics.solve(x);  // from scratch: Newton proper, a factorization every step
+  const StaticsResult r =
+      statics.solve(x);  // from scratch: Newton proper, a factorization every step
   ASSERT_TRUE(r.converged()) << r.reason;
   EXPECT_LE(r.iterations, 12);
   ASSERT_GE(r.log.size(), 3u);
   // The middle sags by millimetres: a nonlinear, not a trivial, solve.
   double sag = 0;
-  for (int i = 0; i < statics.mesh().node_count(); ++i) sag = std::min(sag, x[3 * i + 2] - scene.world_rest_positions()[3 * i + 2]);
+  for (int i = 0; i < statics.mesh().node_count(); ++i)
+    sag = std::min(sag, x[3 * i + 2] - scene.world_rest_positions()[3 * i + 2]);
   EXPECT_LT(sag, -0.002);
   // Superlinear: the ratio of successive residuals keeps shrinking over the last steps,
   // down to far below what linear convergence would give.
@@ -94,7 +96,8 @@ TEST(Statics, CompressedSlenderBarIsNotPositiveDefinite) {
   EXPECT_TRUE(solver.factor(statics.terms(), ws, x));
   for (int i = 0; i < statics.mesh().node_count(); ++i) x[3 * i] *= 0.9;
   EXPECT_FALSE(solver.factor(statics.terms(), ws, x));
-  EXPECT_THROW(solver.solve_with_factor(ws, Eigen::MatrixXd::Ones(x.size(), 1)), std::runtime_error);
+  EXPECT_THROW(solver.solve_with_factor(ws, Eigen::MatrixXd::Ones(x.size(), 1)),
+               std::runtime_error);
   // Shortened 0.1 %: far from buckling, still positive definite.
   x = scene.world_rest_positions();
   for (int i = 0; i < statics.mesh().node_count(); ++i) x[3 * i] *= 0.999;

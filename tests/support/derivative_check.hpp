@@ -93,7 +93,8 @@ inline Eigen::VectorXd energy_gradient(const EnergyTerm& term, const Positions& 
   return g;
 }
 
-inline Eigen::MatrixXd dense_hessian(const EnergyTerm& term, const Positions& x, bool project = false) {
+inline Eigen::MatrixXd dense_hessian(const EnergyTerm& term, const Positions& x,
+                                     bool project = false) {
   Triplets t;
   term.add_hessian(x, t, project);
   SparseMatrix H(x.size(), x.size());

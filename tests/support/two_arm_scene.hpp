@@ -10,25 +10,37 @@ namespace shapectl::test {
 inline std::string two_arm_urdf() {
   auto arm = [](const std::string& s, const std::string& y) {
     return "<joint name='" + s + "1' type='revolute'><parent link='base'/><child link='" + s +
-           "_link1'/><origin xyz='0 " + y + " 0'/><axis xyz='0 0 1'/>"
-           "<limit lower='-2' upper='2' velocity='2' effort='1'/></joint><link name='" + s + "_link1'/>"
-           "<joint name='" + s + "2' type='revolute'><parent link='" + s + "_link1'/><child link='" + s +
+           "_link1'/><origin xyz='0 " + y +
+           " 0'/><axis xyz='0 0 1'/>"
+           "<limit lower='-2' upper='2' velocity='2' effort='1'/></joint><link name='" +
+           s +
+           "_link1'/>"
+           "<joint name='" +
+           s + "2' type='revolute'><parent link='" + s + "_link1'/><child link='" + s +
            "_link2'/><origin xyz='0 0 0.1'/><axis xyz='0 1 0'/>"
-           "<limit lower='-2' upper='2' velocity='2' effort='1'/></joint><link name='" + s + "_link2'/>"
-           "<joint name='" + s + "3' type='revolute'><parent link='" + s + "_link2'/><child link='" + s +
+           "<limit lower='-2' upper='2' velocity='2' effort='1'/></joint><link name='" +
+           s +
+           "_link2'/>"
+           "<joint name='" +
+           s + "3' type='revolute'><parent link='" + s + "_link2'/><child link='" + s +
            "_link3'/><origin xyz='0.25 0 0'/><axis xyz='0 1 0'/>"
-           "<limit lower='-2.5' upper='2.5' velocity='2' effort='1'/></joint><link name='" + s + "_link3'/>"
-           "<joint name='" + s + "_tool_joint' type='fixed'><parent link='" + s + "_link3'/><child link='" +
-           s + "_tool'/><origin xyz='0.2 0 0'/></joint><link name='" + s + "_tool'/>";
+           "<limit lower='-2.5' upper='2.5' velocity='2' effort='1'/></joint><link name='" +
+           s +
+           "_link3'/>"
+           "<joint name='" +
+           s + "_tool_joint' type='fixed'><parent link='" + s + "_link3'/><child link='" + s +
+           "_tool'/><origin xyz='0.2 0 0'/></joint><link name='" + s + "_tool'/>";
   };
-  return "<robot name='two_arms'><link name='base'/>" + arm("l", "0.15") + arm("r", "-0.15") + "</robot>";
+  return "<robot name='two_arms'><link name='base'/>" + arm("l", "0.15") + arm("r", "-0.15") +
+         "</robot>";
 }
 
 // The bar lies between the two tools at the reference joints, gripped 20 mm at each end.
 inline Scene two_arm_scene(const std::array<int, 3>& cells = {12, 1, 1}) {
   Scene s;
   s.source = "two_arm_scene";
-  auto model = std::make_shared<RobotModel>(RobotModel::from_urdf_string(two_arm_urdf(), "two_arms.urdf"));
+  auto model =
+      std::make_shared<RobotModel>(RobotModel::from_urdf_string(two_arm_urdf(), "two_arms.urdf"));
   RobotSetup robot;
   robot.model = model;
   robot.reference_joints = Eigen::VectorXd(6);
@@ -37,7 +49,8 @@ inline Scene two_arm_scene(const std::array<int, 3>& cells = {12, 1, 1}) {
                          {"right", model->link_index("r_tool"), Vec3::Zero()}};
   std::vector<CollisionSphere> spheres;
   for (const char* link : {"l_link3", "r_link3"})
-    for (double x : {0.05, 0.1, 0.15}) spheres.push_back({model->link_index(link), Vec3(x, 0, 0), 0.03});
+    for (double x : {0.05, 0.1, 0.15})
+      spheres.push_back({model->link_index(link), Vec3(x, 0, 0), 0.03});
   robot.collisions = std::make_shared<const CollisionModel>(*model, spheres, 0.005, 1e6);
   robot.joint_limit_margin = 0.05;
   robot.joint_limit_stiffness = 1e3;
@@ -48,7 +61,8 @@ inline Scene two_arm_scene(const std::array<int, 3>& cells = {12, 1, 1}) {
   s.object_mesh = std::make_shared<const TetMesh>(make_box_mesh({length, 0.03, 0.03}, cells));
   s.material = material_from_youngs(5e4, 0.3, 40);
   s.T_world_object.translation() = 0.5 * (left + right);
-  s.T_world_object.linear() = Eigen::Quaterniond::FromTwoVectors(Vec3::UnitX(), left - right).toRotationMatrix();
+  s.T_world_object.linear() =
+      Eigen::Quaterniond::FromTwoVectors(Vec3::UnitX(), left - right).toRotationMatrix();
   s.robot = robot;
   const double end = length / 2 - 0.02 - 1e-9;
   for (int e = 0; e < 2; ++e) {

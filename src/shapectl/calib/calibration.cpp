@@ -19,9 +19,9 @@ using Kind = ParameterCoordinate::Kind;
 // The frames' residuals with the model at one set of parameters.
 struct FitPoint {
   PhysicalParameters parameters;
-  std::vector<Positions> positions;      // each frame's equilibrium
+  std::vector<Positions> positions;  // each frame's equilibrium
   std::vector<FrameResiduals> frames;
-  std::vector<double> cutoffs;           // each frame's outlier cut-off
+  std::vector<double> cutoffs;  // each frame's outlier cut-off
   double cost = 0;
 
   Eigen::VectorXd residuals() const {
@@ -29,7 +29,8 @@ struct FitPoint {
     for (const auto& f : frames) rows += f.residuals.size();
     Eigen::VectorXd r(rows);
     rows = 0;
-    for (const auto& f : frames) r.segment(rows, f.residuals.size()) = f.residuals, rows += f.residuals.size();
+    for (const auto& f : frames)
+      r.segment(rows, f.residuals.size()) = f.residuals, rows += f.residuals.size();
     return r;
   }
   Eigen::MatrixXd jacobian() const {
@@ -37,11 +38,14 @@ struct FitPoint {
     for (const auto& f : frames) rows += f.jacobian.rows();
     Eigen::MatrixXd J(rows, frames.front().jacobian.cols());
     rows = 0;
-    for (const auto& f : frames) J.middleRows(rows, f.jacobian.rows()) = f.jacobian, rows += f.jacobian.rows();
+    for (const auto& f : frames)
+      J.middleRows(rows, f.jacobian.rows()) = f.jacobian, rows += f.jacobian.rows();
     return J;
   }
   double rms(std::size_t k) const {
-    return frames[k].observation_count ? std::sqrt(frames[k].sum_squared_error / frames[k].observation_count) : 0;
+    return frames[k].observation_count
+               ? std::sqrt(frames[k].sum_squared_error / frames[k].observation_count)
+               : 0;
   }
   double rms() const {
     double sum = 0;
@@ -53,9 +57,12 @@ struct FitPoint {
 
 class CalibrationProblem {
  public:
-  CalibrationProblem(const Scene& scene, const Observations& observations, const ParameterSpace& space,
-                     const CalibrationOptions& options)
-      : scene_(scene), observations_(observations), space_(space), options_(options),
+  CalibrationProblem(const Scene& scene, const Observations& observations,
+                     const ParameterSpace& space, const CalibrationOptions& options)
+      : scene_(scene),
+        observations_(observations),
+        space_(space),
+        options_(options),
         surface_(scene.object_mesh->surface_triangles()) {}
 
   // The fit at p. Equilibria start from `warm` (a frame's earlier equilibrium) or, without one
@@ -72,7 +79,8 @@ class CalibrationProblem {
       surface_.update(state.positions());
       const double cutoff = cutoffs.empty() ? outlier_cutoff(frame, surface_) : cutoffs[k];
       Eigen::MatrixXd dx_dz;
-      if (with_jacobian) dx_dz = object.force_response(state, space_.force_derivatives(object, state, p));
+      if (with_jacobian)
+        dx_dz = object.force_response(state, space_.force_derivatives(object, state, p));
       out.frames.push_back(frame_residuals(frame, state.positions(), surface_, cutoff, dx_dz));
       out.cutoffs.push_back(cutoff);
       out.cost += out.frames.back().cost();
@@ -82,8 +90,8 @@ class CalibrationProblem {
   }
 
  private:
-  ObjectState equilibrium(const GrippedObject& object, const Eigen::VectorXd& joints, const Positions* warm,
-                          std::size_t frame) const {
+  ObjectState equilibrium(const GrippedObject& object, const Eigen::VectorXd& joints,
+                          const Positions* warm, std::size_t frame) const {
     if (warm) {
       ObjectState state = object.solve_from(joints, *warm);
       if (state.statics().converged() && object.stable(state)) return state;
@@ -116,27 +124,32 @@ int hold_rank(Kind kind) {
 
 // The coordinates the data determines (indices into the space), after holding one coordinate
 // for each direction it does not; `unidentified` lists those directions.
-std::vector<int> identifiable_coordinates(const ParameterSpace& space, const Eigen::MatrixXd& J, double threshold,
+std::vector<int> identifiable_coordinates(const ParameterSpace& space, const Eigen::MatrixXd& J,
+                                          double threshold,
                                           std::vector<UnidentifiedDirection>& unidentified) {
   std::vector<int> active(space.size());
   for (int k = 0; k < space.size(); ++k) active[k] = k;
   while (!active.empty()) {
     Eigen::MatrixXd scaled(J.rows(), active.size());
-    for (std::size_t a = 0; a < active.size(); ++a) scaled.col(a) = J.col(active[a]) * space.coordinates()[active[a]].scale;
+    for (std::size_t a = 0; a < active.size(); ++a)
+      scaled.col(a) = J.col(active[a]) * space.coordinates()[active[a]].scale;
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeThinV);
     const Eigen::Index last = static_cast<Eigen::Index>(active.size()) - 1;
     const double s = last < svd.singularValues().size() ? svd.singularValues()[last] : 0;
     const double deviation = s > 0 ? 1 / s : INFINITY;
     if (deviation <= threshold) break;
     const Eigen::VectorXd v = svd.matrixV().col(last);
-    UnidentifiedDirection direction{.standard_deviation = deviation};
+    UnidentifiedDirection direction;
+    direction.standard_deviation = deviation;
     // Hold the most-likely-known coordinate among those that make up the direction.
     std::size_t hold = active.size();
     for (std::size_t a = 0; a < active.size(); ++a) {
       const ParameterCoordinate& c = space.coordinates()[active[a]];
       if (std::abs(v[a]) >= 0.1) direction.combination.emplace_back(c.name, v[a]);
       if (std::abs(v[a]) < 0.3 * v.cwiseAbs().maxCoeff()) continue;
-      if (hold == active.size() || hold_rank(c.kind) < hold_rank(space.coordinates()[active[hold]].kind)) hold = a;
+      if (hold == active.size() ||
+          hold_rank(c.kind) < hold_rank(space.coordinates()[active[hold]].kind))
+        hold = a;
     }
     direction.held = space.coordinates()[active[hold]].name;
     unidentified.push_back(direction);
@@ -179,8 +192,8 @@ const char* unit_of(Kind kind) {
 
 }  // namespace
 
-CalibrationResult calibrate(const Scene& scene, const Observations& observations, const FitSelection& fit,
-                            const CalibrationOptions& options) {
+CalibrationResult calibrate(const Scene& scene, const Observations& observations,
+                            const FitSelection& fit, const CalibrationOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   if (!scene.robot) throw std::invalid_argument("calibration needs a scene with a robot and grips");
   if (observations.frames.empty()) throw std::invalid_argument("no observed frames");
@@ -191,8 +204,9 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
   CalibrationResult result;
   FitPoint at = problem.evaluate(initial, {}, {}, true);
   const FitPoint before = at;
-  const std::vector<int> active = identifiable_coordinates(space, at.jacobian(), options.identifiability_threshold,
-                                                           result.unidentified);
+  const std::vector<int> active =
+      identifiable_coordinates(space, at.jacobian(), options.identifiability_threshold,
+                               result.unidentified);
   double lambda = -1;  // set at the first iteration
   result.reason = "iteration limit";
   for (int iteration = 0; iteration < options.max_iterations && !active.empty(); ++iteration) {
@@ -228,7 +242,8 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
         result.iterations = iteration + 1;
         if (decrease < 1e-10 || step < 1e-8) {
           result.converged = true;
-          result.reason = "converged: cost decrease " + std::to_string(decrease) + ", step " + std::to_string(step);
+          result.reason = "converged: cost decrease " + std::to_string(decrease) + ", step " +
+                          std::to_string(step);
         }
       } else {
         lambda *= 4;
@@ -245,23 +260,27 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
 
   // Gauss–Newton covariance of the fitted coordinates (residuals are in units of σ).
   const Eigen::MatrixXd J = columns(at.jacobian(), active);
-  const Eigen::MatrixXd covariance = active.empty() ? Eigen::MatrixXd()
-                                                    : Eigen::MatrixXd((J.transpose() * J).inverse());
+  const Eigen::MatrixXd covariance =
+      active.empty() ? Eigen::MatrixXd() : Eigen::MatrixXd((J.transpose() * J).inverse());
   for (int k = 0; k < space.size(); ++k) {
     const ParameterCoordinate& c = space.coordinates()[k];
-    FittedParameter f{.name = c.name, .unit = unit_of(c.kind), .initial = reported_value(c, initial),
+    FittedParameter f{.name = c.name,
+                      .unit = unit_of(c.kind),
+                      .initial = reported_value(c, initial),
                       .fitted = reported_value(c, at.parameters)};
     const auto a = std::find(active.begin(), active.end(), k);
     f.held = a == active.end();
     if (!f.held) {
       const Eigen::Index i = a - active.begin();
-      f.standard_deviation = space.physical_per_coordinate(c, at.parameters) * std::sqrt(covariance(i, i));
+      f.standard_deviation =
+          space.physical_per_coordinate(c, at.parameters) * std::sqrt(covariance(i, i));
     }
     result.parameters.push_back(f);
   }
   for (std::size_t k = 0; k < observations.frames.size(); ++k) {
     const ObservationFrame& frame = observations.frames[k];
-    result.frames.push_back({.rms_before = before.rms(k), .rms_after = at.rms(k),
+    result.frames.push_back({.rms_before = before.rms(k),
+                             .rms_after = at.rms(k),
                              .markers = static_cast<int>(frame.markers.size()),
                              .points = static_cast<int>(frame.points.size()),
                              .inlier_points_after = at.frames[k].inlier_points});
@@ -273,7 +292,8 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
   result.chi_squared_per_dof = dof > 0 ? at.residuals().squaredNorm() / double(dof) : 0;
   result.fitted = at.parameters;
   result.scene = at.parameters.applied_to(scene);
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;
 }
 

@@ -31,17 +31,17 @@ struct CalibrationOptions {
 
 struct FittedParameter {
   std::string name;
-  std::string unit;       // "Pa", "", "kg/m^3", "m", "rad"
-  double initial = 0;     // physical value (grip offsets: the coordinate's, in m or rad)
+  std::string unit;    // "Pa", "", "kg/m^3", "m", "rad"
+  double initial = 0;  // physical value (grip offsets: the coordinate's, in m or rad)
   double fitted = 0;
   double standard_deviation = 0;  // from the Gauss–Newton covariance with the frames' σ; 0 if held
-  bool held = false;      // not identifiable from these observations: kept at `initial`
+  bool held = false;              // not identifiable from these observations: kept at `initial`
 };
 
 struct UnidentifiedDirection {
   std::vector<std::pair<std::string, double>> combination;  // coordinate name → weight (|w| ≥ 0.1)
-  double standard_deviation = 0;  // in units of the coordinate scales
-  std::string held;               // the parameter kept at its initial value for it
+  double standard_deviation = 0;                            // in units of the coordinate scales
+  std::string held;  // the parameter kept at its initial value for it
 };
 
 struct FrameFit {
@@ -65,7 +65,7 @@ struct CalibrationResult {
 
 // Throws std::invalid_argument for a scene without a robot or observations that do not match
 // it, std::runtime_error when a frame's equilibrium cannot be found.
-CalibrationResult calibrate(const Scene& scene, const Observations& observations, const FitSelection& fit,
-                            const CalibrationOptions& options = {});
+CalibrationResult calibrate(const Scene& scene, const Observations& observations,
+                            const FitSelection& fit, const CalibrationOptions& options = {});
 
 }  // namespace shapectl

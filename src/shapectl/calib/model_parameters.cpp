@@ -26,7 +26,8 @@ Eigen::Matrix3d rotation_of(const Vec3& rotation_vector) {
 }
 
 // ∂E_elastic/∂x for a material with only μ = 1 (or only κ = 1): the energy is linear in both.
-Eigen::VectorXd unit_elastic_gradient(const TetMesh& mesh, const Positions& x, double mu, double kappa) {
+Eigen::VectorXd unit_elastic_gradient(const TetMesh& mesh, const Positions& x, double mu,
+                                      double kappa) {
   Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
   NeoHookean(mesh, Material{.mu = mu, .kappa = kappa, .density = 0}).add_gradient(x, g);
   return g;
@@ -49,10 +50,12 @@ FitSelection parse_fit_selection(const std::string& list) {
     else if (item == "density") s.density = true;
     else if (item == "grip_offsets") s.grip_offsets = true;
     else
-      throw std::invalid_argument("unknown parameter \"" + item +
-                                  "\" (expected youngs_modulus, poisson_ratio, density or grip_offsets)");
+      throw std::invalid_argument(
+          "unknown parameter \"" + item +
+          "\" (expected youngs_modulus, poisson_ratio, density or grip_offsets)");
   }
-  if (s.empty()) throw std::invalid_argument("no parameter to fit (expected a comma-separated list)");
+  if (s.empty())
+    throw std::invalid_argument("no parameter to fit (expected a comma-separated list)");
   return s;
 }
 
@@ -73,22 +76,26 @@ Scene PhysicalParameters::applied_to(const Scene& scene) const {
 }
 
 ParameterSpace::ParameterSpace(const Scene& scene, const FitSelection& selection) {
-  if (selection.youngs_modulus) coordinates_.push_back({Kind::LogYoungsModulus, -1, -1, "youngs_modulus", 1});
-  if (selection.poisson_ratio) coordinates_.push_back({Kind::PoissonLogit, -1, -1, "poisson_ratio", 1});
+  if (selection.youngs_modulus)
+    coordinates_.push_back({Kind::LogYoungsModulus, -1, -1, "youngs_modulus", 1});
+  if (selection.poisson_ratio)
+    coordinates_.push_back({Kind::PoissonLogit, -1, -1, "poisson_ratio", 1});
   if (selection.density) coordinates_.push_back({Kind::LogDensity, -1, -1, "density", 1});
   if (selection.grip_offsets) {
     if (scene.grips.empty()) throw std::invalid_argument("grip_offsets: the scene has no grips");
     for (std::size_t g = 0; g < scene.grips.size(); ++g) {
-      const std::string prefix = "grip_offsets." + scene.robot->end_effectors[scene.grips[g].end_effector].name + ".";
+      const std::string prefix =
+          "grip_offsets." + scene.robot->end_effectors[scene.grips[g].end_effector].name + ".";
       for (int rotation = 0; rotation < 2; ++rotation)
         for (int axis = 0; axis < 3; ++axis)
-          coordinates_.push_back({rotation ? Kind::GripRotation : Kind::GripTranslation, int(g), axis,
-                                  prefix + axis_name(rotation, axis), rotation ? 0.1 : 0.01});
+          coordinates_.push_back({rotation ? Kind::GripRotation : Kind::GripTranslation, int(g),
+                                  axis, prefix + axis_name(rotation, axis), rotation ? 0.1 : 0.01});
     }
   }
 }
 
-PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p, const Eigen::VectorXd& dz) const {
+PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p,
+                                            const Eigen::VectorXd& dz) const {
   PhysicalParameters out = p;
   std::vector<Vec3> dt(p.grip_offsets.size(), Vec3::Zero()), dr = dt;
   for (int k = 0; k < size(); ++k) {
@@ -113,7 +120,8 @@ PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p, const E
   return out;
 }
 
-double ParameterSpace::physical_per_coordinate(const ParameterCoordinate& c, const PhysicalParameters& p) const {
+double ParameterSpace::physical_per_coordinate(const ParameterCoordinate& c,
+                                               const PhysicalParameters& p) const {
   switch (c.kind) {
     case Kind::LogYoungsModulus: return p.youngs_modulus;
     case Kind::LogDensity: return p.density;
@@ -124,7 +132,8 @@ double ParameterSpace::physical_per_coordinate(const ParameterCoordinate& c, con
   return 1;
 }
 
-Eigen::MatrixXd ParameterSpace::force_derivatives(const GrippedObject& object, const ObjectState& state,
+Eigen::MatrixXd ParameterSpace::force_derivatives(const GrippedObject& object,
+                                                  const ObjectState& state,
                                                   const PhysicalParameters& p) const {
   const Positions& x = state.positions();
   const Scene& scene = object.scene();
@@ -168,7 +177,8 @@ Eigen::MatrixXd ParameterSpace::force_derivatives(const GrippedObject& object, c
       for (int k = 0; k < size(); ++k) {
         const ParameterCoordinate& c = coordinates_[k];
         if (c.grip != int(g)) continue;
-        const Vec3 da = c.kind == Kind::GripTranslation ? Vec3(R_link.col(c.axis)) : Vec3(d_rotation.col(c.axis));
+        const Vec3 da = c.kind == Kind::GripTranslation ? Vec3(R_link.col(c.axis))
+                                                        : Vec3(d_rotation.col(c.axis));
         dF.col(k).segment<3>(3 * node.node) += K * da;
       }
     }

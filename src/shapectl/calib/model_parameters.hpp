@@ -28,7 +28,7 @@ FitSelection parse_fit_selection(const std::string& list);
 struct PhysicalParameters {
   double youngs_modulus = 0;  // Pa
   double poisson_ratio = 0;
-  double density = 0;  // kg/m^3
+  double density = 0;                           // kg/m^3
   std::vector<Eigen::Isometry3d> grip_offsets;  // one per scene grip
 
   static PhysicalParameters of(const Scene& scene);
@@ -40,8 +40,8 @@ struct PhysicalParameters {
 struct ParameterCoordinate {
   enum class Kind { LogYoungsModulus, PoissonLogit, LogDensity, GripTranslation, GripRotation };
   Kind kind;
-  int grip = -1;  // for grip coordinates
-  int axis = -1;  // 0..2 for grip coordinates (the TCP frame's x, y, z)
+  int grip = -1;     // for grip coordinates
+  int axis = -1;     // 0..2 for grip coordinates (the TCP frame's x, y, z)
   std::string name;  // "youngs_modulus", "grip_offsets.left.x", "grip_offsets.left.rx"
   // Typical size of a change worth noticing: 1 (a factor e) for the logarithms, 1 cm, 0.1 rad.
   double scale = 1;

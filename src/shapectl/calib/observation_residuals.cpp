@@ -14,8 +14,9 @@ double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surf
   return std::max(4 * frame.sigma, 3 * 1.4826 * *middle);
 }
 
-FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x, const SurfaceDistance& surface,
-                               double cutoff, const Eigen::MatrixXd& dx_dz) {
+FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x,
+                               const SurfaceDistance& surface, double cutoff,
+                               const Eigen::MatrixXd& dx_dz) {
   const bool with_jacobian = dx_dz.size() > 0;
   const double w = 1 / frame.sigma;
   std::vector<std::pair<Vec3, SurfaceHit>> inliers;
@@ -44,7 +45,8 @@ FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x
       if (hit.distance > 0) {  // on the surface the distance has no direction: no pull
         const Vec3 u = (p - hit.point) / hit.distance;
         for (int k = 0; k < 3; ++k)
-          out.jacobian.row(row) -= w * hit.barycentric[k] * u.transpose() * dx_dz.middleRows(3 * hit.nodes[k], 3);
+          out.jacobian.row(row) -=
+              w * hit.barycentric[k] * u.transpose() * dx_dz.middleRows(3 * hit.nodes[k], 3);
       }
     }
     ++row;

@@ -31,7 +31,8 @@ struct FrameResiduals {
 double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surface);
 
 // `surface` must have been updated to x. dx_dz may be empty (residuals only).
-FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x, const SurfaceDistance& surface,
-                               double cutoff, const Eigen::MatrixXd& dx_dz);
+FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x,
+                               const SurfaceDistance& surface, double cutoff,
+                               const Eigen::MatrixXd& dx_dz);
 
 }  // namespace shapectl

@@ -13,7 +13,8 @@ ObservationFrame SimulatedCamera::observe(const TetMesh& mesh, const Positions& 
   ObservationFrame frame;
   frame.joints = joints;
   frame.sigma = sigma;
-  for (int node : marker_nodes) frame.markers.push_back({node, noisy(positions.segment<3>(3 * node))});
+  for (int node : marker_nodes)
+    frame.markers.push_back({node, noisy(positions.segment<3>(3 * node))});
   if (surface_points <= 0) return frame;
 
   // Triangles drawn in proportion to their area, points uniform inside.
@@ -21,7 +22,8 @@ ObservationFrame SimulatedCamera::observe(const TetMesh& mesh, const Positions& 
   std::vector<double> areas;
   Vec3 lo = Vec3::Constant(INFINITY), hi = -lo;
   for (const auto& t : triangles) {
-    const Vec3 a = positions.segment<3>(3 * t[0]), b = positions.segment<3>(3 * t[1]), c = positions.segment<3>(3 * t[2]);
+    const Vec3 a = positions.segment<3>(3 * t[0]), b = positions.segment<3>(3 * t[1]),
+               c = positions.segment<3>(3 * t[2]);
     areas.push_back(0.5 * (b - a).cross(c - a).norm());
     lo = lo.cwiseMin(a).cwiseMin(b).cwiseMin(c);
     hi = hi.cwiseMax(a).cwiseMax(b).cwiseMax(c);
@@ -33,8 +35,8 @@ ObservationFrame SimulatedCamera::observe(const TetMesh& mesh, const Positions& 
     const auto& t = triangles[pick(rng)];
     double u = unit(rng), v = unit(rng);
     if (u + v > 1) u = 1 - u, v = 1 - v;
-    const Vec3 p = (1 - u - v) * positions.segment<3>(3 * t[0]) + u * positions.segment<3>(3 * t[1]) +
-                   v * positions.segment<3>(3 * t[2]);
+    const Vec3 p = (1 - u - v) * positions.segment<3>(3 * t[0]) +
+                   u * positions.segment<3>(3 * t[1]) + v * positions.segment<3>(3 * t[2]);
     frame.points.push_back(noisy(p));
   }
   const Vec3 margin = Vec3::Constant(outlier_margin);

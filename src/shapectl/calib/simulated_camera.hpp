@@ -19,8 +19,8 @@ struct SimulatedCamera {
   double sigma = 0.0003;          // m, per axis
 
   // One frame of the shape `positions` (3n, world) of `mesh`, taken at `joints`.
-  ObservationFrame observe(const TetMesh& mesh, const Positions& positions, const Eigen::VectorXd& joints,
-                           std::mt19937& rng) const;
+  ObservationFrame observe(const TetMesh& mesh, const Positions& positions,
+                           const Eigen::VectorXd& joints, std::mt19937& rng) const;
 };
 
 }  // namespace shapectl

@@ -7,25 +7,29 @@
 
 namespace shapectl {
 
-SimulatedWorld::SimulatedWorld(const Scene& world, const Scene& model, SimulatedCamera camera, double rate,
-                               unsigned seed)
+SimulatedWorld::SimulatedWorld(const Scene& world, const Scene& model, SimulatedCamera camera,
+                               double rate, unsigned seed)
     : object_(world), camera_(std::move(camera)), period_(1 / rate), rng_(seed) {
   if (!model.robot || world.object_mesh->node_count() != model.object_mesh->node_count() ||
       world.object_mesh->tet_count() != model.object_mesh->tet_count())
-    throw std::invalid_argument("the world's object must have the model's mesh (same nodes and tetrahedra)");
+    throw std::invalid_argument(
+        "the world's object must have the model's mesh (same nodes and tetrahedra)");
   if (world.robot->model->active_joint_names() != model.robot->model->active_joint_names())
     throw std::invalid_argument("the world's robot must have the model's active joints");
-  if (!(rate > 0 && std::isfinite(rate))) throw std::invalid_argument("the camera rate must be positive");
+  if (!(rate > 0 && std::isfinite(rate)))
+    throw std::invalid_argument("the camera rate must be positive");
   state_.emplace(equilibrium_along_path(object_, object_.reference_joints()));
 }
 
-std::optional<ObservationFrame> SimulatedWorld::step(double time, const Eigen::VectorXd& measured_joints) {
+std::optional<ObservationFrame> SimulatedWorld::step(double time,
+                                                     const Eigen::VectorXd& measured_joints) {
   ObjectState next = object_.solve_from(measured_joints, state_->positions());
   if (!next.statics().converged()) next = equilibrium_along_path(object_, measured_joints);
   state_.emplace(std::move(next));
   if (time < next_time_) return std::nullopt;
   next_time_ = std::max(next_time_ + period_, time);
-  ObservationFrame frame = camera_.observe(object_.mesh(), state_->positions(), measured_joints, rng_);
+  ObservationFrame frame =
+      camera_.observe(object_.mesh(), state_->positions(), measured_joints, rng_);
   frame.time = time;
   return frame;
 }

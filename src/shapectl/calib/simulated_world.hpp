@@ -16,7 +16,8 @@ class SimulatedWorld {
  public:
   // `world` must hold the model's mesh (same nodes) with the same robot; throws
   // std::invalid_argument otherwise. rate: observations per second.
-  SimulatedWorld(const Scene& world, const Scene& model, SimulatedCamera camera, double rate, unsigned seed = 1);
+  SimulatedWorld(const Scene& world, const Scene& model, SimulatedCamera camera, double rate,
+                 unsigned seed = 1);
 
   // The world's object settled at the robot's measured joints, and an observation of it when
   // one is due at `time` (s, any clock that only moves forward). Throws std::runtime_error when

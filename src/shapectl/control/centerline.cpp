@@ -40,14 +40,16 @@ std::optional<BarAxis> find_bar_axis(const TetMesh& mesh) {
   if (!(axis.length >= 3 * axis.thickness)) return std::nullopt;
 
   // Stations about a third of the thickness long; the node nearest the axis in each.
-  const int stations = std::clamp(static_cast<int>(std::round(3 * axis.length / axis.thickness)), 4, 200);
+  const int stations =
+      std::clamp(static_cast<int>(std::round(3 * axis.length / axis.thickness)), 4, 200);
   std::vector<int> best(stations, -1);
   std::vector<double> best_distance(stations, 1e300);
   for (int i = 0; i < mesh.node_count(); ++i) {
     const Vec3 d = X[i] - axis.center;
     const double s = d.dot(axis.direction);
     const double r = (d - s * axis.direction).norm();
-    const int k = std::min(stations - 1, static_cast<int>((s - axis.s_min) / axis.length * stations));
+    const int k =
+        std::min(stations - 1, static_cast<int>((s - axis.s_min) / axis.length * stations));
     if (r < best_distance[k]) {
       best_distance[k] = r;
       best[k] = i;
@@ -70,7 +72,8 @@ std::vector<Vec3> distinct_points(const BarAxis& axis, const std::vector<Vec3>& 
 }
 }  // namespace
 
-void check_centerline(const BarAxis& axis, const std::vector<Vec3>& polyline, const std::string& source) {
+void check_centerline(const BarAxis& axis, const std::vector<Vec3>& polyline,
+                      const std::string& source) {
   for (std::size_t k = 0; k < polyline.size(); ++k)
     check_target_point(polyline[k], source, "centerline[" + std::to_string(k) + "]");
   const std::vector<Vec3> points = distinct_points(axis, polyline);
@@ -91,7 +94,8 @@ ShapeTargets centerline_targets(const TetMesh& mesh, const BarAxis& axis,
   check_centerline(axis, polyline, "centerline");
   const std::vector<Vec3> points = distinct_points(axis, polyline);
   std::vector<double> arc(points.size(), 0.0);
-  for (std::size_t k = 1; k < points.size(); ++k) arc[k] = arc[k - 1] + (points[k] - points[k - 1]).norm();
+  for (std::size_t k = 1; k < points.size(); ++k)
+    arc[k] = arc[k - 1] + (points[k] - points[k - 1]).norm();
   const double total = arc.back();
   auto at = [&](double length, Vec3* tangent) {
     const auto it = std::upper_bound(arc.begin(), arc.end(), length);
@@ -116,7 +120,8 @@ ShapeTargets centerline_targets(const TetMesh& mesh, const BarAxis& axis,
     const Vec3 rest_tangent = reversed ? Vec3(-axis.direction) : axis.direction;
     const Vec3 offset = d - s * axis.direction;
     targets.nodes.push_back(i);
-    targets.positions.push_back(c + Eigen::Quaterniond::FromTwoVectors(rest_tangent, tangent) * offset);
+    targets.positions.push_back(c +
+                                Eigen::Quaterniond::FromTwoVectors(rest_tangent, tangent) * offset);
   }
   return targets;
 }

@@ -18,11 +18,11 @@
 namespace shapectl {
 
 struct BarAxis {
-  Vec3 center;      // of the rest nodes
-  Vec3 direction;   // unit, along the bar
+  Vec3 center;       // of the rest nodes
+  Vec3 direction;    // unit, along the bar
   double s_min = 0;  // axial range of the nodes relative to center
   double length = 0;
-  double thickness = 0;  // largest cross-section extent
+  double thickness = 0;               // largest cross-section extent
   std::vector<int> centerline_nodes;  // ordered from s_min to s_max
 };
 
@@ -34,7 +34,8 @@ std::optional<BarAxis> find_bar_axis(const TetMesh& mesh);
 // min_centerline_fraction × the bar's length (shorter, a sketch has no shape: its direction is
 // round-off, and a bar squeezed onto it would be no shape at all).
 inline constexpr double min_centerline_fraction = 1e-3;
-void check_centerline(const BarAxis& axis, const std::vector<Vec3>& polyline, const std::string& source);
+void check_centerline(const BarAxis& axis, const std::vector<Vec3>& polyline,
+                      const std::string& source);
 
 // Targets for the centre-line nodes of `mesh` (world-placed rest mesh) from a world polyline
 // (checked with check_centerline; InputError with source "centerline" if it fails). The

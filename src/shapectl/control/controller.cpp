@@ -4,8 +4,8 @@
 #include <chrono>
 #include <cmath>
 
-#include <shapectl/enum_names.hpp>
 #include <shapectl/control/centerline.hpp>
+#include <shapectl/enum_names.hpp>
 #include <shapectl/io/input_error.hpp>
 
 namespace shapectl {
@@ -24,17 +24,18 @@ struct Inbox {
   std::optional<ShapeObservation> observation;  // the newest only: an older one is stale
   std::optional<bool> feedback;
   bool empty() const {
-    return !targets && !centerline && !clear && !paused && !jog && !reset && !observation && !feedback;
+    return !targets && !centerline && !clear && !paused && !jog && !reset && !observation &&
+           !feedback;
   }
 };
 
-constexpr auto kControllerStatuses = enum_names<ControllerStatus>(
-    std::pair{ControllerStatus::Idle, "idle"},
-    std::pair{ControllerStatus::Optimizing, "optimizing"},
-    std::pair{ControllerStatus::Converged, "converged"},
-    std::pair{ControllerStatus::Stuck, "stuck"},
-    std::pair{ControllerStatus::OutOfTime, "out of time"},
-    std::pair{ControllerStatus::Paused, "paused"});
+constexpr auto kControllerStatuses =
+    enum_names<ControllerStatus>(std::pair{ControllerStatus::Idle, "idle"},
+                                 std::pair{ControllerStatus::Optimizing, "optimizing"},
+                                 std::pair{ControllerStatus::Converged, "converged"},
+                                 std::pair{ControllerStatus::Stuck, "stuck"},
+                                 std::pair{ControllerStatus::OutOfTime, "out of time"},
+                                 std::pair{ControllerStatus::Paused, "paused"});
 
 // The status once iterations stopped with `outcome`.
 ControllerStatus status_after(StepOutcome outcome) {
@@ -50,7 +51,9 @@ ControllerStatus status_after(StepOutcome outcome) {
 
 const char* to_string(ControllerStatus status) { return kControllerStatuses.name(status); }
 
-bool parse(std::string_view name, ControllerStatus* status) { return kControllerStatuses.parse(name, status); }
+bool parse(std::string_view name, ControllerStatus* status) {
+  return kControllerStatuses.parse(name, status);
+}
 
 struct Controller::State {
   Scene scene;
@@ -148,8 +151,8 @@ void Controller::State::apply(Inbox in) {
   }
   if (in.paused) paused = *in.paused;
   if (in.jog && paused) {
-    const Eigen::VectorXd theta = in.jog->cwiseMax(object->robot().lower_limits())
-                                      .cwiseMin(object->robot().upper_limits());
+    const Eigen::VectorXd theta =
+        in.jog->cwiseMax(object->robot().lower_limits()).cwiseMin(object->robot().upper_limits());
     Evaluation e = objective->evaluate(theta, current.positions, 0, &current);
     if (objective->confirm_stable(e)) {
       current = std::move(e);
@@ -165,7 +168,8 @@ void Controller::State::apply(Inbox in) {
   }
   const std::vector<Vec3> aimed_before = objective->targets().positions;
   if (in.observation) take(*in.observation);
-  const bool reaimed = in.observation && feedback_on && objective->targets().positions != aimed_before;
+  const bool reaimed =
+      in.observation && feedback_on && objective->targets().positions != aimed_before;
   if (in.clear || in.targets || in.centerline || in.reset || in.feedback || reaimed) {
     objective->rescore(current);
     optimizer->reset();
@@ -177,7 +181,8 @@ void Controller::State::take(const ShapeObservation& observation) {
   // The model's prediction at the joints the observation was taken at (the robot may lag θ*).
   Evaluation predicted = objective->evaluate(observation.joints, current.positions, 0, &current);
   if (!predicted.statics.converged()) {
-    last_error = "observation ignored: no equilibrium at its joints (" + predicted.statics.reason + ")";
+    last_error =
+        "observation ignored: no equilibrium at its joints (" + predicted.statics.reason + ")";
     return;
   }
   feedback->observe(observation.markers, predicted.positions);
@@ -196,7 +201,8 @@ bool Controller::State::moved_enough(const ShapeTargets& corrected) const {
   const ShapeTargets& aimed = objective->targets();
   if (aimed.size() != corrected.size()) return true;
   for (int k = 0; k < aimed.size(); ++k)
-    if ((aimed.positions[k] - corrected.positions[k]).norm() > options.feedback.retarget_threshold) return true;
+    if ((aimed.positions[k] - corrected.positions[k]).norm() > options.feedback.retarget_threshold)
+      return true;
   return false;
 }
 
@@ -254,7 +260,7 @@ void Controller::State::publish() {
   s->model_error = feedback->last_model_error();
   s->observed_error = observed_error;
   s->observations = observations;
-  s->status = paused                       ? ControllerStatus::Paused
+  s->status = paused                         ? ControllerStatus::Paused
               : objective->targets().empty() ? ControllerStatus::Idle
               : !idle                        ? ControllerStatus::Optimizing
                                              : status_after(last_outcome);
@@ -280,7 +286,8 @@ void Controller::State::run() {
   }
 }
 
-Controller::Controller(const Scene& scene, ControllerOptions options) : state_(std::make_unique<State>()) {
+Controller::Controller(const Scene& scene, ControllerOptions options)
+    : state_(std::make_unique<State>()) {
   State& s = *state_;
   s.scene = scene;
   s.options = options;
@@ -360,8 +367,9 @@ void Controller::set_paused(bool paused) {
 
 void Controller::set_joints(const Eigen::VectorXd& joints) {
   if (joints.size() != state_->object->joint_count())
-    throw InputError("joints", "", "one value per active joint (" +
-                                       std::to_string(state_->object->joint_count()) + ")");
+    throw InputError("joints", "",
+                     "one value per active joint (" +
+                         std::to_string(state_->object->joint_count()) + ")");
   if (!joints.allFinite()) throw InputError("joints", "", "finite values");
   {
     std::lock_guard lock(state_->inbox_mutex);
@@ -374,15 +382,17 @@ void Controller::set_joints(const Eigen::VectorXd& joints) {
 void Controller::observe(ShapeObservation observation) {
   const int joints = state_->object->joint_count(), nodes = state_->object->node_count();
   if (observation.joints.size() != joints)
-    throw InputError("observation", "joints", "one value per active joint (" + std::to_string(joints) + ")");
+    throw InputError("observation", "joints",
+                     "one value per active joint (" + std::to_string(joints) + ")");
   if (!observation.joints.allFinite()) throw InputError("observation", "joints", "finite values");
-  if (observation.markers.empty()) throw InputError("observation", "markers", "at least one marker");
+  if (observation.markers.empty())
+    throw InputError("observation", "markers", "at least one marker");
   for (std::size_t k = 0; k < observation.markers.size(); ++k) {
     const auto& [node, position] = observation.markers[k];
     const std::string where = "markers[" + std::to_string(k) + "]";
     if (node < 0 || node >= nodes)
-      throw InputError("observation", where + ".node", "a node from 0 to " + std::to_string(nodes - 1),
-                       std::to_string(node));
+      throw InputError("observation", where + ".node",
+                       "a node from 0 to " + std::to_string(nodes - 1), std::to_string(node));
     check_target_point(position, "observation", where + ".position");
   }
   post(*state_, [&](Inbox& in) { in.observation = std::move(observation); });
@@ -404,8 +414,8 @@ std::shared_ptr<const ControllerSnapshot> Controller::snapshot() const {
   return state_->snapshot;
 }
 
-std::shared_ptr<const ControllerSnapshot> Controller::wait_for_snapshot(std::uint64_t after,
-                                                                        double timeout_seconds) const {
+std::shared_ptr<const ControllerSnapshot> Controller::wait_for_snapshot(
+    std::uint64_t after, double timeout_seconds) const {
   std::unique_lock lock(state_->snapshot_mutex);
   state_->snapshot_changed.wait_for(lock, std::chrono::duration<double>(timeout_seconds),
                                     [&] { return state_->snapshot->sequence > after; });

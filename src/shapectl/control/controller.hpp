@@ -51,21 +51,21 @@ bool parse(std::string_view name, ControllerStatus* status);
 
 // One published state. Everything in the world frame, metres and radians.
 struct ControllerSnapshot {
-  std::uint64_t sequence = 0;     // increases with every publication
-  double time = 0;                // seconds since the controller started
+  std::uint64_t sequence = 0;            // increases with every publication
+  double time = 0;                       // seconds since the controller started
   std::vector<std::string> joint_names;  // active joints, θ order
-  Eigen::VectorXd joints;         // θ: the current best, always safe once a safe state exists
+  Eigen::VectorXd joints;  // θ: the current best, always safe once a safe state exists
   Eigen::VectorXd lower_limits, upper_limits;
   std::vector<Eigen::Isometry3d> T_world_link;  // every link of the robot model
-  Positions positions;            // x̂(θ), 3n
-  ShapeTargets targets;           // what is asked for now (the user's, not the corrected ones)
-  std::vector<Vec3> centerline;   // the sketched centre-line, if the targets came from one
-  ShapeError error;               // of positions against targets
+  Positions positions;                          // x̂(θ), 3n
+  ShapeTargets targets;          // what is asked for now (the user's, not the corrected ones)
+  std::vector<Vec3> centerline;  // the sketched centre-line, if the targets came from one
+  ShapeError error;              // of positions against targets
   double objective = 0;
-  double min_clearance = 0;       // m; +inf without a collision model
+  double min_clearance = 0;  // m; +inf without a collision model
   bool within_limits = true;
   bool safe = true;
-  std::uint64_t iterations = 0;   // optimizer iterations so far
+  std::uint64_t iterations = 0;  // optimizer iterations so far
   double iterations_per_second = 0;
   bool paused = false;
   ControllerStatus status = ControllerStatus::Idle;
@@ -88,7 +88,7 @@ class Controller {
   Controller& operator=(const Controller&) = delete;
 
   const Scene& scene() const;
-  const TetMesh& mesh() const;       // placed rest mesh (node order = file order)
+  const TetMesh& mesh() const;  // placed rest mesh (node order = file order)
   const RobotModel& robot() const;
 
   // Runs iterations in a background thread until stop() or destruction.
@@ -119,7 +119,7 @@ class Controller {
   std::shared_ptr<const ControllerSnapshot> wait_for_snapshot(std::uint64_t after,
                                                               double timeout_seconds) const;
 
- struct State;  // the worker's state (controller.cpp)
+  struct State;  // the worker's state (controller.cpp)
 
  private:
   std::unique_ptr<State> state_;

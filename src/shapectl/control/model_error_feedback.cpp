@@ -8,7 +8,8 @@ namespace shapectl {
 ModelErrorFeedback::ModelErrorFeedback(std::shared_ptr<const TetMesh> mesh, FeedbackOptions options)
     : mesh_(std::move(mesh)), options_(options) {}
 
-void ModelErrorFeedback::observe(const std::vector<std::pair<int, Vec3>>& observed, const Positions& predicted) {
+void ModelErrorFeedback::observe(const std::vector<std::pair<int, Vec3>>& observed,
+                                 const Positions& predicted) {
   double sum = 0;
   for (const auto& [node, y] : observed) {
     const Vec3 error = y - predicted.segment<3>(3 * node);

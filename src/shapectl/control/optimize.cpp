@@ -8,25 +8,28 @@
 namespace shapectl {
 
 namespace {
-constexpr auto kTerminations = enum_names<Termination>(
-    std::pair{Termination::Converged, "converged"},
-    std::pair{Termination::IterationLimit, "iteration limit"},
-    std::pair{Termination::TimeLimit, "time limit"},
-    std::pair{Termination::Stuck, "stuck"},
-    std::pair{Termination::Failed, "failed"});
+constexpr auto kTerminations =
+    enum_names<Termination>(std::pair{Termination::Converged, "converged"},
+                            std::pair{Termination::IterationLimit, "iteration limit"},
+                            std::pair{Termination::TimeLimit, "time limit"},
+                            std::pair{Termination::Stuck, "stuck"},
+                            std::pair{Termination::Failed, "failed"});
 }  // namespace
 
 const char* to_string(Termination termination) { return kTerminations.name(termination); }
 
-bool parse(std::string_view name, Termination* termination) { return kTerminations.parse(name, termination); }
+bool parse(std::string_view name, Termination* termination) {
+  return kTerminations.parse(name, termination);
+}
 
 OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer, Evaluation start,
                         const OptimizeOptions& options) {
   using Clock = std::chrono::steady_clock;
   const auto t0 = Clock::now();
   const std::function<double()> elapsed =
-      options.clock ? options.clock
-                    : std::function<double()>([t0] { return std::chrono::duration<double>(Clock::now() - t0).count(); });
+      options.clock ? options.clock : std::function<double()>([t0] {
+        return std::chrono::duration<double>(Clock::now() - t0).count();
+      });
   OptimizeResult result;
   result.best = std::move(start);
   result.history.push_back({0, 0.0, result.best.error.mean, result.best.objective});
@@ -52,11 +55,12 @@ OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer,
     result.iterations = it;
     result.history.push_back({it, elapsed(), result.best.error.mean, result.best.objective});
     if (outcome == StepOutcome::Converged) {
-      const bool converged = result.best.statics.converged() && std::isfinite(result.best.objective);
+      const bool converged =
+          result.best.statics.converged() && std::isfinite(result.best.objective);
       result.termination = converged ? Termination::Converged : Termination::Failed;
       result.reason = converged ? "stationary after " + std::to_string(it) + " iterations"
-                                       : "stopped after " + std::to_string(it) +
-                                             " iterations at a state that is no converged equilibrium";
+                                : "stopped after " + std::to_string(it) +
+                                      " iterations at a state that is no converged equilibrium";
       break;
     }
     if (outcome == StepOutcome::OutOfTime) {
@@ -65,7 +69,8 @@ OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer,
       break;
     }
     if (outcome == StepOutcome::Stuck) {
-      result.termination = std::isfinite(result.best.objective) ? Termination::Stuck : Termination::Failed;
+      result.termination =
+          std::isfinite(result.best.objective) ? Termination::Stuck : Termination::Failed;
       result.reason = std::isfinite(result.best.objective)
                           ? "no acceptable step after " + std::to_string(it) +
                                 " iterations (every trial was worse, unsafe or failed statics)"

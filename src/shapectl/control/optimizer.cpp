@@ -18,9 +18,9 @@ const char* to_string(StepOutcome outcome) {
 }
 
 namespace {
-constexpr auto kOptimizerKinds = enum_names<OptimizerKind>(
-    std::pair{OptimizerKind::GaussNewton, "gauss-newton"},
-    std::pair{OptimizerKind::Lbfgs, "lbfgs"});
+constexpr auto kOptimizerKinds =
+    enum_names<OptimizerKind>(std::pair{OptimizerKind::GaussNewton, "gauss-newton"},
+                              std::pair{OptimizerKind::Lbfgs, "lbfgs"});
 }  // namespace
 
 const char* to_string(OptimizerKind kind) { return kOptimizerKinds.name(kind); }
@@ -54,7 +54,8 @@ Evaluation evaluate_predicted(const ReducedObjective& objective, const Eigen::Ve
   Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit, &from);
   if (e.statics.status == StaticsStatus::Inverted && e.statics.iterations == 0 &&
       !(out_of_time && out_of_time()))
-    e = objective.evaluate(joints, from.positions, kTrialNewtonLimit, &from);  // the prediction itself inverted
+    e = objective.evaluate(joints, from.positions, kTrialNewtonLimit,
+                           &from);  // the prediction itself inverted
   return e;
 }
 
@@ -111,7 +112,8 @@ void Lbfgs::reset() {
 }
 
 StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) {
-  if (current.statics.converged() && !std::isfinite(current.objective)) return StepOutcome::Stuck;  // as in GaussNewton
+  if (current.statics.converged() && !std::isfinite(current.objective))
+    return StepOutcome::Stuck;  // as in GaussNewton
   if (gradient_.size() == 0 || gradient_at_ != current.joints) {
     if (budget_spent()) return StepOutcome::OutOfTime;
     gradient_ = objective.gradient(current, method_);
@@ -136,7 +138,8 @@ StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) 
     q += (alpha[k] - beta) * s_[k];
   }
   Eigen::VectorXd d = -q;
-  if (!(g.dot(d) < 0) || !d.allFinite()) {  // not a descent direction: restart from steepest descent
+  if (!(g.dot(d) < 0) ||
+      !d.allFinite()) {  // not a descent direction: restart from steepest descent
     // Only the curvature pairs are dropped: the gradient at current.joints stays valid (a full
     // reset() here once emptied the gradient this step still reads).
     s_.clear();
@@ -144,7 +147,8 @@ StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) 
     d = -g * (max_step / g.cwiseAbs().maxCoeff());
   }
   const double slope = g.dot(d);
-  if (!(slope < 0) || !std::isfinite(slope)) return StepOutcome::Stuck;  // g overflowed in the product
+  if (!(slope < 0) || !std::isfinite(slope))
+    return StepOutcome::Stuck;  // g overflowed in the product
   double t = 1.0;
   for (int k = 0; k < 16; ++k, t *= 0.5) {
     if (budget_spent()) return StepOutcome::OutOfTime;

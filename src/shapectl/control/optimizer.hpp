@@ -83,9 +83,9 @@ class Lbfgs : public Optimizer {
 std::unique_ptr<Optimizer> make_optimizer(OptimizerKind kind, GradientMethod gradient);
 
 // Solves statics at `joints`, trying the prediction first and falling back to the plain warm
-// start (`from`'s positions) if the predicted state is inverted. The fallback is skipped (the inverted
-// evaluation returned) if `out_of_time` says the budget is spent.
-// Chord steps use `from`'s factorization (the state both starts came from).
+// start (`from`'s positions) if the predicted state is inverted. The fallback is skipped (the
+// inverted evaluation returned) if `out_of_time` says the budget is spent. Chord steps use `from`'s
+// factorization (the state both starts came from).
 Evaluation evaluate_predicted(const ReducedObjective& objective, const Eigen::VectorXd& joints,
                               const Evaluation& from, const Positions& predicted,
                               const std::function<bool()>& out_of_time = {});

@@ -11,15 +11,17 @@ using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
-constexpr auto kGradientMethods = enum_names<GradientMethod>(
-    std::pair{GradientMethod::Sensitivity, "sensitivity"},
-    std::pair{GradientMethod::Adjoint, "adjoint"},
-    std::pair{GradientMethod::FiniteDifference, "finite-difference"});
+constexpr auto kGradientMethods =
+    enum_names<GradientMethod>(std::pair{GradientMethod::Sensitivity, "sensitivity"},
+                               std::pair{GradientMethod::Adjoint, "adjoint"},
+                               std::pair{GradientMethod::FiniteDifference, "finite-difference"});
 }  // namespace
 
 const char* to_string(GradientMethod method) { return kGradientMethods.name(method); }
 
-bool parse(std::string_view name, GradientMethod* method) { return kGradientMethods.parse(name, method); }
+bool parse(std::string_view name, GradientMethod* method) {
+  return kGradientMethods.parse(name, method);
+}
 
 std::vector<std::string> gradient_names() { return kGradientMethods.names(); }
 
@@ -111,7 +113,8 @@ Eigen::VectorXd ReducedObjective::shape_gradient_x(const Evaluation& at) const {
   Eigen::VectorXd g = Eigen::VectorXd::Zero(at.positions.size());
   for (int k = 0; k < targets_.size(); ++k) {
     const int i = targets_.nodes[k];
-    g.segment<3>(3 * i) += weights_.shape * (at.positions.segment<3>(3 * i) - targets_.positions[k]);
+    g.segment<3>(3 * i) +=
+        weights_.shape * (at.positions.segment<3>(3 * i) - targets_.positions[k]);
   }
   return g;
 }
@@ -136,7 +139,8 @@ Eigen::VectorXd ReducedObjective::gradient(const Evaluation& at, GradientMethod 
     }
   } else {
     const Eigen::VectorXd dO_dx = shape_gradient_x(at);
-    if (method == GradientMethod::Adjoint) g = object_->adjoint(*at.state, dO_dx, options_.stale_factor_step);
+    if (method == GradientMethod::Adjoint)
+      g = object_->adjoint(*at.state, dO_dx, options_.stale_factor_step);
     else g = sensitivity(at, true).transpose() * dO_dx;
     const KinematicsState& state = at.state->kinematics();
     Eigen::VectorXd barrier(joint_count());

@@ -4,9 +4,9 @@
 // its gradient by direct sensitivities, by the adjoint method or by finite differences, and
 // its least-squares form (residuals and Jacobian) for Gauss–Newton.
 #include <chrono>
+#include <limits>
 #include <memory>
 #include <mutex>
-#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -30,13 +30,13 @@ struct Evaluation {
   Eigen::VectorXd joints;
   Positions positions;  // x̂(θ)
   StaticsResult statics;
-  double shape = 0;         // weighted terms of the objective
+  double shape = 0;  // weighted terms of the objective
   double collision = 0;
   double joint_limits = 0;
   double objective = std::numeric_limits<double>::infinity();
   ShapeError error;
   double min_clearance = std::numeric_limits<double>::infinity();  // m, margin not subtracted
-  bool within_limits = true;  // hard limits, no margin
+  bool within_limits = true;                                       // hard limits, no margin
   std::shared_ptr<ObjectState> state;
   // A configuration we may hand to a robot.
   bool safe() const { return statics.converged() && min_clearance >= 0 && within_limits; }
@@ -104,7 +104,7 @@ class ReducedObjective {
     ObjectiveTiming timing;
   };
   void score(Evaluation& e) const;
-  Evaluation describe(ObjectState state) const;  // scores a solved state
+  Evaluation describe(ObjectState state) const;                  // scores a solved state
   Eigen::VectorXd shape_gradient_x(const Evaluation& at) const;  // ∂O_shape/∂x, weighted
   void count_statics(double seconds) const;
   void count_gradient(double seconds) const;

@@ -36,11 +36,13 @@ TargetsInput read_targets(const JsonInput& json, int node_count) {
     if (list.size() > max_centerline_points)
       list.fail_problem(std::to_string(list.size()) + " points, more than the limit of " +
                         std::to_string(max_centerline_points));
-    for (std::size_t k = 0; k < list.size(); ++k) in.centerline.push_back(list.at(k).vec3_within(max_distance, "a point", "m"));
+    for (std::size_t k = 0; k < list.size(); ++k)
+      in.centerline.push_back(list.at(k).vec3_within(max_distance, "a point", "m"));
     double length = 0;
     for (std::size_t k = 1; k < in.centerline.size(); ++k)
       length += (in.centerline[k] - in.centerline[k - 1]).norm();
-    if (in.centerline.size() < 2 || !(length > 0)) list.fail("a polyline of at least 2 distinct points");
+    if (in.centerline.size() < 2 || !(length > 0))
+      list.fail("a polyline of at least 2 distinct points");
   }
   return in;
 }

@@ -60,7 +60,8 @@ double neo_hookean_tet(const TetRest& rest, const Material& m, const Vec12& x, V
     const Mat9x12 B = dF_dx(rest.Dm_inverse);
     // P = μ(F − F⁻ᵀ) + κ ln J F⁻ᵀ
     const Mat3 P = m.mu * (F - F_inv_T) + m.kappa * log_J * F_inv_T;
-    *gradient = rest.volume * B.transpose() * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(P.data());
+    *gradient =
+        rest.volume * B.transpose() * Eigen::Map<const Eigen::Matrix<double, 9, 1>>(P.data());
   }
   if (hessian) {
     // dP = μ dF + (μ − κ ln J) F⁻ᵀ dFᵀ F⁻ᵀ + κ tr(F⁻¹dF) F⁻ᵀ
@@ -89,7 +90,8 @@ double neo_hookean_tet(const TetRest& rest, const Material& m, const Vec12& x, V
       for (int i = 0; i < 3; ++i)
         for (int col = 0; col < 12; ++col)
           (*hessian)(3 * a + i, col) =
-              rest.volume * (b(0, a) * CB(i, col) + b(1, a) * CB(3 + i, col) + b(2, a) * CB(6 + i, col));
+              rest.volume *
+              (b(0, a) * CB(i, col) + b(1, a) * CB(3 + i, col) + b(2, a) * CB(6 + i, col));
   }
   return rest.volume * psi;
 }
@@ -118,28 +120,30 @@ void NeoHookean::add_gradient(const Positions& x, Eigen::VectorXd& gradient) con
                     });
   // Serial scatter: nodes are shared between tets.
   for (std::size_t e = 0; e < tets.size(); ++e)
-    for (int a = 0; a < 4; ++a) gradient.segment<3>(3 * tets[e].nodes[a]) += per_tet[e].segment<3>(3 * a);
+    for (int a = 0; a < 4; ++a)
+      gradient.segment<3>(3 * tets[e].nodes[a]) += per_tet[e].segment<3>(3 * a);
 }
 
 void NeoHookean::add_hessian(const Positions& x, Triplets& hessian, bool project_psd) const {
   const auto& tets = mesh_.tets();
   const std::size_t offset = hessian.size();
   hessian.resize(offset + 144 * tets.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tets.size(), kGrain),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
-                      Mat12 H;
-                      for (std::size_t e = r.begin(); e != r.end(); ++e) {
-                        const auto& t = tets[e];
-                        H.setConstant(std::numeric_limits<double>::quiet_NaN());
-                        neo_hookean_tet(t, material_, gather(x, t), nullptr, &H, project_psd);
-                        auto* out = &hessian[offset + 144 * e];
-                        for (int a = 0; a < 4; ++a)
-                          for (int i = 0; i < 3; ++i)
-                            for (int b = 0; b < 4; ++b)
-                              for (int j = 0; j < 3; ++j)
-                                *out++ = {3 * t.nodes[a] + i, 3 * t.nodes[b] + j, H(3 * a + i, 3 * b + j)};
-                      }
-                    });
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, tets.size(), kGrain),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        Mat12 H;
+        for (std::size_t e = r.begin(); e != r.end(); ++e) {
+          const auto& t = tets[e];
+          H.setConstant(std::numeric_limits<double>::quiet_NaN());
+          neo_hookean_tet(t, material_, gather(x, t), nullptr, &H, project_psd);
+          auto* out = &hessian[offset + 144 * e];
+          for (int a = 0; a < 4; ++a)
+            for (int i = 0; i < 3; ++i)
+              for (int b = 0; b < 4; ++b)
+                for (int j = 0; j < 3; ++j)
+                  *out++ = {3 * t.nodes[a] + i, 3 * t.nodes[b] + j, H(3 * a + i, 3 * b + j)};
+        }
+      });
 }
 
 }  // namespace shapectl

@@ -36,7 +36,8 @@ fs::path write_temporary(const fs::path& file, const std::string& text) {
   fs::path temporary;
   int fd = -1;
   for (int attempt = 0; fd < 0; ++attempt) {
-    temporary = file.string() + ".tmp." + std::to_string(getpid()) + "." + std::to_string(counter++);
+    temporary =
+        file.string() + ".tmp." + std::to_string(getpid()) + "." + std::to_string(counter++);
     fd = open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
     if (fd < 0 && (errno != EEXIST || attempt >= 100))
       fail(file, "cannot create '" + temporary.string() + "': " + std::strerror(errno));

@@ -12,7 +12,8 @@ class InputError : public std::runtime_error {
   template <class Found>
   InputError(const std::string& source, const std::string& where, const std::string& expected,
              const Found& found)
-      : std::runtime_error(compose(source, where, "expected " + expected + ", got " + show(found))) {}
+      : std::runtime_error(
+            compose(source, where, "expected " + expected + ", got " + show(found))) {}
   // "bar.msh:1042: element 511: node 9000 out of range (mesh has 1536 nodes)"
   InputError(const std::string& source, const std::string& where, const std::string& problem)
       : std::runtime_error(compose(source, where, problem)) {}

@@ -38,11 +38,13 @@ std::string read_input_file(const std::filesystem::path& file, std::uintmax_t ma
   // O_NONBLOCK: opening a FIFO must not wait for a writer; the type is checked on the open
   // descriptor, so the file cannot be swapped between the check and the read.
   const Descriptor in{open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC)};
-  if (in.fd < 0) throw InputError(name, "", "cannot open file (" + std::string(std::strerror(errno)) + ")");
+  if (in.fd < 0)
+    throw InputError(name, "", "cannot open file (" + std::string(std::strerror(errno)) + ")");
   struct stat info {};
   if (fstat(in.fd, &info) != 0)
     throw InputError(name, "", "cannot open file (" + std::string(std::strerror(errno)) + ")");
-  if (!S_ISREG(info.st_mode)) throw InputError(name, "", "not a regular file (" + file_kind(info.st_mode) + ")");
+  if (!S_ISREG(info.st_mode))
+    throw InputError(name, "", "not a regular file (" + file_kind(info.st_mode) + ")");
   const std::string limit = "larger than the " + std::to_string(max_bytes) + " byte limit for " +
                             std::string(what) + " files";
   if (static_cast<std::uintmax_t>(info.st_size) > max_bytes)
@@ -53,7 +55,8 @@ std::string read_input_file(const std::filesystem::path& file, std::uintmax_t ma
   for (;;) {
     const ssize_t n = read(in.fd, buffer, sizeof buffer);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) throw InputError(name, "", "cannot read file (" + std::string(std::strerror(errno)) + ")");
+    if (n < 0)
+      throw InputError(name, "", "cannot read file (" + std::string(std::strerror(errno)) + ")");
     if (n == 0) break;
     text.append(buffer, static_cast<std::size_t>(n));
     if (text.size() > max_bytes) throw InputError(name, "", limit);  // it grew while we read

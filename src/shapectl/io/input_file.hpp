@@ -9,10 +9,11 @@
 namespace shapectl {
 
 // Size limits per kind of input file, in bytes.
-inline constexpr std::uintmax_t max_json_file_bytes = 8u << 20;    // scene, targets, joints, spheres
-inline constexpr std::uintmax_t max_urdf_file_bytes = 16u << 20;   // YuMi's is 22 kB
+inline constexpr std::uintmax_t max_json_file_bytes = 8u << 20;   // scene, targets, joints, spheres
+inline constexpr std::uintmax_t max_urdf_file_bytes = 16u << 20;  // YuMi's is 22 kB
 inline constexpr std::uintmax_t max_mesh_file_bytes = 256u << 20;  // a million-tet MSH is ~60 MB
-inline constexpr std::uintmax_t max_session_log_bytes = 1u << 30;  // an hour of EGM at 250 Hz: ~400 MB
+inline constexpr std::uintmax_t max_session_log_bytes = 1u
+                                                        << 30;  // an hour of EGM at 250 Hz: ~400 MB
 
 // The whole file. Throws InputError naming the file: "cannot open file (<reason>)" when it is
 // missing or unreadable, "not a regular file (...)" for a directory, FIFO or device, and

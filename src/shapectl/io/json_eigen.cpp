@@ -48,7 +48,8 @@ Mat3 rotation_from_rpy(const Vec3& rpy) {
 // Closed form with pitch in [−π/2, π/2]: a small rotation gives small angles (Eigen's
 // eulerAngles keeps yaw in [0, π] and may answer a small rotation with angles near ±π).
 Vec3 rpy_from_rotation(const Mat3& R) {
-  return {std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)), std::atan2(R(1, 0), R(0, 0))};
+  return {std::atan2(R(2, 1), R(2, 2)), std::asin(std::clamp(-R(2, 0), -1.0, 1.0)),
+          std::atan2(R(1, 0), R(0, 0))};
 }
 
 nlohmann::json result_pose_json(const Vec3& position, const Mat3& rotation) {

@@ -17,7 +17,6 @@ long line_at(std::string_view text, std::size_t at) {
   return 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n');
 }
 
-
 // Tracks where the parser is ("object.mesh.box", "grips[1]") and refuses a key an object
 // already has: with nlohmann's default the last one would silently win.
 class DuplicateKeyCheck {
@@ -43,9 +42,7 @@ class DuplicateKeyCheck {
           throw InputError(source_, path(), "duplicate key (each key may appear once)");
         break;
       }
-      case Event::value:
-        count_element();
-        break;
+      case Event::value: count_element(); break;
     }
     return true;
   }
@@ -63,7 +60,8 @@ class DuplicateKeyCheck {
   std::string path() const {
     std::string out;
     for (const Frame& f : frames_)
-      out += f.object ? (out.empty() ? "" : ".") + bounded_preview(f.key) : "[" + std::to_string(f.index) + "]";
+      out += f.object ? (out.empty() ? "" : ".") + bounded_preview(f.key)
+                      : "[" + std::to_string(f.index) + "]";
     return out;
   }
   const std::string& source_;
@@ -94,7 +92,9 @@ std::size_t json_too_deep_at(std::string_view text, int max_depth) {
 nlohmann::json parse_json_text(std::string_view text, const std::string& source,
                                const JsonLimits& limits) {
   if (text.size() > limits.max_bytes)
-    throw InputError(source, "", "longer than the " + std::to_string(limits.max_bytes) + " byte limit for JSON");
+    throw InputError(source, "",
+                     "longer than the " + std::to_string(limits.max_bytes) +
+                         " byte limit for JSON");
   if (const std::size_t at = json_too_deep_at(text, limits.max_depth); at != std::string_view::npos)
     throw InputError(source + ":" + std::to_string(line_at(text, at)), "",
                      "JSON nested deeper than " + std::to_string(limits.max_depth) + " levels");
@@ -187,8 +187,7 @@ bool JsonInput::has(std::string_view key) const {
 JsonInput JsonInput::at(std::string_view key) const {
   if (!value_.is_object()) fail("an object");
   auto it = value_.find(key);
-  if (it == value_.end())
-    throw InputError(source_, child_path(key), "missing key");
+  if (it == value_.end()) throw InputError(source_, child_path(key), "missing key");
   return JsonInput(*it, source_, child_path(key));
 }
 

@@ -50,27 +50,28 @@ class JsonInput {
   bool is_number() const { return value_.is_number(); }
 
   bool has(std::string_view key) const;
-  JsonInput at(std::string_view key) const;   // required member of an object
-  JsonInput at(std::size_t index) const;      // element of an array
-  std::size_t size() const;                   // length of an array (error if not an array)
-  std::vector<std::string> keys() const;      // members of an object, in file order
+  JsonInput at(std::string_view key) const;  // required member of an object
+  JsonInput at(std::size_t index) const;     // element of an array
+  std::size_t size() const;                  // length of an array (error if not an array)
+  std::vector<std::string> keys() const;     // members of an object, in file order
   // Every member must be one of `known`; a typo must never silently change the physics.
   void expect_only(std::initializer_list<std::string_view> known) const;
   void expect_only(const std::vector<std::string>& known) const;
 
-  double number() const;        // finite
-  double positive() const;      // finite, > 0
-  double non_negative() const;  // finite, >= 0
-  long integer() const;         // a whole number
+  double number() const;                    // finite
+  double positive() const;                  // finite, > 0
+  double non_negative() const;              // finite, >= 0
+  long integer() const;                     // a whole number
   long integer_in(long lo, long hi) const;  // lo <= value <= hi
   // lo <= value <= hi; `unit` ("m", "Pa") is shown with the range in the message.
   double number_in(double lo, double hi, const std::string& unit) const;
   // [x, y, z] with |(x, y, z)| <= radius; `what` names it ("a point", "a gravity vector").
-  Eigen::Vector3d vec3_within(double radius, const std::string& what, const std::string& unit) const;
+  Eigen::Vector3d vec3_within(double radius, const std::string& what,
+                              const std::string& unit) const;
   bool boolean() const;
   std::string string() const;
-  Eigen::Vector3d vec3() const;             // [x, y, z], finite
-  std::vector<double> numbers() const;      // array of finite numbers
+  Eigen::Vector3d vec3() const;         // [x, y, z], finite
+  std::vector<double> numbers() const;  // array of finite numbers
 
   // Throws InputError "<source>: <path>: expected <expected>, got <what is there>".
   [[noreturn]] void fail(const std::string& expected) const;

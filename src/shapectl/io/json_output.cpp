@@ -55,7 +55,8 @@ std::optional<std::string> non_finite_in(const Json& v, const std::string& where
   if (v.is_number_float() && !std::isfinite(v.template get<double>())) return where;
   if (v.is_object())
     for (auto it = v.begin(); it != v.end(); ++it)
-      if (auto found = non_finite_in(it.value(), where + (where.empty() ? "" : ".") + it.key())) return found;
+      if (auto found = non_finite_in(it.value(), where + (where.empty() ? "" : ".") + it.key()))
+        return found;
   if (v.is_array())
     for (std::size_t k = 0; k < v.size(); ++k)
       if (auto found = non_finite_in(v[k], where + "[" + std::to_string(k) + "]")) return found;
@@ -74,7 +75,9 @@ void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_
   write_file_atomically(file, pretty_text(value));
 }
 
-std::optional<std::string> first_non_finite(const nlohmann::json& value) { return non_finite_in(value, ""); }
+std::optional<std::string> first_non_finite(const nlohmann::json& value) {
+  return non_finite_in(value, "");
+}
 std::optional<std::string> first_non_finite(const nlohmann::ordered_json& value) {
   return non_finite_in(value, "");
 }

@@ -23,7 +23,8 @@ double SessionLog::elapsed() const {
 void SessionLog::write(std::string_view event, const nlohmann::json& fields) {
   nlohmann::json line = {{"t", elapsed()}, {"event", event}};
   if (fields.is_object()) line.update(fields);
-  const std::string text = line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  const std::string text =
+      line.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   std::lock_guard lock(mutex_);
   // One write and a flush per line: the OS has every finished line even if we crash next.
   std::fwrite(text.data(), 1, text.size(), out_);
@@ -58,8 +59,10 @@ std::vector<LoggedEvent> read_session_log(const std::filesystem::path& file, int
         if (truncated_lines) ++*truncated_lines;
         break;
       }
-      throw InputError(where, "", "expected a JSON object with a number \"t\" and a string "
-                                  "\"event\", got: " + bounded_preview(text));
+      throw InputError(where, "",
+                       "expected a JSON object with a number \"t\" and a string "
+                       "\"event\", got: " +
+                           bounded_preview(text));
     }
     events.push_back({line, j["t"].get<double>(), j["event"].get<std::string>(), std::move(j)});
   }

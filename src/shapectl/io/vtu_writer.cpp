@@ -37,15 +37,16 @@ void check_sizes(const Positions& positions, const std::vector<std::array<int, 4
   for (const auto& t : tets)
     for (int v : t)
       if (v < 0 || v >= n)
-        throw std::invalid_argument("write_vtu: tet node " + std::to_string(v) +
-                                    " out of range (" + std::to_string(n) + " nodes)");
+        throw std::invalid_argument("write_vtu: tet node " + std::to_string(v) + " out of range (" +
+                                    std::to_string(n) + " nodes)");
   if (!positions.allFinite()) throw std::invalid_argument("write_vtu: a position is not finite");
   for (const auto& f : node_fields) {
     if (f.values.size() != positions.size())
       throw std::invalid_argument("write_vtu: field '" + f.name + "' has size " +
                                   std::to_string(f.values.size()) + ", expected " +
                                   std::to_string(positions.size()));
-    if (!f.values.allFinite()) throw std::invalid_argument("write_vtu: field '" + f.name + "' is not finite");
+    if (!f.values.allFinite())
+      throw std::invalid_argument("write_vtu: field '" + f.name + "' is not finite");
   }
 }
 

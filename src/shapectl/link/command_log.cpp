@@ -66,11 +66,15 @@ CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
       ++check.links;
       // JSON has no infinity: unbounded limits were written as null.
       constexpr double inf = std::numeric_limits<double>::infinity();
-      GovernorLimits all{vector_from_json(f.at("lower"), -inf), vector_from_json(f.at("upper"), inf),
-                         vector_from_json(f.at("velocity"), inf), vector_from_json(f.at("acceleration"), inf)};
+      GovernorLimits all{vector_from_json(f.at("lower"), -inf),
+                         vector_from_json(f.at("upper"), inf),
+                         vector_from_json(f.at("velocity"), inf),
+                         vector_from_json(f.at("acceleration"), inf)};
       channels.clear();
       for (const auto& c : f.at("channels"))
-        channels[c.at("name").get<std::string>()] = {all.subset(c.at("joints").get<std::vector<int>>()), {}};
+        channels[c.at("name").get<std::string>()] = {all.subset(
+                                                         c.at("joints").get<std::vector<int>>()),
+                                                     {}};
       dt = f.at("period").get<double>();
     } else if (e.event == "connect") {
       const auto it = channels.find(f.at("channel").get<std::string>());
@@ -86,12 +90,12 @@ CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
       const Eigen::VectorXd q = vector_from_json(f.at("joints"), NAN);
       ++check.commands;
       if (q.size() != c.limits.size() || !q.allFinite()) {
-        violation(e, name + ": command is not " + std::to_string(c.limits.size()) + " finite values");
+        violation(e,
+                  name + ": command is not " + std::to_string(c.limits.size()) + " finite values");
         continue;
       }
       const bool hold = f.value("hold", false);
-      if (hold && !c.last.empty() && q != c.last.back())
-        violation(e, name + ": a hold that moved");
+      if (hold && !c.last.empty() && q != c.last.back()) violation(e, name + ": a hold that moved");
       // Restarted from rest: the step before counts as zero.
       if (!c.last.empty() && f.value("from_rest", false)) c.last = {c.last.back(), c.last.back()};
       for (Eigen::Index i = 0; i < q.size() && !hold; ++i) {
@@ -101,7 +105,8 @@ CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
           return std::max({0.0, c.limits.lower[i] - x, x - c.limits.upper[i]});
         };
         if (out(q[i]) > slack && !c.last.empty() && out(q[i]) > out(c.last.back()[i]) + slack)
-          violation(e, joint + ": " + std::to_string(q[i]) + " rad outside the band, moving outwards");
+          violation(e,
+                    joint + ": " + std::to_string(q[i]) + " rad outside the band, moving outwards");
         if (c.last.empty()) continue;
         const double dq = std::abs(q[i] - c.last.back()[i]);
         const double v_ratio = dq / (c.limits.velocity[i] * dt);

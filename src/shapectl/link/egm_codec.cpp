@@ -22,7 +22,8 @@ constexpr int chain_of_axis7 = 2;
 
 void put_joints(const ArmJoints& q, egm::EgmJoints* joints, egm::EgmJoints* external) {
   joints->clear_joints();
-  for (int axis = 0; axis < 6; ++axis) joints->add_joints(q[chain_of_robot_axis[axis]] * deg_per_rad);
+  for (int axis = 0; axis < 6; ++axis)
+    joints->add_joints(q[chain_of_robot_axis[axis]] * deg_per_rad);
   external->clear_joints();
   external->add_joints(q[chain_of_axis7] * deg_per_rad);
 }
@@ -75,10 +76,9 @@ bool EgmCodec::decode_robot(std::string_view datagram, EgmFeedback& out, std::st
   out.tm = m.header().tm();
   out.motors_on = m.has_motorstate() && m.motorstate().state() == egm::EgmMotorState::MOTORS_ON;
   out.egm_running = m.has_mcistate() && m.mcistate().state() == egm::EgmMCIState::MCI_RUNNING;
-  out.rapid_running =
-      m.has_rapidexecstate() &&
-      (m.rapidexecstate().state() == egm::EgmRapidCtrlExecState::RAPID_RUNNING ||
-       m.rapidexecstate().state() == egm::EgmRapidCtrlExecState::RAPID_UNDEFINED);
+  out.rapid_running = m.has_rapidexecstate() &&
+                      (m.rapidexecstate().state() == egm::EgmRapidCtrlExecState::RAPID_RUNNING ||
+                       m.rapidexecstate().state() == egm::EgmRapidCtrlExecState::RAPID_UNDEFINED);
   return true;
 }
 
@@ -131,11 +131,11 @@ bool EgmCodec::decode_sensor(std::string_view datagram, EgmCommand& out, std::st
   if (m.header().mtype() != egm::EgmHeader::MSGTYPE_CORRECTION)
     return *why = "not a CORRECTION message", false;
   if (!m.has_planned()) return *why = "no planned", false;
-  if (!get_joints(m.planned().joints(), m.planned().externaljoints(), out.joints, why)) return false;
+  if (!get_joints(m.planned().joints(), m.planned().externaljoints(), out.joints, why))
+    return false;
   out.velocity.setZero();
-  if (m.has_speedref() &&
-      !get_joints(m.speedref().joints(), m.speedref().externaljoints(), out.velocity, why,
-                  plausible_deg_per_s))
+  if (m.has_speedref() && !get_joints(m.speedref().joints(), m.speedref().externaljoints(),
+                                      out.velocity, why, plausible_deg_per_s))
     return false;
   out.seqno = m.header().seqno();
   out.tm = m.header().tm();

@@ -17,20 +17,20 @@ using ArmJoints = Eigen::Matrix<double, 7, 1>;  // chain order, rad (or rad/s)
 
 // EgmRobot: the controller's sample.
 struct EgmFeedback {
-  std::uint32_t seqno = 0;  // controller's counter
-  std::uint32_t tm = 0;     // controller's time stamp, ms
+  std::uint32_t seqno = 0;               // controller's counter
+  std::uint32_t tm = 0;                  // controller's time stamp, ms
   ArmJoints joints = ArmJoints::Zero();  // measured (feedBack)
   bool motors_on = false;
-  bool egm_running = false;   // mciState RUNNING
-  bool rapid_running = false; // rapidExecState RUNNING or UNDEFINED (an EGM quirk after restart)
+  bool egm_running = false;    // mciState RUNNING
+  bool rapid_running = false;  // rapidExecState RUNNING or UNDEFINED (an EGM quirk after restart)
   // Why the arm will not follow commands ("motors off", "EGM not running", ...); empty if it will.
   std::string_view fault() const;
 };
 
 // EgmSensor: our reply.
 struct EgmCommand {
-  std::uint32_t seqno = 0;  // our counter, +1 per message
-  std::uint32_t tm = 0;     // our time stamp, ms
+  std::uint32_t seqno = 0;                 // our counter, +1 per message
+  std::uint32_t tm = 0;                    // our time stamp, ms
   ArmJoints joints = ArmJoints::Zero();    // planned position
   ArmJoints velocity = ArmJoints::Zero();  // speedRef (feed-forward), rad/s
 };

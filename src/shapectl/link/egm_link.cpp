@@ -78,10 +78,11 @@ std::vector<LinkChannel> egm_arm_channels(const RobotModel& robot) {
 EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck check,
                  std::shared_ptr<SessionLog> log)
     : SupervisedLink(config.egm_period, log,
-                     LinkSupervisor(to_string(LinkKind::Egm), robot.active_joint_names(), egm_arm_channels(robot),
-                                    robot.lower_limits(), robot.upper_limits(), governor_limits(config, robot),
-                                    {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance,
-                                     config.egm_period},
+                     LinkSupervisor(to_string(LinkKind::Egm), robot.active_joint_names(),
+                                    egm_arm_channels(robot), robot.lower_limits(),
+                                    robot.upper_limits(), governor_limits(config, robot),
+                                    {config.watchdog_timeout, config.max_tracking_error,
+                                     config.arrive_tolerance, config.egm_period},
                                     std::move(check), log.get())),
       buffer_(EgmCodec::max_datagram + 1) {
   for (const auto& c : supervisor_.channels()) {
@@ -93,8 +94,8 @@ EgmLink::EgmLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
   pending_.resize(sockets_.size());
   latency_us_.reserve(latency_capacity);
   if (log_)
-    log_link_started(*log_, to_string(LinkKind::Egm), robot.active_joint_names(), supervisor_.channels(),
-                     supervisor_.limits(), period_);
+    log_link_started(*log_, to_string(LinkKind::Egm), robot.active_joint_names(),
+                     supervisor_.channels(), supervisor_.limits(), period_);
 }
 
 EgmLink::~EgmLink() { stop(); }
@@ -117,8 +118,9 @@ void EgmLink::run(std::stop_token stop) {
       long n;
       while ((n = sockets_[c].receive(buffer_, &from)) >= 0)
         handle_datagram(static_cast<int>(c),
-                        std::string_view(buffer_.data(), static_cast<std::size_t>(
-                                                             std::min<long>(n, static_cast<long>(buffer_.size())))),
+                        std::string_view(buffer_.data(),
+                                         static_cast<std::size_t>(
+                                             std::min<long>(n, static_cast<long>(buffer_.size())))),
                         from, std::chrono::steady_clock::now());
     }
     send_due_replies();
@@ -142,8 +144,8 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
     }
     if (log_ && count <= max_logged_rejections)
       log_->write("datagram_rejected", {{"channel", supervisor_.channels()[c].name},
-                                         {"bytes", datagram.size()},
-                                         {"reason", why}});
+                                        {"bytes", datagram.size()},
+                                        {"reason", why}});
     return;
   }
   EgmCommand command;
@@ -174,8 +176,8 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
         fault = "the controller's sample period is " + std::to_string(filter.cycle_ms()) +
                 " ms (feedback time stamps), egm_period is " + std::to_string(period_ms) +
                 " ms: set \\SampleRate or egm_period to match";
-      reply.step = supervisor_.on_feedback(channel, reply.measured, fault, now(),
-                                           filter.controller_time());
+      reply.step =
+          supervisor_.on_feedback(channel, reply.measured, fault, now(), filter.controller_time());
       command.joints = supervisor_.command(channel);
       command.velocity =
           reply.step.advanced ? supervisor_.command_velocity(channel) : ArmJoints::Zero();
@@ -184,11 +186,14 @@ void EgmLink::handle_datagram(int channel, std::string_view datagram, const sock
     }
   }
   if (log_ && !bound_to.empty())
-    log_->write("controller_bound", {{"channel", supervisor_.channels()[c].name}, {"address", bound_to}});
+    log_->write("controller_bound",
+                {{"channel", supervisor_.channels()[c].name}, {"address", bound_to}});
   if (log_ && log_foreign)
-    log_->write("foreign_sender", {{"channel", supervisor_.channels()[c].name},
-                                   {"address", address_text(from)},
-                                   {"note", "ignored; at most " + std::to_string(max_logged_rejections) + " such lines are logged"}});
+    log_->write("foreign_sender",
+                {{"channel", supervisor_.channels()[c].name},
+                 {"address", address_text(from)},
+                 {"note", "ignored; at most " + std::to_string(max_logged_rejections) +
+                              " such lines are logged"}});
   if (verdict != FeedbackVerdict::accepted || !reply.step.send) return;
   reply.bytes = codec_.encode_sensor(command);
   reply.joints = command.joints;

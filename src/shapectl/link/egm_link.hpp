@@ -8,8 +8,8 @@
 // that are not valid EgmRobot messages are counted and ignored.
 #include <chrono>
 #include <deque>
-#include <string>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <shapectl/link/egm_codec.hpp>
@@ -67,9 +67,9 @@ class EgmLink : public SupervisedLink {
   void send_due_replies();
   void send_reply(int channel, const Reply& reply);
 
-  std::vector<UdpSocket> sockets_;  // one per channel
-  EgmCodec codec_;                  // link thread only
-  std::vector<char> buffer_;        // link thread only
+  std::vector<UdpSocket> sockets_;          // one per channel
+  EgmCodec codec_;                          // link thread only
+  std::vector<char> buffer_;                // link thread only
   std::vector<std::deque<Reply>> pending_;  // per channel, link thread only
 
   // Guarded by mutex_:

@@ -37,9 +37,15 @@ EgmSimulator::EgmSimulator(EgmSimulatorConfig config) : config_(std::move(config
   const std::array<int, 2> ports = {config_.left_port, config_.right_port};
   const std::array<ArmJoints, 2> initial = {config_.left_initial, config_.right_initial};
   for (int a = 0; a < 2; ++a) {
-    auto arm = std::make_unique<Arm>(Arm{std::nullopt, {},
-                                         SimRobot(yumi_arm_limits(config_.acceleration), initial[a]),
-                                         {}, 0, {}, false, {}});
+    auto arm =
+        std::make_unique<Arm>(Arm{std::nullopt,
+                                  {},
+                                  SimRobot(yumi_arm_limits(config_.acceleration), initial[a]),
+                                  {},
+                                  0,
+                                  {},
+                                  false,
+                                  {}});
     if (ports[a] > 0) {
       arm->sensor = ipv4_address(config_.sensor_address, ports[a], "egm-sim sensor address");
       arm->socket.emplace("0.0.0.0", 0, "egm-sim");
@@ -85,8 +91,10 @@ void EgmSimulator::run(std::stop_token stop) {
     // not checked.
     const auto woke = std::chrono::steady_clock::now();
     const bool late = woke - next > period / 2;
-    const double tick_time = std::chrono::duration<double>(
-        std::chrono::system_clock::now().time_since_epoch() - (woke - next)).count();
+    const double tick_time =
+        std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch() -
+                                      (woke - next))
+            .count();
     const bool paused = paused_;
     for (auto& arm : arms_) {
       if (!arm->socket) continue;
@@ -136,9 +144,10 @@ void EgmSimulator::tick(Arm& arm, bool paused, bool late, double tick_time) {
     if (!arm.recent.empty())
       s.max_speed = std::max(s.max_speed, (q - arm.recent.back()).cwiseAbs().maxCoeff() / dt);
     if (arm.recent.size() == 2)
-      s.max_acceleration = std::max(
-          s.max_acceleration,
-          (q - 2 * arm.recent.back() + arm.recent.front()).cwiseAbs().maxCoeff() / (dt * dt));
+      s.max_acceleration =
+          std::max(s.max_acceleration,
+                   (q - 2 * arm.recent.back() + arm.recent.front()).cwiseAbs().maxCoeff() /
+                       (dt * dt));
     if (arm.recent.size() == 2) arm.recent.erase(arm.recent.begin());
     arm.recent.push_back(q);
     arm.robot.command(q);

@@ -22,11 +22,11 @@ namespace shapectl {
 GovernorLimits yumi_arm_limits(double acceleration);
 
 struct EgmSimulatorConfig {
-  std::string sensor_address = "127.0.0.1";  // where the link listens
-  int left_port = 6511;                       // 0: no left arm
-  int right_port = 6512;                      // 0: no right arm
-  double period = 0.004;                      // s between feedback messages (250 Hz)
-  ArmJoints left_initial = ArmJoints::Zero();   // chain order, rad
+  std::string sensor_address = "127.0.0.1";    // where the link listens
+  int left_port = 6511;                        // 0: no left arm
+  int right_port = 6512;                       // 0: no right arm
+  double period = 0.004;                       // s between feedback messages (250 Hz)
+  ArmJoints left_initial = ArmJoints::Zero();  // chain order, rad
   ArmJoints right_initial = ArmJoints::Zero();
   double acceleration = 10;  // rad/s², the simulated arms' own limit
 };
@@ -34,14 +34,14 @@ struct EgmSimulatorConfig {
 struct EgmSimArmStats {
   bool present = false;
   std::uint64_t feedback_sent = 0;
-  std::uint64_t commands = 0;       // valid EgmSensor replies received
-  std::uint64_t rejected = 0;       // replies that were not valid EgmSensor messages
+  std::uint64_t commands = 0;                  // valid EgmSensor replies received
+  std::uint64_t rejected = 0;                  // replies that were not valid EgmSensor messages
   ArmJoints position = ArmJoints::Zero();      // the simulated arm, rad
   ArmJoints last_command = ArmJoints::Zero();  // rad
   // From consecutive cycles' commands (period apart), over all joints; restarted after a
   // pause, a cycle without a new command, or a late tick of the simulator's own.
-  double max_speed = 0;         // rad/s
-  double max_acceleration = 0;  // rad/s²
+  double max_speed = 0;              // rad/s
+  double max_acceleration = 0;       // rad/s²
   std::uint64_t outside_limits = 0;  // commands outside the arm's joint limits
 };
 
@@ -64,7 +64,7 @@ class EgmSimulator {
 
   EgmSimulatorConfig config_;
   std::vector<std::unique_ptr<Arm>> arms_;  // [left, right]
-  EgmCodec codec_;  // simulator thread only
+  EgmCodec codec_;                          // simulator thread only
   std::atomic<bool> paused_{false};
   mutable std::mutex mutex_;  // guards the arms' stats and robots
   std::jthread thread_;

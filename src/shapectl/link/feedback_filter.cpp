@@ -5,9 +5,7 @@ namespace shapectl {
 namespace {
 
 // b − a in serial-number arithmetic: positive when b is ahead.
-std::int64_t ahead(std::uint32_t a, std::uint32_t b) {
-  return static_cast<std::int32_t>(b - a);
-}
+std::int64_t ahead(std::uint32_t a, std::uint32_t b) { return static_cast<std::int32_t>(b - a); }
 
 }  // namespace
 

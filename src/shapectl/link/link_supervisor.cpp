@@ -35,8 +35,14 @@ LinkSupervisor::LinkSupervisor(std::string kind, std::vector<std::string> joint_
       log_(log) {
   assert(static_cast<int>(joint_names_.size()) == limits_.size());
   for (const auto& spec : channels_) {
-    Channel c{spec, MotionGovernor(limits_.subset(spec.joints)), MotionPacer(settings_.period),
-              {}, -std::numeric_limits<double>::infinity(), false, {}, {}};
+    Channel c{spec,
+              MotionGovernor(limits_.subset(spec.joints)),
+              MotionPacer(settings_.period),
+              {},
+              -std::numeric_limits<double>::infinity(),
+              false,
+              {},
+              {}};
     c.measured = c.governor.position();
     state_.push_back(std::move(c));
   }
@@ -72,9 +78,9 @@ std::string LinkSupervisor::target_problem(const Eigen::VectorXd& joints, bool s
   if (!safe) return "optimizer marked the target unsafe (collision or limits)";
   for (Eigen::Index i = 0; i < joints.size(); ++i)
     if (joints[i] < hard_lower_[i] || joints[i] > hard_upper_[i])
-      return "target for " + joint_names_[static_cast<std::size_t>(i)] + " (" +
-             format(joints[i]) + " rad) is outside its limits [" + format(hard_lower_[i]) +
-             ", " + format(hard_upper_[i]) + "]";
+      return "target for " + joint_names_[static_cast<std::size_t>(i)] + " (" + format(joints[i]) +
+             " rad) is outside its limits [" + format(hard_lower_[i]) + ", " +
+             format(hard_upper_[i]) + "]";
   std::string why;
   if (check_ && !check_(joints, &why)) return "target pose: " + why;
   return {};
@@ -128,7 +134,8 @@ void LinkSupervisor::disarm(const std::string& reason) {
   log("disarm", {{"reason", reason_}});
 }
 
-std::string LinkSupervisor::outside_limits(const Channel& c, const Eigen::VectorXd& measured) const {
+std::string LinkSupervisor::outside_limits(const Channel& c,
+                                           const Eigen::VectorXd& measured) const {
   for (std::size_t i = 0; i < c.spec.joints.size(); ++i) {
     const int j = c.spec.joints[i];
     const double q = measured[static_cast<Eigen::Index>(i)];
@@ -171,7 +178,10 @@ FeedbackStep LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& mea
              format(settings_.max_tracking_error) + " rad");
   }
   const PaceStep pace = c.pacer.on_feedback(now, controller_time);
-  FeedbackStep step{.send = true, .advanced = pace.advance, .from_rest = false, .send_at = pace.send_at};
+  FeedbackStep step{.send = true,
+                    .advanced = pace.advance,
+                    .from_rest = false,
+                    .send_at = pace.send_at};
   if (!pace.advance) return step;
   if (pace.from_rest && !c.governor.at_rest()) {
     c.governor.halt();
@@ -222,9 +232,9 @@ LinkStatus LinkSupervisor::status(double now) const {
     oldest = std::max(oldest, now - c.last_feedback);
     for (std::size_t i = 0; i < c.spec.joints.size(); ++i)
       s.measured[c.spec.joints[i]] = c.measured[static_cast<Eigen::Index>(i)];
-    arrived = arrived && c.governor.arrived_at(channel_part(target_, c)) &&
-              (c.measured - c.governor.position()).cwiseAbs().maxCoeff() <=
-                  settings_.arrive_tolerance;
+    arrived =
+        arrived && c.governor.arrived_at(channel_part(target_, c)) &&
+        (c.measured - c.governor.position()).cwiseAbs().maxCoeff() <= settings_.arrive_tolerance;
   }
   s.feedback_age = oldest;
   s.commanded = full_commanded();

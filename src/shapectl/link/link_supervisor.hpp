@@ -129,7 +129,7 @@ class LinkSupervisor {
   std::string reason_ = "not armed";
   bool has_target_ = false;
   std::string target_problem_;  // why the last target was refused; empty when it was fine
-  Eigen::VectorXd target_;  // band-clamped
+  Eigen::VectorXd target_;      // band-clamped
 };
 
 }  // namespace shapectl

@@ -15,15 +15,15 @@ namespace shapectl {
 namespace {
 
 void expect_positive(const char* name, double value) {
-  if (!(value > 0 && std::isfinite(value))) throw InputError("link", name, "a positive number", value);
+  if (!(value > 0 && std::isfinite(value)))
+    throw InputError("link", name, "a positive number", value);
 }
 
 }  // namespace
 
 namespace {
-constexpr auto kLinkKinds = enum_names<LinkKind>(
-    std::pair{LinkKind::Sim, "sim"},
-    std::pair{LinkKind::Egm, "egm"});
+constexpr auto kLinkKinds =
+    enum_names<LinkKind>(std::pair{LinkKind::Sim, "sim"}, std::pair{LinkKind::Egm, "egm"});
 }  // namespace
 
 const char* to_string(LinkKind kind) { return kLinkKinds.name(kind); }
@@ -43,8 +43,8 @@ void validate(const LinkConfig& c) {
   expect_positive("sim_period", c.sim_period);
   expect_positive("sim_acceleration", c.sim_acceleration);
   expect_positive("egm_period", c.egm_period);
-  for (const auto& [name, port] : {std::pair{"egm_left_port", c.egm_left_port},
-                                   std::pair{"egm_right_port", c.egm_right_port}})
+  for (const auto& [name, port] :
+       {std::pair{"egm_left_port", c.egm_left_port}, std::pair{"egm_right_port", c.egm_right_port}})
     if (port < 0 || port > 65535) throw InputError("link", name, "a port 0..65535", port);
 }
 
@@ -76,7 +76,8 @@ PoseCheck collision_pose_check(const RobotModel& robot,
     const KinematicsState state = forward_kinematics(*model, joints);
     const double clearance = collisions->min_clearance(state);
     if (clearance >= 0) return true;
-    if (why) *why = "self-collision (spheres overlap by " + std::to_string(-clearance * 1000) + " mm)";
+    if (why)
+      *why = "self-collision (spheres overlap by " + std::to_string(-clearance * 1000) + " mm)";
     return false;
   };
 }
@@ -86,7 +87,8 @@ std::unique_ptr<RobotLink> make_robot_link(const LinkConfig& config, const Robot
                                            std::shared_ptr<SessionLog> log) {
   validate(config);
   PoseCheck check = collision_pose_check(robot, std::move(collisions));
-  if (config.kind == LinkKind::Egm) return std::make_unique<EgmLink>(config, robot, std::move(check), std::move(log));
+  if (config.kind == LinkKind::Egm)
+    return std::make_unique<EgmLink>(config, robot, std::move(check), std::move(log));
   return std::make_unique<SimLink>(config, robot, std::move(check), std::move(log));
 }
 

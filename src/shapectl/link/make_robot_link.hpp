@@ -35,23 +35,23 @@ struct LinkConfig {
   LinkKind kind = LinkKind::Sim;
 
   // Motion governor, per joint. The velocity is capped by the robot's own limit (URDF).
-  double max_velocity = 0.5;       // rad/s
-  double max_acceleration = 1.0;   // rad/s²
-  double limit_margin = 0.02;      // rad kept from each joint limit
-  double watchdog_timeout = 0.1;   // s without feedback: hold and disarm
-  double max_tracking_error = 0.2; // rad, commanded vs measured while armed
-  double arrive_tolerance = 1e-3;  // rad, measured vs target for "arrived"
+  double max_velocity = 0.5;        // rad/s
+  double max_acceleration = 1.0;    // rad/s²
+  double limit_margin = 0.02;       // rad kept from each joint limit
+  double watchdog_timeout = 0.1;    // s without feedback: hold and disarm
+  double max_tracking_error = 0.2;  // rad, commanded vs measured while armed
+  double arrive_tolerance = 1e-3;   // rad, measured vs target for "arrived"
 
   // sim
-  double sim_period = 0.004;            // s between commands
-  double sim_acceleration = 10;         // rad/s², the simulated robot's own limit
-  Eigen::VectorXd sim_initial_joints;   // where it starts (active order); empty: 0 in limits
+  double sim_period = 0.004;           // s between commands
+  double sim_acceleration = 10;        // rad/s², the simulated robot's own limit
+  Eigen::VectorXd sim_initial_joints;  // where it starts (active order); empty: 0 in limits
 
   // egm
   std::string egm_address = "0.0.0.0";  // local address the ports bind to
-  int egm_left_port = 6511;              // ROB_L's UdpUc device sends here; 0: any free port
-  int egm_right_port = 6512;             // ROB_R
-  double egm_period = 0.004;             // s, the controller's \SampleRate (one step per message)
+  int egm_left_port = 6511;             // ROB_L's UdpUc device sends here; 0: any free port
+  int egm_right_port = 6512;            // ROB_R
+  double egm_period = 0.004;            // s, the controller's \SampleRate (one step per message)
 };
 
 // InputError "link: max_velocity: expected a positive number, got -1" and similar.

@@ -59,8 +59,8 @@ void MotionGovernor::step_towards(const Eigen::VectorXd& target, double dt) {
     const double error = goal[i] - position_[i];
     const double distance = std::abs(error);
     // Wanted speed: as fast as allowed, but able to stop at the goal, and landing on it.
-    const double speed = std::min({limits_.velocity[i],
-                                   stopping_speed(distance, plan_fraction * a, dt), distance / dt});
+    const double speed = std::min(
+        {limits_.velocity[i], stopping_speed(distance, plan_fraction * a, dt), distance / dt});
     const double wanted = std::copysign(speed, error);
     const double v = std::clamp(wanted, velocity_[i] - a * dt, velocity_[i] + a * dt);
     velocity_[i] = v;

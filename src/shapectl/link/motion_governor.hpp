@@ -11,9 +11,9 @@
 namespace shapectl {
 
 struct GovernorLimits {
-  Eigen::VectorXd lower, upper;    // rad; the band commands stay in (joint limits − margin)
-  Eigen::VectorXd velocity;        // rad/s, > 0
-  Eigen::VectorXd acceleration;    // rad/s², > 0
+  Eigen::VectorXd lower, upper;  // rad; the band commands stay in (joint limits − margin)
+  Eigen::VectorXd velocity;      // rad/s, > 0
+  Eigen::VectorXd acceleration;  // rad/s², > 0
   int size() const { return static_cast<int>(velocity.size()); }
   // The limits of some joints, in the order of `joints` (indices into this).
   GovernorLimits subset(const std::vector<int>& joints) const;

@@ -35,8 +35,8 @@ constexpr double clock_drift = 1e-4;
 struct PaceStep {
   bool advance = false;    // take one governor step of `period`; else resend the last command
   bool from_rest = false;  // zero the governor's velocity first
-  double send_at = 0;      // when to send the reply (s, our clock): now, or up to the allowance later
-  double lands_at = 0;     // the controller tick it lands on (s, controller clock)
+  double send_at = 0;   // when to send the reply (s, our clock): now, or up to the allowance later
+  double lands_at = 0;  // the controller tick it lands on (s, controller clock)
 };
 
 class MotionPacer {
@@ -51,7 +51,7 @@ class MotionPacer {
  private:
   double period_;
   bool has_offset_ = false;
-  double offset_ = 0;        // min(arrival − stamp), our clock minus the controller's
+  double offset_ = 0;  // min(arrival − stamp), our clock minus the controller's
   double last_arrival_ = 0;
   double last_send_ = 0;     // replies leave in order
   double last_landing_ = 0;  // controller clock

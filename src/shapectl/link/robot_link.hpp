@@ -14,14 +14,14 @@ namespace shapectl {
 class RobotModel;
 
 struct LinkStatus {
-  std::string kind;              // "sim" or "egm"
-  bool connected = false;        // feedback is arriving
-  bool armed = false;            // commands may move the robot
-  double feedback_age = 0;       // seconds since the last feedback (inf if never)
-  std::string reason;            // why it is holding or disarmed; empty when all is well
-  Eigen::VectorXd measured;      // θ as the robot reports it (active-joint order)
-  Eigen::VectorXd commanded;     // θ last commanded
-  bool arrived = false;          // armed, at rest on the target, measured within tolerance
+  std::string kind;           // "sim" or "egm"
+  bool connected = false;     // feedback is arriving
+  bool armed = false;         // commands may move the robot
+  double feedback_age = 0;    // seconds since the last feedback (inf if never)
+  std::string reason;         // why it is holding or disarmed; empty when all is well
+  Eigen::VectorXd measured;   // θ as the robot reports it (active-joint order)
+  Eigen::VectorXd commanded;  // θ last commanded
+  bool arrived = false;       // armed, at rest on the target, measured within tolerance
   std::uint64_t commands_sent = 0;
   std::uint64_t rejected_datagrams = 0;  // egm: malformed, truncated, oversized, wrong type
   std::uint64_t lost_datagrams = 0;      // egm: controller sequence numbers never received

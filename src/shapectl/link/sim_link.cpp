@@ -33,19 +33,23 @@ SimLink::SimLink(const LinkConfig& config, const RobotModel& robot, PoseCheck ch
                  std::shared_ptr<SessionLog> log)
     : SupervisedLink(config.sim_period, log,
                      LinkSupervisor(to_string(LinkKind::Sim), robot.active_joint_names(),
-                                    {{"robot", [&] {
-                                        std::vector<int> all(static_cast<std::size_t>(robot.active_count()));
-                                        for (int i = 0; i < robot.active_count(); ++i) all[static_cast<std::size_t>(i)] = i;
+                                    {{"robot",
+                                      [&] {
+                                        std::vector<int> all(
+                                            static_cast<std::size_t>(robot.active_count()));
+                                        for (int i = 0; i < robot.active_count(); ++i)
+                                          all[static_cast<std::size_t>(i)] = i;
                                         return all;
                                       }()}},
-                                    robot.lower_limits(), robot.upper_limits(), governor_limits(config, robot),
-                                    {config.watchdog_timeout, config.max_tracking_error, config.arrive_tolerance,
-                                     config.sim_period},
+                                    robot.lower_limits(), robot.upper_limits(),
+                                    governor_limits(config, robot),
+                                    {config.watchdog_timeout, config.max_tracking_error,
+                                     config.arrive_tolerance, config.sim_period},
                                     std::move(check), log.get())),
       robot_(sim_robot_limits(config, robot, supervisor_.limits()), sim_initial(config, robot)) {
   if (log_)
-    log_link_started(*log_, to_string(LinkKind::Sim), robot.active_joint_names(), supervisor_.channels(),
-                     supervisor_.limits(), period_);
+    log_link_started(*log_, to_string(LinkKind::Sim), robot.active_joint_names(),
+                     supervisor_.channels(), supervisor_.limits(), period_);
 }
 
 SimLink::~SimLink() { stop(); }

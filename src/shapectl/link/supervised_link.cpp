@@ -2,7 +2,8 @@
 
 namespace shapectl {
 
-SupervisedLink::SupervisedLink(double period, std::shared_ptr<SessionLog> log, LinkSupervisor supervisor)
+SupervisedLink::SupervisedLink(double period, std::shared_ptr<SessionLog> log,
+                               LinkSupervisor supervisor)
     : period_(period),
       log_(std::move(log)),
       supervisor_(std::move(supervisor)),

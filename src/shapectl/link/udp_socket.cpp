@@ -25,11 +25,13 @@ UdpSocket::UdpSocket(const std::string& address, int port, const std::string& wh
   if (port < 0 || port > 65535) throw InputError(what, "", "a port 0..65535", port);
   const sockaddr_in a = ipv4_address(address, port, what);
   fd_ = ::socket(AF_INET, SOCK_DGRAM | SOCK_NONBLOCK | SOCK_CLOEXEC, 0);
-  if (fd_ < 0) throw InputError(what, "", std::string("cannot create a socket: ") + std::strerror(errno));
+  if (fd_ < 0)
+    throw InputError(what, "", std::string("cannot create a socket: ") + std::strerror(errno));
   if (::bind(fd_, reinterpret_cast<const sockaddr*>(&a), sizeof a) != 0) {
     const std::string error = std::strerror(errno);
     ::close(fd_);
-    throw InputError(what, "", "cannot bind " + address + ":" + std::to_string(port) + ": " + error);
+    throw InputError(what, "",
+                     "cannot bind " + address + ":" + std::to_string(port) + ": " + error);
   }
   sockaddr_in bound{};
   socklen_t size = sizeof bound;

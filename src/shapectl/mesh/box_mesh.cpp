@@ -13,8 +13,8 @@ TetMesh make_box_mesh(const Vec3& size, const std::array<int, 3>& cells,
   static const char* axis_names[3] = {"x", "y", "z"};
   for (int a = 0; a < 3; ++a) {
     if (!(std::isfinite(size[a]) && size[a] > 0))
-      throw InputError("box mesh", std::string("size.") + axis_names[a],
-                       "a positive finite length", size[a]);
+      throw InputError("box mesh", std::string("size.") + axis_names[a], "a positive finite length",
+                       size[a]);
     if (cells[a] < 1)
       throw InputError("box mesh", std::string("cells.") + axis_names[a], "at least 1 cell",
                        cells[a]);
@@ -48,8 +48,10 @@ TetMesh make_box_mesh(const Vec3& size, const std::array<int, 3>& cells,
   for (int k = 0; k < nz; ++k)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i) {
-        const Vec3 centre = 0.5 * (rest_positions[index(i, j, k)] + rest_positions[index(i + 1, j + 1, k + 1)]);
-        if (hole && (centre - hole->min).minCoeff() > 0 && (hole->max - centre).minCoeff() > 0) continue;
+        const Vec3 centre =
+            0.5 * (rest_positions[index(i, j, k)] + rest_positions[index(i + 1, j + 1, k + 1)]);
+        if (hole && (centre - hole->min).minCoeff() > 0 && (hole->max - centre).minCoeff() > 0)
+          continue;
         for (const auto& tet : kuhn) {
           std::array<int, 4> t;
           for (int a = 0; a < 4; ++a)

@@ -64,7 +64,8 @@ void add_node(TextLines& in, MshContent& msh, long long tag, const Vec3& x) {
 void add_tet(TextLines& in, MshContent& msh, long long tag, std::size_t first) {
   const std::string where = "element " + std::to_string(tag);
   if (static_cast<long>(msh.tets.size()) >= max_mesh_tets)
-    in.fail(where, "more than " + std::to_string(max_mesh_tets) + " tetrahedra (the limit for a mesh)");
+    in.fail(where,
+            "more than " + std::to_string(max_mesh_tets) + " tetrahedra (the limit for a mesh)");
   std::array<int, 4> tet;
   for (int a = 0; a < 4; ++a) {
     const long long node = in.integer(first + a, where, "node tag");
@@ -83,7 +84,8 @@ void add_tet(TextLines& in, MshContent& msh, long long tag, std::size_t first) {
 
 void expect_end(TextLines& in, const std::string& end, const std::string& after) {
   in.next(end);
-  if (in[0] != end) in.fail("", "expected " + end + " after " + after + ", found '" + shown(in[0]) + "'");
+  if (in[0] != end)
+    in.fail("", "expected " + end + " after " + after + ", found '" + shown(in[0]) + "'");
 }
 
 // MSH 2.2 $Nodes and $Elements: a count n, then n lines, each read by `read_item()`.
@@ -143,8 +145,8 @@ void read_blocks_4(TextLines& in, const std::string& section, const std::string&
   const int count_line = in.line();
   long long read = 0;
   for (long long b = 0; b < blocks; ++b) {
-    const std::string block = item + " block " + std::to_string(b + 1) + " of " +
-                              std::to_string(blocks);
+    const std::string block =
+        item + " block " + std::to_string(b + 1) + " of " + std::to_string(blocks);
     next_data(in, block + " (count on line " + std::to_string(count_line) + ")");
     in.expect_values(4, block, "entity dimension, entity tag, " + third + ", " + item + " count");
     read += read_block(block);
@@ -152,8 +154,9 @@ void read_blocks_4(TextLines& in, const std::string& section, const std::string&
   if (read != n)
     in.fail("", "the $" + section + " header on line " + std::to_string(count_line) + " says " +
                     std::to_string(n) + " " + item + "s, its blocks hold " + std::to_string(read));
-  expect_end(in, "$End" + section, std::to_string(blocks) + " " + item + " blocks (count on line " +
-                                       std::to_string(count_line) + ")");
+  expect_end(in, "$End" + section,
+             std::to_string(blocks) + " " + item + " blocks (count on line " +
+                 std::to_string(count_line) + ")");
 }
 
 // MSH 4.1: per block "dim entity parametric count", count lines of tags, then count lines
@@ -163,7 +166,8 @@ void read_nodes_4(TextLines& in, MshContent& msh) {
     const long long dim = in.integer(0, block, "entity dimension");
     const long long parametric = in.integer(2, block, "parametric flag");
     const long long in_block = in.count(3, "node count");
-    if (dim < 0 || dim > 3) in.fail(block, "entity dimension must be 0..3, got " + std::to_string(dim));
+    if (dim < 0 || dim > 3)
+      in.fail(block, "entity dimension must be 0..3, got " + std::to_string(dim));
     if (parametric != 0 && parametric != 1)
       in.fail(block, "parametric flag must be 0 or 1, got " + std::to_string(parametric));
     const int header_line = in.line();
@@ -209,8 +213,8 @@ void skip_section(TextLines& in) {
   const int start = in.line();
   while (in.next())
     if (in[0] == end) return;
-  in.fail("", "file ends early: the section started on line " + std::to_string(start) +
-                  " has no " + end);
+  in.fail("", "file ends early: the section started on line " + std::to_string(start) + " has no " +
+                  end);
 }
 
 }  // namespace

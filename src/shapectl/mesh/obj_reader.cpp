@@ -13,7 +13,8 @@ TriangleSurface read_obj(const std::string& name, const std::string& text) {
   SurfaceBuilder builder(name);
   while (in.next()) {
     if (in[0] == "v") {
-      if (in.size() < 4) in.fail("", "expected 'v x y z', found " + std::to_string(in.size() - 1) + " values");
+      if (in.size() < 4)
+        in.fail("", "expected 'v x y z', found " + std::to_string(in.size() - 1) + " values");
       builder.add_vertex(in.point(1, ""));
     } else if (in[0] == "f") {
       if (in.size() < 4) in.fail("face", "expected at least 3 vertices");

@@ -38,8 +38,8 @@ TriangleSurface read_ascii_stl(const std::string& name, const std::string& text)
       if (!builder.add_polygon(corners)) in.fail("facet", "uses the same vertex twice");
       in_facet = false;
     } else if (word != "solid" && word != "endsolid" && word != "outer" && word != "endloop") {
-      in.fail("", "expected an STL keyword (facet, vertex, endfacet, ...), found '" +
-                      shown(word) + "'");
+      in.fail("", "expected an STL keyword (facet, vertex, endfacet, ...), found '" + shown(word) +
+                      "'");
     }
   }
   if (in_facet) in.fail("", "file ends inside a facet");
@@ -58,8 +58,9 @@ TriangleSurface read_binary_stl(const std::string& name, const std::string& byte
   };
   const std::size_t count = (bytes.size() - 84) / 50;
   if (count > static_cast<std::size_t>(max_surface_triangles))
-    throw InputError(name, "", std::to_string(count) + " triangles, more than the limit of " +
-                                   std::to_string(max_surface_triangles) + " for a surface");
+    throw InputError(name, "",
+                     std::to_string(count) + " triangles, more than the limit of " +
+                         std::to_string(max_surface_triangles) + " for a surface");
   SurfaceBuilder builder(name);
   for (std::size_t t = 0; t < count; ++t) {
     std::vector<int> corners;
@@ -91,7 +92,8 @@ TriangleSurface read_stl(const std::string& name, const std::string& bytes) {
     return read_ascii_stl(name, bytes);
   throw InputError(name, "",
                    "neither ASCII STL (starting with 'solid') nor binary STL (84 + 50 bytes per "
-                   "triangle; this file has " + std::to_string(bytes.size()) + " bytes)");
+                   "triangle; this file has " +
+                       std::to_string(bytes.size()) + " bytes)");
 }
 
 }  // namespace shapectl

@@ -9,8 +9,9 @@ namespace shapectl {
 
 void SurfaceBuilder::add_vertex(const Vec3& x) {
   if (static_cast<long>(unique_of_read_.size()) >= 3 * max_surface_triangles)
-    throw InputError(name_, "", "more than " + std::to_string(3 * max_surface_triangles) +
-                                    " vertices (the limit for a surface)");
+    throw InputError(name_, "",
+                     "more than " + std::to_string(3 * max_surface_triangles) +
+                         " vertices (the limit for a surface)");
   const auto [it, inserted] =
       merged_.emplace(std::array<double, 3>{x.x(), x.y(), x.z()}, int(surface_.vertices.size()));
   if (inserted) surface_.vertices.push_back(x);
@@ -19,8 +20,9 @@ void SurfaceBuilder::add_vertex(const Vec3& x) {
 
 bool SurfaceBuilder::add_polygon(const std::vector<int>& corners) {
   if (static_cast<long>(surface_.triangles.size() + corners.size()) - 2 > max_surface_triangles)
-    throw InputError(name_, "", "more than " + std::to_string(max_surface_triangles) +
-                                    " triangles (the limit for a surface)");
+    throw InputError(name_, "",
+                     "more than " + std::to_string(max_surface_triangles) +
+                         " triangles (the limit for a surface)");
   std::vector<int> unique;
   for (int c : corners) unique.push_back(unique_of_read_[c]);
   std::vector<int> sorted = unique;

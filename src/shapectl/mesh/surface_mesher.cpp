@@ -29,8 +29,9 @@ void expect_closed(const TriangleSurface& surface, const std::string& source) {
   for (const auto& [edge, count] : uses)
     if (count != 2)
       throw InputError(source, "",
-                       "the surface is not closed: edge " + shown_point(surface.vertices[edge.first]) +
-                           "-" + shown_point(surface.vertices[edge.second]) + " belongs to " +
+                       "the surface is not closed: edge " +
+                           shown_point(surface.vertices[edge.first]) + "-" +
+                           shown_point(surface.vertices[edge.second]) + " belongs to " +
                            std::to_string(count) + " triangle" + (count == 1 ? "" : "s") +
                            ", expected 2");
 }
@@ -53,9 +54,11 @@ TetMesh tetrahedralize_surface(const TriangleSurface& surface, const SurfaceMesh
     return options.origin_path.empty() ? name : options.origin_path + "." + name;
   };
   if (!(std::isfinite(ratio) && (ratio == 0 || ratio >= 1)))
-    throw InputError(option_file, option("max_radius_edge_ratio"), "0 (off) or a ratio >= 1", ratio);
+    throw InputError(option_file, option("max_radius_edge_ratio"), "0 (off) or a ratio >= 1",
+                     ratio);
   if (!(std::isfinite(volume) && volume >= 0))
-    throw InputError(option_file, option("max_tet_volume"), "0 (no bound) or a positive volume in m^3", volume);
+    throw InputError(option_file, option("max_tet_volume"),
+                     "0 (no bound) or a positive volume in m^3", volume);
   const int n = static_cast<int>(surface.vertices.size());
   for (const auto& t : surface.triangles)
     for (int v : t)
@@ -64,11 +67,12 @@ TetMesh tetrahedralize_surface(const TriangleSurface& surface, const SurfaceMesh
   // TetGen's exact predicates overflow on huge coordinates (products of four of them).
   for (int i = 0; i < n; ++i)
     if (!(surface.vertices[i].cwiseAbs().maxCoeff() <= 1e6))
-      throw InputError(source, "vertex " + std::to_string(i), "coordinates within 1e6 m of the origin",
-                       shown_point(surface.vertices[i]));
+      throw InputError(source, "vertex " + std::to_string(i),
+                       "coordinates within 1e6 m of the origin", shown_point(surface.vertices[i]));
   if (surface.triangles.empty()) throw InputError(source, "", "no triangles");
   if (static_cast<long>(surface.triangles.size()) > max_surface_triangles)
-    throw InputError(source, "", "more than " + std::to_string(max_surface_triangles) + " triangles");
+    throw InputError(source, "",
+                     "more than " + std::to_string(max_surface_triangles) + " triangles");
   expect_closed(surface, source);
   // Refuse a volume bound that asks for more tets than a mesh may have, before TetGen runs.
   const double enclosed = enclosed_volume(surface);
@@ -95,8 +99,9 @@ TetMesh tetrahedralize_surface(const TriangleSurface& surface, const SurfaceMesh
                          " added points for these options; allow larger or less regular "
                          "tets (a larger max_tet_volume or max_radius_edge_ratio)");
   if (static_cast<long>(out.tets.size()) > max_mesh_tets)
-    throw InputError(source, "", "TetGen made " + std::to_string(out.tets.size()) +
-                                     " tetrahedra, more than the limit of " + std::to_string(max_mesh_tets));
+    throw InputError(source, "",
+                     "TetGen made " + std::to_string(out.tets.size()) +
+                         " tetrahedra, more than the limit of " + std::to_string(max_mesh_tets));
 
   // TetGen keeps the input points first; a surface vertex it dropped would break that promise.
   for (int i = 0; i < n; ++i)

@@ -29,7 +29,8 @@ TriangleSurface read_surface(const std::filesystem::path& file) {
   const std::string extension = lowercase(file.extension().string());
   const std::string name = file.string();
   if (!is_surface_file(file))
-    throw InputError(name, "", "unknown surface format '" + extension + "' (supported: .obj, .stl, .off)");
+    throw InputError(name, "",
+                     "unknown surface format '" + extension + "' (supported: .obj, .stl, .off)");
   const std::string text = read_text_file(file);
   if (extension == ".obj") return read_obj(name, text);
   if (extension == ".stl") return read_stl(name, text);

@@ -17,8 +17,8 @@ namespace {
 long long header_field(const TextLines& in, std::size_t i, const std::string& what, long long max) {
   const long long value = in.integer(i, "header", what);
   if (value < 0 || value > max)
-    in.fail("header", what + " must be 0.." + std::to_string(max) + ", got " +
-                          std::to_string(value));
+    in.fail("header",
+            what + " must be 0.." + std::to_string(max) + ", got " + std::to_string(value));
   return value;
 }
 
@@ -62,8 +62,8 @@ Points read_node_file(const std::filesystem::path& file) {
 
 struct Elements {
   std::vector<std::array<int, 4>> tets;
-  std::vector<int> lines;            // line of each tet, for messages
-  std::vector<long long> numbers;    // the file's number of each tet
+  std::vector<int> lines;          // line of each tet, for messages
+  std::vector<long long> numbers;  // the file's number of each tet
 };
 
 // "<tets> <4 or 10> <region attribute>", then "<number> n0 n1 n2 n3 [...] [attribute]" per tet.
@@ -76,7 +76,8 @@ Elements read_ele_file(const std::filesystem::path& file, const Points& points) 
   const long long corners = in.integer(1, "header", "nodes per tetrahedron");
   if (corners != 4 && corners != 10)
     in.fail("header", "nodes per tetrahedron must be 4 or 10, got " + std::to_string(corners));
-  const long long attributes = in.size() > 2 ? header_field(in, 2, "region attribute count", 1000) : 0;
+  const long long attributes =
+      in.size() > 2 ? header_field(in, 2, "region attribute count", 1000) : 0;
   const long long node_count = static_cast<long long>(points.positions.size());
   Elements elements;
   for (long long e = 0; e < n; ++e) {

@@ -126,8 +126,9 @@ TetgenOutput tetrahedralize_isolated(tetgenbehavior& behavior, tetgenio& in,
   if (bytes.size() != sizeof header + sizeof(double) * 3 * points + sizeof(int) * 4 * tets)
     throw InputError(source, "",
                      "TetGen stopped unexpectedly (" +
-                         (WIFSIGNALED(status) ? "signal " + std::to_string(WTERMSIG(status))
-                                              : "exit code " + std::to_string(WEXITSTATUS(status))) +
+                         (WIFSIGNALED(status)
+                              ? "signal " + std::to_string(WTERMSIG(status))
+                              : "exit code " + std::to_string(WEXITSTATUS(status))) +
                          ")");
   TetgenOutput result;
   result.points.resize(points);

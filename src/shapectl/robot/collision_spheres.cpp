@@ -20,7 +20,8 @@ std::vector<int> rigid_groups(const RobotModel& robot) {
     const bool fixed = j >= 0 && !robot.joints()[static_cast<std::size_t>(j)].movable();
     // Parents come before children, so the parent's group is known.
     group[static_cast<std::size_t>(link)] =
-        fixed ? group[static_cast<std::size_t>(robot.joints()[static_cast<std::size_t>(j)].parent_link)]
+        fixed ? group[static_cast<std::size_t>(
+                    robot.joints()[static_cast<std::size_t>(j)].parent_link)]
               : link;
   }
   return group;
@@ -73,24 +74,28 @@ CollisionModel::CollisionModel(const RobotModel& robot, std::vector<CollisionSph
     for (std::size_t link_b = link_a + 1; link_b < range.size(); ++link_b) {
       auto outer = range[link_a];
       auto inner = range[link_b];
-      if (outer.first == outer.second || inner.first == inner.second || !checked[link_a][link_b]) continue;
+      if (outer.first == outer.second || inner.first == inner.second || !checked[link_a][link_b])
+        continue;
       // The link with more spheres forms the inner loop, which is the one that vectorises.
       if (outer.second - outer.first > inner.second - inner.first) std::swap(outer, inner);
       for (int a = outer.first; a < outer.second; ++a) {
         blocks_.push_back({a, inner.first, inner.second});
         for (int b = inner.first; b < inner.second; ++b) {
           pairs_.emplace_back(a, b);
-          reach_.push_back(radii_[static_cast<std::size_t>(a)] + radii_[static_cast<std::size_t>(b)] + margin_);
+          reach_.push_back(radii_[static_cast<std::size_t>(a)] +
+                           radii_[static_cast<std::size_t>(b)] + margin_);
         }
       }
     }
   }
 }
 
-void CollisionModel::sphere_centers(const KinematicsState& state, std::vector<Vec3>& centers) const {
+void CollisionModel::sphere_centers(const KinematicsState& state,
+                                    std::vector<Vec3>& centers) const {
   centers.resize(spheres_.size());
   for (std::size_t s = 0; s < spheres_.size(); ++s)
-    centers[s] = state.T_world_link[static_cast<std::size_t>(spheres_[s].link)] * spheres_[s].center_link;
+    centers[s] =
+        state.T_world_link[static_cast<std::size_t>(spheres_[s].link)] * spheres_[s].center_link;
 }
 
 double CollisionModel::min_clearance(const KinematicsState& state) const {
@@ -105,9 +110,11 @@ std::vector<SphereClearance> CollisionModel::closest_pairs(const KinematicsState
   std::vector<SphereClearance> all;
   all.reserve(pairs_.size());
   for (const auto& [a, b] : pairs_) {
-    const double distance = (centers[static_cast<std::size_t>(a)] - centers[static_cast<std::size_t>(b)]).norm();
-    all.push_back({a, b, distance - spheres_[static_cast<std::size_t>(a)].radius -
-                             spheres_[static_cast<std::size_t>(b)].radius});
+    const double distance =
+        (centers[static_cast<std::size_t>(a)] - centers[static_cast<std::size_t>(b)]).norm();
+    all.push_back({a, b,
+                   distance - spheres_[static_cast<std::size_t>(a)].radius -
+                       spheres_[static_cast<std::size_t>(b)].radius});
   }
   count = std::min(count, all.size());
   std::partial_sort(all.begin(), all.begin() + static_cast<long>(count), all.end(),
@@ -124,7 +131,8 @@ double CollisionModel::value(const RobotModel& robot, const KinematicsState& sta
   double* y = x + n;
   double* z = y + n;
   for (std::size_t s = 0; s < n; ++s) {
-    const Vec3 c = state.T_world_link[static_cast<std::size_t>(spheres_[s].link)] * spheres_[s].center_link;
+    const Vec3 c =
+        state.T_world_link[static_cast<std::size_t>(spheres_[s].link)] * spheres_[s].center_link;
     x[s] = c.x();
     y[s] = c.y();
     z[s] = c.z();
@@ -204,10 +212,13 @@ CollisionModel CollisionModel::from_json(const RobotModel& robot, const JsonInpu
   json.expect_only({"description", "margin", "stiffness", "spheres", "ignore_pairs"});
   if (json.has("description")) json.at("description").string();
   const double margin = json.has("margin") ? json.at("margin").non_negative() : 0.0;
-  const double stiffness = json.has("stiffness") ? json.at("stiffness").positive() : default_stiffness;
+  const double stiffness =
+      json.has("stiffness") ? json.at("stiffness").positive() : default_stiffness;
   auto link_named = [&](const JsonInput& where, const std::string& name) {
     const auto link = robot.find_link(name);
-    if (!link) where.fail_problem("unknown link '" + bounded_preview(name) + "' (not in " + robot.source() + ")");
+    if (!link)
+      where.fail_problem("unknown link '" + bounded_preview(name) + "' (not in " + robot.source() +
+                         ")");
     return *link;
   };
 

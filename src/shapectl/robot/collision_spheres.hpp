@@ -33,7 +33,7 @@ struct CollisionSphere {
 };
 
 struct SphereClearance {
-  int first = -1;   // sphere indices
+  int first = -1;  // sphere indices
   int second = -1;
   double clearance = 0;  // |s_i − s_j| − r_i − r_j, metres; negative when the spheres overlap
 };

@@ -12,7 +12,9 @@ struct CubicBarrier {
 
   double value(double v) const { return v > 0 ? stiffness * v * v * v : 0.0; }
   double derivative(double v) const { return v > 0 ? 3 * stiffness * v * v : 0.0; }
-  double residual(double v) const { return v > 0 ? std::sqrt(2 * stiffness) * v * std::sqrt(v) : 0.0; }
+  double residual(double v) const {
+    return v > 0 ? std::sqrt(2 * stiffness) * v * std::sqrt(v) : 0.0;
+  }
   double residual_derivative(double v) const {
     return v > 0 ? 1.5 * std::sqrt(2 * stiffness * v) : 0.0;
   }

@@ -56,15 +56,17 @@ struct Errors {
   double clearance = std::numeric_limits<double>::infinity();
 };
 
-Errors goal_errors(const RobotModel& model, const std::vector<IkGoal>& goals, const IkOptions& options,
-                   const Eigen::VectorXd& q) {
+Errors goal_errors(const RobotModel& model, const std::vector<IkGoal>& goals,
+                   const IkOptions& options, const Eigen::VectorXd& q) {
   const KinematicsState state = forward_kinematics(model, q);
   Errors e;
   for (const auto& g : goals) {
     const auto& T = state.T_world_link[static_cast<std::size_t>(g.link)];
     e.position = std::max(e.position, (T * g.point_link - g.position_world).norm());
     if (g.rotation_world)
-      e.orientation = std::max(e.orientation, Eigen::AngleAxisd(T.linear() * g.rotation_world->transpose()).angle());
+      e.orientation =
+          std::max(e.orientation,
+                   Eigen::AngleAxisd(T.linear() * g.rotation_world->transpose()).angle());
   }
   if (options.collisions) e.clearance = options.collisions->min_clearance(state);
   return e;
@@ -124,8 +126,9 @@ Start run_lm(const RobotModel& model, const std::vector<IkGoal>& goals, const Ik
 
 }  // namespace
 
-void ik_residuals(const RobotModel& model, const std::vector<IkGoal>& goals, const IkOptions& options,
-                  const Eigen::VectorXd& joints, Eigen::VectorXd& residuals, Eigen::MatrixXd* jacobian) {
+void ik_residuals(const RobotModel& model, const std::vector<IkGoal>& goals,
+                  const IkOptions& options, const Eigen::VectorXd& joints,
+                  Eigen::VectorXd& residuals, Eigen::MatrixXd* jacobian) {
   const int n = model.active_count();
   int rows = 0;
   for (const auto& g : goals) rows += g.rotation_world ? 12 : 3;
@@ -150,8 +153,10 @@ void ik_residuals(const RobotModel& model, const std::vector<IkGoal>& goals, con
         const Joint& joint = model.joints()[static_cast<std::size_t>(entry.joint)];
         if (joint.type == JointType::Prismatic) continue;
         const Eigen::Matrix3d dR =
-            g.orientation_weight * entry.scale * skew(state.joint_axes_world[static_cast<std::size_t>(entry.joint)]) * R;
-        jacobian->block(row, entry.column, 9, 1) += Eigen::Map<const Eigen::Matrix<double, 9, 1>>(dR.data());
+            g.orientation_weight * entry.scale *
+            skew(state.joint_axes_world[static_cast<std::size_t>(entry.joint)]) * R;
+        jacobian->block(row, entry.column, 9, 1) +=
+            Eigen::Map<const Eigen::Matrix<double, 9, 1>>(dR.data());
       }
     }
     row += 9;
@@ -170,12 +175,13 @@ IkResult solve_inverse_kinematics(const RobotModel& model, const std::vector<IkG
                                   const Eigen::VectorXd& joints0, const IkOptions& options) {
   IkResult result;
   if (joints0.size() != model.active_count() || !joints0.allFinite()) {
-    result.reason = "start joints: expected " + std::to_string(model.active_count()) + " finite values";
+    result.reason =
+        "start joints: expected " + std::to_string(model.active_count()) + " finite values";
     return result;
   }
   for (std::size_t k = 0; k < goals.size(); ++k)
-    if (goals[k].link < 0 || goals[k].link >= model.link_count() || !goals[k].position_world.allFinite() ||
-        !goals[k].point_link.allFinite()) {
+    if (goals[k].link < 0 || goals[k].link >= model.link_count() ||
+        !goals[k].position_world.allFinite() || !goals[k].point_link.allFinite()) {
       result.reason = "goal " + std::to_string(k) + ": unknown link or non-finite point";
       return result;
     }
@@ -214,15 +220,15 @@ IkResult solve_inverse_kinematics(const RobotModel& model, const std::vector<IkG
   std::ostringstream why;
   if (!reached(best_errors, options)) {
     result.status = IkStatus::NotReached;
-    why << "goals not reached after " << result.starts << " starts: position error " << best_errors.position
-        << " m, orientation error " << best_errors.orientation << " rad";
+    why << "goals not reached after " << result.starts << " starts: position error "
+        << best_errors.position << " m, orientation error " << best_errors.orientation << " rad";
   } else if (!(best_errors.clearance > 0)) {
     result.status = IkStatus::Colliding;
     why << "goals reached only in self-collision (clearance " << best_errors.clearance << " m)";
   } else {
     result.status = IkStatus::Converged;
-    why << "position error " << best_errors.position << " m after " << result.iterations << " iterations, "
-        << result.starts << " start(s)";
+    why << "position error " << best_errors.position << " m after " << result.iterations
+        << " iterations, " << result.starts << " start(s)";
   }
   result.reason = why.str();
   return result;

@@ -22,19 +22,19 @@ struct IkGoal {
   Vec3 position_world = Vec3::Zero();  // where the tool point should be, metres
   // Wanted orientation of the link frame (world), or none for a position-only goal.
   std::optional<Eigen::Matrix3d> rotation_world = std::nullopt;
-  double orientation_weight = 0.1;     // metres per unit of |R − R*|_F: trades rotation for position
+  double orientation_weight = 0.1;  // metres per unit of |R − R*|_F: trades rotation for position
 };
 
 struct IkOptions {
   const CollisionModel* collisions = nullptr;  // may be null: no self-collision barrier
   double collision_weight = 1.0;
-  double joint_limit_margin = 0.05;   // rad (m for prismatic); the result stays this far inside
-  double position_tolerance = 1e-4;   // m, largest goal distance to accept
+  double joint_limit_margin = 0.05;     // rad (m for prismatic); the result stays this far inside
+  double position_tolerance = 1e-4;     // m, largest goal distance to accept
   double orientation_tolerance = 1e-3;  // rad, largest goal angle to accept
-  int max_iterations = 300;           // per start
-  int restarts = 8;                   // random starts after the first
+  int max_iterations = 300;             // per start
+  int restarts = 8;                     // random starts after the first
   unsigned seed = 1;
-  double max_step = 0.3;              // rad, largest joint change per iteration
+  double max_step = 0.3;  // rad, largest joint change per iteration
 };
 
 enum class IkStatus { Converged, NotReached, Colliding, InvalidInput };
@@ -42,13 +42,13 @@ std::string_view to_string(IkStatus status);
 
 struct IkResult {
   IkStatus status = IkStatus::InvalidInput;
-  std::string reason;          // "goal 1 is 0.12 m away after 9 starts", ...
-  Eigen::VectorXd joints;      // the best θ found (active joints); always within the limits
-  double position_error = 0;   // m, largest over goals
+  std::string reason;            // "goal 1 is 0.12 m away after 9 starts", ...
+  Eigen::VectorXd joints;        // the best θ found (active joints); always within the limits
+  double position_error = 0;     // m, largest over goals
   double orientation_error = 0;  // rad, largest over goals with an orientation
-  double min_clearance = 0;    // m, +inf without collision model or pairs
-  int iterations = 0;          // over all starts
-  int starts = 0;              // starts tried (1 + restarts used)
+  double min_clearance = 0;      // m, +inf without collision model or pairs
+  int iterations = 0;            // over all starts
+  int starts = 0;                // starts tried (1 + restarts used)
 };
 
 // θ0 (size model.active_count()) is the first start; it is clamped into the limits.
@@ -57,8 +57,8 @@ IkResult solve_inverse_kinematics(const RobotModel& model, const std::vector<IkG
 
 // The least-squares residuals at θ (½|r|² is the cost) and, if `jacobian` is not null, their
 // derivative (rows × active_count). Exposed for derivative tests.
-void ik_residuals(const RobotModel& model, const std::vector<IkGoal>& goals, const IkOptions& options,
-                  const Eigen::VectorXd& joints, Eigen::VectorXd& residuals,
-                  Eigen::MatrixXd* jacobian = nullptr);
+void ik_residuals(const RobotModel& model, const std::vector<IkGoal>& goals,
+                  const IkOptions& options, const Eigen::VectorXd& joints,
+                  Eigen::VectorXd& residuals, Eigen::MatrixXd* jacobian = nullptr);
 
 }  // namespace shapectl

@@ -9,7 +9,9 @@ JointLimits::JointLimits(const RobotModel& model, double margin, double stiffnes
 
 JointLimits::JointLimits(Eigen::VectorXd lower, Eigen::VectorXd upper, double margin,
                          double stiffness)
-    : lower_(lower.array() + margin), upper_(upper.array() - margin), margin_(margin),
+    : lower_(lower.array() + margin),
+      upper_(upper.array() - margin),
+      margin_(margin),
       barrier_{stiffness} {
   assert(lower_.size() == upper_.size() && margin >= 0 && stiffness >= 0);
 }
@@ -45,7 +47,8 @@ void JointLimits::residuals(const Eigen::VectorXd& joints, Eigen::VectorXd& r,
   }
 }
 
-std::vector<LimitViolation> limit_violations(const RobotModel& model, const Eigen::VectorXd& joints) {
+std::vector<LimitViolation> limit_violations(const RobotModel& model,
+                                             const Eigen::VectorXd& joints) {
   std::vector<LimitViolation> out;
   for (int j = 0; j < model.joint_count(); ++j) {
     const Joint& joint = model.joints()[static_cast<std::size_t>(j)];

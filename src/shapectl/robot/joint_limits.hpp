@@ -42,6 +42,7 @@ struct LimitViolation {
   double upper;
 };
 // Every movable joint of `joints` (size model.joint_count(), see RobotModel::full_joints).
-std::vector<LimitViolation> limit_violations(const RobotModel& model, const Eigen::VectorXd& joints);
+std::vector<LimitViolation> limit_violations(const RobotModel& model,
+                                             const Eigen::VectorXd& joints);
 
 }  // namespace shapectl

@@ -9,7 +9,8 @@ Eigen::VectorXd read_joints(const JsonInput& json, const RobotModel& robot,
   // A result file of statics, solve or run (it says whether it converged) carries many other
   // keys: only its joints are read. A hand-written file holds nothing else, so a typo there is
   // still an error.
-  const bool result_file = json.is_object() && json.has("converged") && json.raw().at("converged").is_boolean();
+  const bool result_file =
+      json.is_object() && json.has("converged") && json.raw().at("converged").is_boolean();
   if (!result_file) json.expect_only({"joints"});
   const JsonInput joints = json.at("joints");
   Eigen::VectorXd theta = defaults;

@@ -1,6 +1,7 @@
 #pragma once
 // JOINTS.json: {"joints": {name: value}}, values of active joints (rad, or m for prismatic); or
-// the result file of `statics`, `solve` or `run` (it has "converged"), whose other keys are ignored.
+// the result file of `statics`, `solve` or `run` (it has "converged"), whose other keys are
+// ignored.
 #include <Eigen/Core>
 #include <filesystem>
 

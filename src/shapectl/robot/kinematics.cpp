@@ -39,7 +39,8 @@ void forward_kinematics(const RobotModel& model, const Eigen::VectorXd& active,
   const auto& all = model.joints();
   for (std::size_t j = 0; j < joints; ++j) {
     const int a = model.active_index(static_cast<int>(j));
-    state.joints[static_cast<long>(j)] = a >= 0 ? active[a] : model.fixed_value(static_cast<int>(j));
+    state.joints[static_cast<long>(j)] =
+        a >= 0 ? active[a] : model.fixed_value(static_cast<int>(j));
   }
   for (std::size_t j = 0; j < joints; ++j)
     if (all[j].mimic_master >= 0)
@@ -49,7 +50,8 @@ void forward_kinematics(const RobotModel& model, const Eigen::VectorXd& active,
   state.T_world_link[0].setIdentity();
   for (std::size_t j = 0; j < joints; ++j) {
     const Joint& joint = all[j];
-    const Eigen::Isometry3d& T_parent = state.T_world_link[static_cast<std::size_t>(joint.parent_link)];
+    const Eigen::Isometry3d& T_parent =
+        state.T_world_link[static_cast<std::size_t>(joint.parent_link)];
     Eigen::Isometry3d& T = state.T_world_link[static_cast<std::size_t>(joint.child_link)];
     T.linear().noalias() = T_parent.linear() * joint.T_parent_child.linear();
     T.translation().noalias() = T_parent.linear() * joint.T_parent_child.translation();

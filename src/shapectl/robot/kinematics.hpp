@@ -11,7 +11,7 @@ namespace shapectl {
 
 // The robot at one configuration. Sized for one model; reuse it to avoid allocation.
 struct KinematicsState {
-  Eigen::VectorXd joints;                      // every joint's value (RobotModel::full_joints)
+  Eigen::VectorXd joints;                       // every joint's value (RobotModel::full_joints)
   std::vector<Eigen::Isometry3d> T_world_link;  // per link
   // Per joint: its axis and a point on it (the child frame origin), world frame.
   std::vector<Vec3> joint_axes_world;

@@ -97,7 +97,8 @@ void RobotModel::set_fixed_joint_values(const std::map<std::string, double>& val
     if (!joint.movable() || joint.mimic_master >= 0 || active_index(*j) >= 0)
       throw InputError(source, quoted("joint", name),
                        "only inactive, movable, non-mimic joints take fixed values");
-    if (!std::isfinite(value)) throw InputError(source, quoted("joint", name), "a finite value", value);
+    if (!std::isfinite(value))
+      throw InputError(source, quoted("joint", name), "a finite value", value);
     fixed_values_[*j] = value;
   }
 }
@@ -116,7 +117,8 @@ Eigen::VectorXd RobotModel::active_joints_from_map(const std::map<std::string, d
     if (active_index(*j) < 0)
       throw InputError(source, quoted("joint", name),
                        joint.movable() ? "not an active joint" : "a fixed joint has no value");
-    if (!std::isfinite(value)) throw InputError(source, quoted("joint", name), "a finite value", value);
+    if (!std::isfinite(value))
+      throw InputError(source, quoted("joint", name), "a finite value", value);
     active[active_index(*j)] = value;
   }
   return active;

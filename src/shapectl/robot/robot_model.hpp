@@ -27,7 +27,7 @@ struct Shape {
 
 struct Link {
   std::string name;
-  int parent_joint = -1;  // index into joints(); -1 for the root
+  int parent_joint = -1;                // index into joints(); -1 for the root
   std::vector<Shape> collision_shapes;  // meshes are not loaded (a warning says so)
   std::vector<Shape> visual_shapes;
 };
@@ -84,7 +84,7 @@ class RobotModel {
   std::vector<std::string> active_joint_names() const;
   int active_count() const { return static_cast<int>(active_joints_.size()); }
   int active_index(int joint) const { return active_index_[static_cast<std::size_t>(joint)]; }
-  Eigen::VectorXd lower_limits() const;     // size active_count()
+  Eigen::VectorXd lower_limits() const;  // size active_count()
   Eigen::VectorXd upper_limits() const;
   Eigen::VectorXd velocity_limits() const;
 

@@ -30,7 +30,9 @@ struct Grid {
 
 Grid make_grid(const Vec3& min, const Vec3& size) {
   const double edge = cell_edge(size);
-  Grid g{min, Vec3::Zero(), {cells_for(size.x(), edge), cells_for(size.y(), edge), cells_for(size.z(), edge)}};
+  Grid g{min,
+         Vec3::Zero(),
+         {cells_for(size.x(), edge), cells_for(size.y(), edge), cells_for(size.z(), edge)}};
   for (int a = 0; a < 3; ++a) g.step[a] = size[a] / g.cells[a];
   return g;
 }
@@ -124,7 +126,8 @@ std::vector<CoverSphere> cover_triangle_mesh(const std::vector<Vec3>& vertices,
     if (!(g.step[axis] > 0)) return std::pair<int, int>{0, g.cells[axis] - 1};
     const int first = static_cast<int>(std::floor((a - g.min[axis]) / g.step[axis] - 1e-9));
     const int last = static_cast<int>(std::floor((b - g.min[axis]) / g.step[axis] + 1e-9));
-    return std::pair<int, int>{std::clamp(first, 0, g.cells[axis] - 1), std::clamp(last, 0, g.cells[axis] - 1)};
+    return std::pair<int, int>{std::clamp(first, 0, g.cells[axis] - 1),
+                               std::clamp(last, 0, g.cells[axis] - 1)};
   };
   for (const auto& t : triangles) {
     const Vec3 tlo = vertices[t[0]].cwiseMin(vertices[t[1]]).cwiseMin(vertices[t[2]]);

@@ -49,12 +49,14 @@ std::vector<MeshCollision> read_mesh_collisions(const RobotModel& model,
     const auto found = urdf->links_.find(model.links()[static_cast<std::size_t>(l)].name);
     if (found == urdf->links_.end() || !found->second) continue;
     for (const auto& collision : found->second->collision_array) {
-      if (!collision || !collision->geometry || collision->geometry->type != urdf::Geometry::MESH) continue;
+      if (!collision || !collision->geometry || collision->geometry->type != urdf::Geometry::MESH)
+        continue;
       const auto& mesh = static_cast<const urdf::Mesh&>(*collision->geometry);
       MeshCollision m{l, mesh.filename, Vec3(mesh.scale.x, mesh.scale.y, mesh.scale.z),
                       to_isometry(collision->origin)};
       if (!m.scale.allFinite() || !m.T_link_mesh.matrix().allFinite())
-        throw InputError(urdf_file.string(), "link '" + model.links()[static_cast<std::size_t>(l)].name + "'",
+        throw InputError(urdf_file.string(),
+                         "link '" + model.links()[static_cast<std::size_t>(l)].name + "'",
                          "mesh collision with non-finite scale or origin");
       meshes.push_back(std::move(m));
     }
@@ -76,7 +78,8 @@ std::optional<std::filesystem::path> resolve_mesh_file(
     }
     return std::nullopt;
   }
-  std::filesystem::path path = filename.rfind(file, 0) == 0 ? filename.substr(file.size()) : filename;
+  std::filesystem::path path =
+      filename.rfind(file, 0) == 0 ? filename.substr(file.size()) : filename;
   if (path.is_relative()) path = urdf_directory / path;
   if (exists_file(path)) return path;
   return std::nullopt;

@@ -13,9 +13,9 @@
 namespace shapectl {
 
 struct MeshCollision {
-  int link = -1;                  // index into model.links()
-  std::string filename;           // as written in the URDF
-  Vec3 scale = Vec3::Ones();      // per axis, applied before the pose
+  int link = -1;              // index into model.links()
+  std::string filename;       // as written in the URDF
+  Vec3 scale = Vec3::Ones();  // per axis, applied before the pose
   Eigen::Isometry3d T_link_mesh = Eigen::Isometry3d::Identity();
 };
 

@@ -8,9 +8,9 @@
 #include <limits>
 #include <mutex>
 #include <optional>
-#include <string_view>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/input_file.hpp>
@@ -44,18 +44,35 @@ std::size_t xml_too_deep_at(std::string_view xml, int max_depth) {
   };
   for (std::size_t i = xml.find('<'); i < xml.size(); i = xml.find('<', i)) {
     const std::string_view rest = xml.substr(i);
-    if (rest.starts_with("<!--")) { i = skip_past(i + 4, "-->"); continue; }
-    if (rest.starts_with("<![CDATA[")) { i = skip_past(i + 9, "]]>"); continue; }
-    if (rest.starts_with("<?")) { i = skip_past(i + 2, "?>"); continue; }
-    if (rest.starts_with("<!")) { i = skip_past(i + 2, ">"); continue; }
-    if (rest.starts_with("</")) { --depth; i = skip_past(i + 2, ">"); continue; }
+    if (rest.starts_with("<!--")) {
+      i = skip_past(i + 4, "-->");
+      continue;
+    }
+    if (rest.starts_with("<![CDATA[")) {
+      i = skip_past(i + 9, "]]>");
+      continue;
+    }
+    if (rest.starts_with("<?")) {
+      i = skip_past(i + 2, "?>");
+      continue;
+    }
+    if (rest.starts_with("<!")) {
+      i = skip_past(i + 2, ">");
+      continue;
+    }
+    if (rest.starts_with("</")) {
+      --depth;
+      i = skip_past(i + 2, ">");
+      continue;
+    }
     // An opening tag: find its end outside quoted attribute values.
     char quote = 0;
     std::size_t j = i + 1;
     for (; j < xml.size(); ++j) {
       const char c = xml[j];
-      if (quote) { if (c == quote) quote = 0; }
-      else if (c == '"' || c == '\'') quote = c;
+      if (quote) {
+        if (c == quote) quote = 0;
+      } else if (c == '"' || c == '\'') quote = c;
       else if (c == '>') break;
     }
     if (j >= xml.size()) return std::string_view::npos;  // unterminated: TinyXML reports it
@@ -67,7 +84,8 @@ std::size_t xml_too_deep_at(std::string_view xml, int max_depth) {
 
 // The value of attribute `name` in an element's opening tag `head`, or nullopt.
 std::optional<std::string> attribute(std::string_view head, std::string_view name) {
-  for (std::size_t at = head.find(name); at != std::string_view::npos; at = head.find(name, at + 1)) {
+  for (std::size_t at = head.find(name); at != std::string_view::npos;
+       at = head.find(name, at + 1)) {
     if (at == 0 || !std::isspace(static_cast<unsigned char>(head[at - 1]))) continue;
     std::size_t k = at + name.size();
     while (k < head.size() && std::isspace(static_cast<unsigned char>(head[k]))) ++k;
@@ -101,8 +119,9 @@ std::map<std::string, int> element_lines(const std::string& xml, const std::stri
         std::string_view(xml).substr(at, end == std::string::npos ? std::string::npos : end - at);
     if (need_type && head.find("type") == std::string::npos) continue;
     if (++elements > max_urdf_elements)
-      throw InputError(source, "", "more than " + std::to_string(max_urdf_elements) + " <" + tag +
-                                       "> elements (the limit for a robot)");
+      throw InputError(source, "",
+                       "more than " + std::to_string(max_urdf_elements) + " <" + tag +
+                           "> elements (the limit for a robot)");
     const auto name = attribute(head, "name");
     if (!name) continue;
     line += static_cast<int>(std::count(xml.begin() + static_cast<long>(counted_to),
@@ -116,8 +135,10 @@ std::map<std::string, int> element_lines(const std::string& xml, const std::stri
 // The XML must nest no deeper than max_xml_depth before TinyXML parses it.
 const std::string& checked_depth(const std::string& xml, const std::string& source) {
   if (const std::size_t at = xml_too_deep_at(xml, max_xml_depth); at != std::string_view::npos)
-    throw InputError(source + ":" + std::to_string(1 + std::count(xml.begin(), xml.begin() + static_cast<long>(at), '\n')),
-                     "", "XML elements nested deeper than " + std::to_string(max_xml_depth) + " levels");
+    throw InputError(
+        source + ":" +
+            std::to_string(1 + std::count(xml.begin(), xml.begin() + static_cast<long>(at), '\n')),
+        "", "XML elements nested deeper than " + std::to_string(max_xml_depth) + " levels");
   return xml;
 }
 
@@ -149,9 +170,9 @@ class UrdfReader {
                              " (a kinematic loop?)");
     resolve_mimics(*urdf, model);
     if (skipped_meshes_ > 0)
-      model.warnings_.push_back(source_ + ": " + std::to_string(skipped_meshes_) +
-                                " mesh geometries skipped (meshes are not loaded), first: " +
-                                first_skipped_);
+      model.warnings_.push_back(
+          source_ + ": " + std::to_string(skipped_meshes_) +
+          " mesh geometries skipped (meshes are not loaded), first: " + first_skipped_);
     model.fixed_values_ = Eigen::VectorXd::Zero(model.joint_count());
     std::vector<std::string> movable;
     for (const Joint& joint : model.joints_)
@@ -216,7 +237,8 @@ class UrdfReader {
     out.name = link.name;
     out.parent_joint = parent_joint;
     for (const auto& visual : link.visual_array)
-      if (visual) add_shape(link.name, "visual", visual->geometry, visual->origin, out.visual_shapes);
+      if (visual)
+        add_shape(link.name, "visual", visual->geometry, visual->origin, out.visual_shapes);
     for (const auto& collision : link.collision_array)
       if (collision)
         add_shape(link.name, "collision", collision->geometry, collision->origin,
@@ -252,13 +274,13 @@ class UrdfReader {
       case urdf::Joint::CONTINUOUS: out.type = JointType::Continuous; break;
       case urdf::Joint::PRISMATIC: out.type = JointType::Prismatic; break;
       default:
-        throw InputError(where, element,
-                         "unsupported joint type; expected revolute, continuous, prismatic or fixed");
+        throw InputError(
+            where, element,
+            "unsupported joint type; expected revolute, continuous, prismatic or fixed");
     }
     const Vec3 axis(in.axis.x, in.axis.y, in.axis.z);
     if (!axis.allFinite() || !(axis.norm() > 1e-12))
-      throw InputError(where, element + ": axis", "a finite non-zero vector",
-                       vec_text(axis));
+      throw InputError(where, element + ": axis", "a finite non-zero vector", vec_text(axis));
     out.axis = axis.normalized();
     out.lower = -inf;
     out.upper = inf;
@@ -271,7 +293,8 @@ class UrdfReader {
       if (out.type != JointType::Continuous) {
         if (!std::isfinite(in.limits->lower) || !std::isfinite(in.limits->upper))
           throw InputError(where, element + ": limit", "finite lower and upper",
-                           std::to_string(in.limits->lower) + " / " + std::to_string(in.limits->upper));
+                           std::to_string(in.limits->lower) + " / " +
+                               std::to_string(in.limits->upper));
         if (in.limits->lower > in.limits->upper)
           throw InputError(where, element,
                            "limit lower " + number_text(in.limits->lower) + " > upper " +
@@ -302,7 +325,8 @@ class UrdfReader {
         offset = current->mimic->multiplier * offset + current->mimic->offset;
         multiplier *= current->mimic->multiplier;
         if (!seen.insert(master).second)
-          throw InputError(where, element, "mimic joints form a cycle through '" + bounded_preview(master) + "'");
+          throw InputError(where, element,
+                           "mimic joints form a cycle through '" + bounded_preview(master) + "'");
         current = urdf.getJoint(master);
         if (!current) throw InputError(where, element, "unknown " + named("joint", master));
         if (current->type == urdf::Joint::FIXED)
@@ -323,13 +347,15 @@ class UrdfReader {
     Shape shape;
     shape.T_link_shape = pose(origin, where, element + " origin");
     auto positive = [&](double v, const std::string& what) {
-      if (!std::isfinite(v) || !(v > 0)) throw InputError(where, element + " " + what, "a positive number", v);
+      if (!std::isfinite(v) || !(v > 0))
+        throw InputError(where, element + " " + what, "a positive number", v);
       return v;
     };
     switch (geometry->type) {
       case urdf::Geometry::SPHERE: {
         shape.kind = Shape::Kind::Sphere;
-        shape.radius = positive(static_cast<const urdf::Sphere&>(*geometry).radius, "sphere radius");
+        shape.radius =
+            positive(static_cast<const urdf::Sphere&>(*geometry).radius, "sphere radius");
         break;
       }
       case urdf::Geometry::BOX: {
@@ -349,7 +375,8 @@ class UrdfReader {
       default: {
         if (skipped_meshes_++ == 0)
           first_skipped_ = element + " mesh '" +
-                           bounded_preview(static_cast<const urdf::Mesh&>(*geometry).filename) + "'";
+                           bounded_preview(static_cast<const urdf::Mesh&>(*geometry).filename) +
+                           "'";
         return;
       }
     }

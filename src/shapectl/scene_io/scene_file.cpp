@@ -25,10 +25,10 @@ namespace shapectl {
 namespace {
 
 // Generous bounds on scene numbers: finite but absurd values (gravity 1e300) are typos.
-constexpr double max_distance = 1e3;        // m, positions and sizes
-constexpr double max_gravity = 1e3;         // m/s^2 (100 g)
-constexpr double max_stiffness = 1e12;      // N/m, and the barrier stiffnesses
-constexpr double max_weight = 1e12;         // objective weights
+constexpr double max_distance = 1e3;    // m, positions and sizes
+constexpr double max_gravity = 1e3;     // m/s^2 (100 g)
+constexpr double max_stiffness = 1e12;  // N/m, and the barrier stiffnesses
+constexpr double max_weight = 1e12;     // objective weights
 
 // A positive number from lo to hi; "a positive number" for zero or negative values.
 double positive_in(const JsonInput& j, double lo, double hi, const std::string& unit) {
@@ -62,7 +62,8 @@ NodeSelection read_node_selection(const JsonInput& j, int node_count) {
 Eigen::Isometry3d read_pose(const JsonInput& j) {
   j.expect_only({"position", "rpy"});
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-  if (j.has("position")) T.translation() = j.at("position").vec3_within(max_distance, "a position", "m");
+  if (j.has("position"))
+    T.translation() = j.at("position").vec3_within(max_distance, "a position", "m");
   if (j.has("rpy")) T.linear() = rotation_from_rpy(j.at("rpy").vec3_within(1e3, "angles", "rad"));
   return T;
 }
@@ -81,8 +82,9 @@ std::shared_ptr<const TetMesh> read_box_mesh(const JsonInput& box) {
   std::array<int, 3> n{};
   for (int k = 0; k < 3; ++k) n[k] = static_cast<int>(cells.at(k).integer_in(1, 1000));
   if (6LL * n[0] * n[1] * n[2] > max_mesh_tets)
-    cells.fail("at most " + std::to_string(max_mesh_tets / 6) + " cells in all (6 tetrahedra each, at most " +
-               std::to_string(max_mesh_tets) + " tetrahedra)");
+    cells.fail("at most " + std::to_string(max_mesh_tets / 6) +
+               " cells in all (6 tetrahedra each, at most " + std::to_string(max_mesh_tets) +
+               " tetrahedra)");
   // Each tet of a cell h has volume hx hy hz / 6 and its diagonal as longest edge; TetMesh
   // calls a tet degenerate below 1e-9 × edge³: refuse with margin, naming the field.
   const Vec3 h = size.cwiseQuotient(Vec3(n[0], n[1], n[2]));
@@ -107,7 +109,8 @@ std::shared_ptr<const TetMesh> read_box_mesh(const JsonInput& box) {
 
 // "units" or "scale" of a mesh file: the factor from file coordinates to metres.
 double read_mesh_scale(const JsonInput& j) {
-  if (j.has("units") && j.has("scale")) j.at("scale").fail_problem("give \"units\" or \"scale\", not both");
+  if (j.has("units") && j.has("scale"))
+    j.at("scale").fail_problem("give \"units\" or \"scale\", not both");
   if (j.has("scale")) return positive_in(j.at("scale"), 1e-9, 1e9, "");
   if (!j.has("units")) return 1;
   const std::string units = j.at("units").string();
@@ -120,7 +123,8 @@ double read_mesh_scale(const JsonInput& j) {
 // A mesh file, its coordinates scaled to metres: a surface before TetGen sees it (so
 // max_tet_volume is in m^3 either way), a volume mesh node by node.
 std::shared_ptr<const TetMesh> read_mesh_file(const std::filesystem::path& file, double scale,
-                                              const SurfaceMeshOptions& options, const MeshOrigin& origin) {
+                                              const SurfaceMeshOptions& options,
+                                              const MeshOrigin& origin) {
   if (is_surface_file(file)) {
     TriangleSurface surface = read_surface(file);
     Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
@@ -130,7 +134,8 @@ std::shared_ptr<const TetMesh> read_mesh_file(const std::filesystem::path& file,
       hi = hi.cwiseMax(v);
     }
     // Before TetGen: a surface in mm would otherwise fail on its volume bound, or take long.
-    if (!surface.vertices.empty()) check_object_extent(options.origin_file, origin, hi - lo, nullptr);
+    if (!surface.vertices.empty())
+      check_object_extent(options.origin_file, origin, hi - lo, nullptr);
     return std::make_shared<const TetMesh>(tetrahedralize_surface(surface, options, file.string()));
   }
   const TetMesh mesh = load_mesh(file, options);
@@ -146,7 +151,8 @@ std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j, MeshOrigin& origin)
   origin.field = j.path();
   if (j.is_string()) {
     const auto path = j.directory() / j.string();
-    origin.kind = is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
+    origin.kind =
+        is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
     return read_mesh_file(path, 1, {.origin_file = j.source(), .origin_path = j.path()}, origin);
   }
   if (!j.is_object()) j.fail("a mesh file name or an object with \"box\" or \"file\"");
@@ -155,7 +161,8 @@ std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j, MeshOrigin& origin)
     origin.kind = MeshOrigin::Kind::Box;
     return read_box_mesh(j.at("box"));
   }
-  j.expect_only({"file", "units", "scale", "max_radius_edge_ratio", "max_tet_volume", "keep_surface"});
+  j.expect_only(
+      {"file", "units", "scale", "max_radius_edge_ratio", "max_tet_volume", "keep_surface"});
   SurfaceMeshOptions options{.origin_file = j.source(), .origin_path = j.path()};
   if (j.has("max_radius_edge_ratio"))
     options.max_radius_edge_ratio = j.at("max_radius_edge_ratio").non_negative();
@@ -163,7 +170,8 @@ std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j, MeshOrigin& origin)
   if (j.has("keep_surface")) options.keep_surface = j.at("keep_surface").boolean();
   const double scale = read_mesh_scale(j);
   const auto path = j.directory() / j.at("file").string();
-  origin.kind = is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
+  origin.kind =
+      is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
   origin.units_given = j.has("units") || j.has("scale");
   return read_mesh_file(path, scale, options, origin);
 }
@@ -204,7 +212,8 @@ RobotSetup read_robot(const JsonInput& j) {
     }
   }
   if (j.has("fixed_joints"))
-    r.model->set_fixed_joint_values(read_map(j.at("fixed_joints")), j.source() + ": robot.fixed_joints");
+    r.model->set_fixed_joint_values(read_map(j.at("fixed_joints")),
+                                    j.source() + ": robot.fixed_joints");
   r.reference_joints = Eigen::VectorXd::Zero(r.model->active_count());
   if (j.has("reference_joints"))
     r.reference_joints = r.model->active_joints_from_map(read_map(j.at("reference_joints")),
@@ -225,7 +234,8 @@ RobotSetup read_robot(const JsonInput& j) {
   }
   if (j.has("collision_spheres"))
     r.collisions = std::make_shared<const CollisionModel>(
-        CollisionModel::load_json_file(*r.model, j.directory() / j.at("collision_spheres").string()));
+        CollisionModel::load_json_file(*r.model,
+                                       j.directory() / j.at("collision_spheres").string()));
   if (j.has("joint_limit_margin")) {
     j.at("joint_limit_margin").non_negative();
     r.joint_limit_margin = j.at("joint_limit_margin").number_in(0, 10, "rad or m");
@@ -252,7 +262,8 @@ std::vector<Grip> read_grips(const JsonInput& list, const RobotSetup& robot, con
     if (g.has("nodes")) {
       const JsonInput nodes = g.at("nodes");
       for (std::size_t n = 0; n < nodes.size(); ++n)
-        selection.nodes.push_back(static_cast<int>(nodes.at(n).integer_in(0, mesh.node_count() - 1)));
+        selection.nodes.push_back(
+            static_cast<int>(nodes.at(n).integer_in(0, mesh.node_count() - 1)));
     }
     if (!g.has("region") && !g.has("nodes")) g.fail("a grip with \"region\" or \"nodes\"");
     grip.nodes = selection.resolve(mesh);
@@ -269,9 +280,10 @@ void read_object(const JsonInput& object, Scene& scene) {
   const double reach = std::max(scene.object_mesh->bounds_min().cwiseAbs().maxCoeff(),
                                 scene.object_mesh->bounds_max().cwiseAbs().maxCoeff());
   if (!(reach <= max_distance))
-    object.at("mesh").fail_problem("node coordinates beyond " + std::to_string(int(max_distance)) +
-                                   " m of the origin (coordinates are metres; a mesh file drawn in mm or cm "
-                                   "needs \"units\")");
+    object.at("mesh").fail_problem(
+        "node coordinates beyond " + std::to_string(int(max_distance)) +
+        " m of the origin (coordinates are metres; a mesh file drawn in mm or cm "
+        "needs \"units\")");
   scene.material = read_material(object.at("material"));
   if (object.has("pose")) scene.T_world_object = read_pose(object.at("pose"));
 }
@@ -283,9 +295,11 @@ StaticsSettings read_statics(const JsonInput& s) {
     const std::string name = s.at("linear_solver").string();
     CholeskyBackend backend;
     if (parse(name, &backend)) statics.backend = backend;
-    else if (name != "auto") s.at("linear_solver").fail("\"auto\", \"ldlt\", \"band\" or \"cholmod\"");
+    else if (name != "auto")
+      s.at("linear_solver").fail("\"auto\", \"ldlt\", \"band\" or \"cholmod\"");
   }
-  if (s.has("max_iterations")) statics.max_iterations = static_cast<int>(s.at("max_iterations").integer_in(1, 100000));
+  if (s.has("max_iterations"))
+    statics.max_iterations = static_cast<int>(s.at("max_iterations").integer_in(1, 100000));
   if (s.has("relative_tolerance"))
     statics.relative_tolerance = positive_in(s.at("relative_tolerance"), 1e-300, 1, "");
   return statics;
@@ -298,7 +312,8 @@ ObjectiveWeights read_objective(const JsonInput& o) {
     return o.at(key).number_in(0, max_weight, "");
   };
   ObjectiveWeights weights;
-  if (o.has("shape_weight")) weights.shape = positive_in(o.at("shape_weight"), 1e-12, max_weight, "");
+  if (o.has("shape_weight"))
+    weights.shape = positive_in(o.at("shape_weight"), 1e-12, max_weight, "");
   if (o.has("collision_weight")) weights.collision = weight("collision_weight");
   if (o.has("joint_limit_weight")) weights.joint_limits = weight("joint_limit_weight");
   return weights;
@@ -308,13 +323,15 @@ ObjectiveWeights read_objective(const JsonInput& o) {
 
 Scene load_scene(const std::filesystem::path& file) {
   const JsonInput root = JsonInput::load(file);
-  root.expect_only({"object", "gravity", "fixed", "statics", "robot", "grips", "grip_stiffness",
-                    "objective"});
+  root.expect_only(
+      {"object", "gravity", "fixed", "statics", "robot", "grips", "grip_stiffness", "objective"});
   Scene scene;
   scene.source = file;
   read_object(root.at("object"), scene);
-  if (root.has("gravity")) scene.gravity = root.at("gravity").vec3_within(max_gravity, "a gravity vector", "m/s^2");
-  if (root.has("fixed")) scene.fixed = read_node_selection(root.at("fixed"), scene.object_mesh->node_count());
+  if (root.has("gravity"))
+    scene.gravity = root.at("gravity").vec3_within(max_gravity, "a gravity vector", "m/s^2");
+  if (root.has("fixed"))
+    scene.fixed = read_node_selection(root.at("fixed"), scene.object_mesh->node_count());
   if (root.has("statics")) scene.statics = read_statics(root.at("statics"));
   if (root.has("robot")) scene.robot = read_robot(root.at("robot"));
   if (root.has("grips")) {

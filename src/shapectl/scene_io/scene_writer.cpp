@@ -8,25 +8,29 @@ namespace shapectl {
 namespace {
 
 // `path` as written in `from_dir`'s file, rewritten for a file in `to_dir`.
-std::string rebased(const std::string& path, const std::filesystem::path& from_dir, const std::filesystem::path& to_dir) {
+std::string rebased(const std::string& path, const std::filesystem::path& from_dir,
+                    const std::filesystem::path& to_dir) {
   const std::filesystem::path p(path);
   if (p.is_absolute()) return path;
   const auto target = std::filesystem::weakly_canonical(std::filesystem::absolute(from_dir / p));
-  const auto relative = target.lexically_relative(std::filesystem::weakly_canonical(std::filesystem::absolute(to_dir)));
+  const auto relative = target.lexically_relative(
+      std::filesystem::weakly_canonical(std::filesystem::absolute(to_dir)));
   return relative.empty() ? target.string() : relative.string();
 }
 
-void rebase_member(nlohmann::ordered_json& object, const char* key, const std::filesystem::path& from_dir,
-                   const std::filesystem::path& to_dir) {
+void rebase_member(nlohmann::ordered_json& object, const char* key,
+                   const std::filesystem::path& from_dir, const std::filesystem::path& to_dir) {
   if (object.is_object() && object.contains(key) && object[key].is_string())
     object[key] = rebased(object[key].get<std::string>(), from_dir, to_dir);
 }
 
 }  // namespace
 
-nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source, const Scene& scene,
+nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source,
+                                              const Scene& scene,
                                               const std::filesystem::path& out) {
-  nlohmann::ordered_json j = nlohmann::ordered_json::parse(read_input_file(source, max_json_file_bytes, "JSON"));
+  nlohmann::ordered_json j =
+      nlohmann::ordered_json::parse(read_input_file(source, max_json_file_bytes, "JSON"));
   nlohmann::ordered_json& material = j["object"]["material"];
   if (material.contains("mu")) {
     material["mu"] = scene.material.mu;

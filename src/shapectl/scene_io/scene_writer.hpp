@@ -16,7 +16,7 @@ namespace shapectl {
 // form the file used: youngs_modulus/poisson_ratio or mu/kappa; and density) and each grip's
 // offset ("offset": {"position", "rpy"}; none when it is the identity), its paths made
 // relative to `out`'s directory.
-nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source, const Scene& scene,
-                                              const std::filesystem::path& out);
+nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source,
+                                              const Scene& scene, const std::filesystem::path& out);
 
 }  // namespace shapectl

@@ -17,7 +17,8 @@ std::string lower(std::string_view s) {
 }
 
 bool all_digits(std::string_view s) {
-  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+  return !s.empty() &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
 }
 
 // A dotted quad, each octet 0-255 without leading zeros (which some resolvers read as octal).
@@ -47,7 +48,8 @@ bool is_hostname(std::string_view h) {
   while (!h.empty()) {
     const std::size_t end = std::min(h.find('.'), h.size());
     const std::string_view label = h.substr(0, end);
-    if (label.empty() || label.size() > 63 || label.front() == '-' || label.back() == '-') return false;
+    if (label.empty() || label.size() > 63 || label.front() == '-' || label.back() == '-')
+      return false;
     for (unsigned char c : label)
       if (!std::isalnum(c) && c != '-') return false;
     last = label;
@@ -88,7 +90,8 @@ std::optional<std::filesystem::path> resolve_static_file(const std::filesystem::
   std::string_view path = target.substr(0, target.find_first_of("?#"));
   if (!path.starts_with('/')) return std::nullopt;
   for (char c : path)
-    if (c == '\\' || c == '%' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return std::nullopt;
+    if (c == '\\' || c == '%' || static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      return std::nullopt;
   std::string relative = path == "/" ? "index.html" : std::string(path.substr(1));
   // Every segment must be a plain name: no "", ".", "..", or hidden files.
   std::size_t start = 0;
@@ -104,7 +107,8 @@ std::optional<std::filesystem::path> resolve_static_file(const std::filesystem::
   const auto file = std::filesystem::canonical(root / relative, ec);
   if (ec || !std::filesystem::is_regular_file(file, ec)) return std::nullopt;
   // Symlinks must not lead out of the root.
-  const auto [root_end, file_it] = std::mismatch(root.begin(), root.end(), file.begin(), file.end());
+  const auto [root_end, file_it] =
+      std::mismatch(root.begin(), root.end(), file.begin(), file.end());
   if (root_end != root.end()) return std::nullopt;
   return file;
 }

@@ -27,9 +27,11 @@ nlohmann::json parse_json(std::string_view text) {
     throw InputError(source, "", "JSON nested deeper than " + std::to_string(max_json_depth));
   // Strictly: a key given twice is an error naming it, never silently the last one.
   try {
-    return parse_json_text(text, source, {.max_bytes = max_message_bytes, .max_depth = max_json_depth});
+    return parse_json_text(text, source,
+                           {.max_bytes = max_message_bytes, .max_depth = max_json_depth});
   } catch (const InputError&) {
-    if (!nlohmann::json::accept(text.begin(), text.end())) throw InputError(source, "", "not valid JSON");
+    if (!nlohmann::json::accept(text.begin(), text.end()))
+      throw InputError(source, "", "not valid JSON");
     throw;  // valid JSON with a key given twice
   }
 }
@@ -157,7 +159,8 @@ Eigen::VectorXd read_joint_list(const JsonInput& list, const ProtocolContext& co
   if (list.size() != count) list.fail("an array of " + std::to_string(count) + " joint values");
   Eigen::VectorXd joints(static_cast<Eigen::Index>(count));
   for (std::size_t k = 0; k < count; ++k)
-    joints[static_cast<Eigen::Index>(k)] = read_joint_value(list.at(k), context, static_cast<int>(k));
+    joints[static_cast<Eigen::Index>(k)] =
+        read_joint_value(list.at(k), context, static_cast<int>(k));
   return joints;
 }
 
@@ -177,11 +180,16 @@ std::string read_scene_name(const JsonInput& scene, const ProtocolContext& conte
 // client must not make the server read its files); the live loop uses its markers.
 ShapeObservation read_observation(const JsonInput& frame, const ProtocolContext& context) {
   if (!context.robot) frame.fail_problem("the scene has no robot: nothing to close the loop with");
-  const ObservationFrame f = read_observation_frame(
-      frame, {.node_count = context.node_count, .robot = context.robot, .allow_points_files = false});
+  const ObservationFrame f = read_observation_frame(frame, {.node_count = context.node_count,
+                                                            .robot = context.robot,
+                                                            .allow_points_files = false});
   if (f.markers.empty())
-    frame.fail_problem("a frame without markers: the live loop uses markers (point clouds go to shapectl calibrate)");
-  ShapeObservation o{.joints = f.joints, .time = f.time.value_or(0)};
+    frame.fail_problem(
+        "a frame without markers: the live loop uses markers (point clouds go to shapectl "
+        "calibrate)");
+  ShapeObservation o;
+  o.joints = f.joints;
+  o.time = f.time.value_or(0);
   for (const ObservedMarker& m : f.markers) o.markers.emplace_back(m.node, m.position);
   return o;
 }
@@ -190,9 +198,11 @@ ShapeObservation read_observation(const JsonInput& frame, const ProtocolContext&
 void read_arguments(const JsonInput& message, const ProtocolContext& context, Command& c) {
   using T = Command::Type;
   switch (c.type) {
-    case T::Ping: case T::ClearTargets: case T::Reset: case T::Arm: case T::Disarm:
-      message.expect_only({"type", "id"});
-      break;
+    case T::Ping:
+    case T::ClearTargets:
+    case T::Reset:
+    case T::Arm:
+    case T::Disarm: message.expect_only({"type", "id"}); break;
     case T::SetTarget:
       message.expect_only({"type", "id", "node", "position"});
       c.node = read_node(message.at("node"), context);
@@ -241,7 +251,8 @@ void read_arguments(const JsonInput& message, const ProtocolContext& context, Co
 }  // namespace
 
 nlohmann::json message_id(std::string_view text) {
-  if (text.size() > max_message_bytes || json_too_deep_at(text, max_json_depth) != std::string_view::npos)
+  if (text.size() > max_message_bytes ||
+      json_too_deep_at(text, max_json_depth) != std::string_view::npos)
     return nullptr;
   const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
   if (!j.is_object()) return nullptr;
@@ -266,8 +277,8 @@ std::string ok_reply(const nlohmann::json& id) {
 
 std::string error_reply(const nlohmann::json& id, const std::string& message) {
   // Replace invalid UTF-8 (echoed client bytes) instead of throwing.
-  return nlohmann::json{{"type", "error"}, {"id", id}, {"message", message}}
-      .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+  return nlohmann::json{{"type", "error"}, {"id", id}, {"message", message}}.dump(
+      -1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 std::string positions_frame(const ControllerSnapshot& snapshot) {

@@ -40,22 +40,35 @@ struct ProtocolContext {
 
 struct Command {
   enum class Type {
-    Ping, SetTarget, RemoveTarget, SetTargets, ClearTargets, SetCenterline, SetPaused,
-    SetJoint, SetJoints, Reset, LoadScene, Arm, Disarm, Observe, SetFeedback
+    Ping,
+    SetTarget,
+    RemoveTarget,
+    SetTargets,
+    ClearTargets,
+    SetCenterline,
+    SetPaused,
+    SetJoint,
+    SetJoints,
+    Reset,
+    LoadScene,
+    Arm,
+    Disarm,
+    Observe,
+    SetFeedback
   };
   Type type = Type::Ping;
-  nlohmann::json id;            // echoed in the reply; null when the client sent none
-  int node = -1;                // SetTarget, RemoveTarget
-  Vec3 position = Vec3::Zero(); // SetTarget, world frame, m
-  ShapeTargets targets;         // SetTargets
-  std::vector<Vec3> points;     // SetCenterline, world frame, m
-  bool paused = false;          // SetPaused
-  int joint = -1;               // SetJoint: index into the active joints
-  double value = 0;             // SetJoint, rad (m for prismatic joints)
-  Eigen::VectorXd joints;       // SetJoints
-  std::string scene;            // LoadScene: one of ProtocolContext::scene_names
-  ShapeObservation observation; // Observe: markers and the joints they were taken at
-  bool feedback = false;        // SetFeedback
+  nlohmann::json id;             // echoed in the reply; null when the client sent none
+  int node = -1;                 // SetTarget, RemoveTarget
+  Vec3 position = Vec3::Zero();  // SetTarget, world frame, m
+  ShapeTargets targets;          // SetTargets
+  std::vector<Vec3> points;      // SetCenterline, world frame, m
+  bool paused = false;           // SetPaused
+  int joint = -1;                // SetJoint: index into the active joints
+  double value = 0;              // SetJoint, rad (m for prismatic joints)
+  Eigen::VectorXd joints;        // SetJoints
+  std::string scene;             // LoadScene: one of ProtocolContext::scene_names
+  ShapeObservation observation;  // Observe: markers and the joints they were taken at
+  bool feedback = false;         // SetFeedback
 };
 
 // The client's "id" if `text` is an object carrying a valid one (integer or string of at most

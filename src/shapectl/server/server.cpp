@@ -70,7 +70,8 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   // Open HTTP connections, oldest first (each one adds and removes itself).
   std::list<HttpConnection*> http_connections;
   LogLimiter log_limit{max_log_lines_per_second, std::chrono::seconds(1)};
-  LogLimiter accept_log_limit{1, std::chrono::seconds(1)};  // a failing accept() says so once a second
+  LogLimiter accept_log_limit{1,
+                              std::chrono::seconds(1)};  // a failing accept() says so once a second
   // Client objects alive, handshakes under way included; declared before ioc so it outlives the
   // handlers that ioc destroys.
   int websockets = 0;
@@ -268,7 +269,8 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
       response.content_length(size);
       return send(std::move(response));
     }
-    http::response<http::file_body> response{std::piecewise_construct, std::make_tuple(std::move(body)),
+    http::response<http::file_body> response{std::piecewise_construct,
+                                             std::make_tuple(std::move(body)),
                                              std::make_tuple(http::status::ok, request.version())};
     decorate(response, request, content_type(*file));
     response.content_length(size);
@@ -276,14 +278,16 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
   }
 
   void upgrade(http::request<http::string_body> request, const std::string& host) {
-    if (request.target() != "/ws") return reply_text(request, http::status::not_found, "not found\n");
+    if (request.target() != "/ws")
+      return reply_text(request, http::status::not_found, "not found\n");
     if (!origin_allowed(view(request[http::field::origin]), host))
       return reply_text(request, http::status::forbidden, "origin not allowed\n");
     if (server_.websockets >= server_.options.max_clients)
       return reply_text(request, http::status::service_unavailable, "too many clients\n");
     stream_.expires_never();
     forget();  // a WebSocket page now, counted by max_clients
-    auto client = std::make_shared<Client>(stream_.release_socket(), server_, server_.next_client_id++);
+    auto client =
+        std::make_shared<Client>(stream_.release_socket(), server_, server_.next_client_id++);
     client->accept(std::move(request));
   }
 
@@ -312,11 +316,12 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     auto held = std::make_shared<std::decay_t<Response>>(std::forward<Response>(response));
     response_ = held;
     stream_.expires_after(response_timeout);
-    http::async_write(stream_, *held, [self = shared_from_this(), held](beast::error_code ec, std::size_t) {
-      self->response_.reset();
-      if (ec || !held->keep_alive()) return self->shutdown();
-      self->read();
-    });
+    http::async_write(stream_, *held,
+                      [self = shared_from_this(), held](beast::error_code ec, std::size_t) {
+                        self->response_.reset();
+                        if (ec || !held->keep_alive()) return self->shutdown();
+                        self->read();
+                      });
   }
 
   void shutdown() {
@@ -372,10 +377,12 @@ void Server::Impl::accept() {
 void Server::Impl::admit(tcp::socket socket) {
   if (http_connections.size() >= http_cap) {
     if (!evict_idle_http()) {
-      log("HTTP connection limit (" + std::to_string(http_cap) + ") reached, all busy: refused one");
+      log("HTTP connection limit (" + std::to_string(http_cap) +
+          ") reached, all busy: refused one");
       return refuse(std::move(socket));
     }
-    log("HTTP connection limit (" + std::to_string(http_cap) + ") reached: closed the oldest idle one");
+    log("HTTP connection limit (" + std::to_string(http_cap) +
+        ") reached: closed the oldest idle one");
   }
   std::make_shared<HttpConnection>(std::move(socket), *this)->read();
 }

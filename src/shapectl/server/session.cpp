@@ -56,7 +56,8 @@ nlohmann::json robot_json(const RobotSetup& setup) {
   nlohmann::json spheres = nlohmann::json::array();
   if (setup.collisions)
     for (const CollisionSphere& s : setup.collisions->spheres())
-      spheres.push_back({{"link", s.link}, {"center", vec3_json(s.center_link)}, {"radius", s.radius}});
+      spheres.push_back(
+          {{"link", s.link}, {"center", vec3_json(s.center_link)}, {"radius", s.radius}});
   nlohmann::json end_effectors = nlohmann::json::array();
   for (const EndEffector& e : setup.end_effectors)
     end_effectors.push_back({{"name", e.name}, {"link", e.link}, {"tcp", vec3_json(e.tcp_link)}});
@@ -117,13 +118,15 @@ Session::~Session() = default;
 void Session::load(const SceneEntry& entry) {
   // Load first: a bad scene leaves the current one running.
   const Scene scene = load_scene(entry.path);
-  if (!scene.robot) throw InputError(entry.path.string(), "robot", "missing: the GUI needs a scene with a robot");
+  if (!scene.robot)
+    throw InputError(entry.path.string(), "robot", "missing: the GUI needs a scene with a robot");
   // A robot link drives one robot: every scene must have the same joints as the first.
   if (link_ && controller_) {
-    const auto joints = scene.robot ? scene.robot->model->active_joint_names() : std::vector<std::string>{};
+    const auto joints =
+        scene.robot ? scene.robot->model->active_joint_names() : std::vector<std::string>{};
     if (joints != controller_->robot().active_joint_names())
-      throw InputError("message", "scene", "a scene with the robot link's robot; " + entry.name +
-                                               " has other joints");
+      throw InputError("message", "scene",
+                       "a scene with the robot link's robot; " + entry.name + " has other joints");
   }
   auto controller = std::make_unique<Controller>(scene, options_);
   if (controller_) controller_->stop();
@@ -182,9 +185,10 @@ void Session::apply(const Command& c) {
   using T = Command::Type;
   auto edited = [&] { last_edit_time_ = now(); };
   switch (c.type) {
-    case T::Ping:
-      break;
-    case T::SetTarget: case T::RemoveTarget: case T::SetTargets: {
+    case T::Ping: break;
+    case T::SetTarget:
+    case T::RemoveTarget:
+    case T::SetTargets: {
       ShapeTargets next = targets_;
       if (c.type == T::SetTargets) next = c.targets;
       const auto it = std::find(next.nodes.begin(), next.nodes.end(), c.node);
@@ -221,7 +225,8 @@ void Session::apply(const Command& c) {
       paused_ = c.paused;
       jog_.reset();
       break;
-    case T::SetJoint: case T::SetJoints: {
+    case T::SetJoint:
+    case T::SetJoints: {
       if (!paused_) throw InputError("message", "type", "jogging needs the optimizer paused first");
       Eigen::VectorXd joints = c.joints;
       if (c.type == T::SetJoint) {
@@ -254,12 +259,8 @@ void Session::apply(const Command& c) {
       if (!link_) throw InputError("message", "type", "no robot link in this session");
       link_->disarm("disarmed from the GUI");
       break;
-    case T::Observe:
-      controller_->observe(c.observation);
-      break;
-    case T::SetFeedback:
-      controller_->set_feedback(c.feedback);
-      break;
+    case T::Observe: controller_->observe(c.observation); break;
+    case T::SetFeedback: controller_->set_feedback(c.feedback); break;
   }
 }
 
@@ -274,7 +275,8 @@ bool publishable(const ControllerSnapshot& s) {
     if (!ok(p)) return false;
   for (const auto& p : s.centerline)
     if (!ok(p)) return false;
-  return ok(s.joints) && ok(s.positions) && std::isfinite(s.error.mean) && std::isfinite(s.error.max);
+  return ok(s.joints) && ok(s.positions) && std::isfinite(s.error.mean) &&
+         std::isfinite(s.error.max);
 }
 }  // namespace
 
@@ -314,8 +316,10 @@ nlohmann::json Session::describe_scene() const {
   }
   nlohmann::json bar = nullptr;
   if (const auto axis = find_bar_axis(mesh))
-    bar = {{"center", vec3_json(axis->center)}, {"direction", vec3_json(axis->direction)},
-           {"length", axis->length}, {"thickness", axis->thickness}};
+    bar = {{"center", vec3_json(axis->center)},
+           {"direction", vec3_json(axis->direction)},
+           {"length", axis->length},
+           {"thickness", axis->thickness}};
   nlohmann::json scenes = nlohmann::json::array();
   for (const auto& s : scenes_) scenes.push_back(s.name);
   return {{"type", "scene"},
@@ -328,9 +332,10 @@ nlohmann::json Session::describe_scene() const {
           {"bar", bar},
           {"robot", scene.robot ? robot_json(*scene.robot) : nlohmann::json(nullptr)},
           {"link", link_ != nullptr},
-          {"limits", {{"max_message_bytes", max_message_bytes},
-                      {"max_coordinate", max_coordinate},
-                      {"max_centerline_points", max_centerline_points}}}};
+          {"limits",
+           {{"max_message_bytes", max_message_bytes},
+            {"max_coordinate", max_coordinate},
+            {"max_centerline_points", max_centerline_points}}}};
 }
 
 std::string Session::scene_message() const {

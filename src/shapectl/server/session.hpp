@@ -46,7 +46,7 @@ class Session {
   ~Session();
 
   struct Reply {
-    std::string text;            // "ok" or "error" message for the sender
+    std::string text;  // "ok" or "error" message for the sender
     bool ok = false;
     std::string log;             // a line for the server log when the message was bad
     bool scene_changed = false;  // broadcast scene_message() to everyone
@@ -68,7 +68,7 @@ class Session {
   Controller& controller() { return *controller_; }
   const std::string& scene_name() const { return scene_name_; }
 
-  static constexpr double editing_window = 0.3;   // s
+  static constexpr double editing_window = 0.3;  // s
   static constexpr std::size_t history_capacity = 6000;
 
  private:
@@ -85,11 +85,12 @@ class Session {
   std::unique_ptr<Controller> controller_;
   std::shared_ptr<const ControllerSnapshot> snapshot_;
   nlohmann::json scene_description_;  // the static part of scene_message()
-  bool paused_ = false;   // as the clients set it (the controller ignores jogs unless paused)
+  bool paused_ = false;  // as the clients set it (the controller ignores jogs unless paused)
   ShapeTargets targets_;
   // Joints asked for by jogs since the last pause: quick jogs of two joints must not undo each
   // other while the controller has not yet published the first.
-  std::optional<Eigen::VectorXd> jog_;  // node targets as the clients set them (a centre-line clears them)
+  std::optional<Eigen::VectorXd>
+      jog_;  // node targets as the clients set them (a centre-line clears them)
   std::chrono::steady_clock::time_point started_;
   double last_edit_time_ = -1e9;
   std::deque<HistorySample> history_;

@@ -58,8 +58,9 @@ Levels bfs(const Graph& g, int root, const std::vector<char>& done) {
 int pseudo_peripheral(const Graph& g, int start, const std::vector<char>& done) {
   Levels from = bfs(g, start, done);
   for (int root = start;;) {
-    const int candidate = *std::min_element(from.last.begin(), from.last.end(),
-                                            [&](int a, int b) { return g[a].size() < g[b].size(); });
+    const int candidate = *std::min_element(from.last.begin(), from.last.end(), [&](int a, int b) {
+      return g[a].size() < g[b].size();
+    });
     Levels next = bfs(g, candidate, done);
     if (next.depth <= from.depth) return root;
     root = candidate;
@@ -73,7 +74,8 @@ std::vector<int> reverse_cuthill_mckee(const SparseMatrix& lower) {
   const int n = static_cast<int>(g.size());
   std::vector<int> by_degree(n);
   for (int i = 0; i < n; ++i) by_degree[i] = i;
-  std::stable_sort(by_degree.begin(), by_degree.end(), [&](int a, int b) { return g[a].size() < g[b].size(); });
+  std::stable_sort(by_degree.begin(), by_degree.end(),
+                   [&](int a, int b) { return g[a].size() < g[b].size(); });
   std::vector<char> done(n, 0);
   std::vector<int> order;
   order.reserve(n);
@@ -132,7 +134,8 @@ bool BandCholesky::factorize(const SparseMatrix& lower) {
   // As for LDLᵀ: a pivot (L_jj²) tiny next to the largest means singular in double precision.
   double smallest = INFINITY, largest = 0;
   for (int j = 0; j < size_; ++j) {
-    const double pivot = band_[static_cast<std::size_t>(j) * rows] * band_[static_cast<std::size_t>(j) * rows];
+    const double pivot =
+        band_[static_cast<std::size_t>(j) * rows] * band_[static_cast<std::size_t>(j) * rows];
     smallest = std::min(smallest, pivot);
     largest = std::max(largest, pivot);
   }

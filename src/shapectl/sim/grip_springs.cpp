@@ -10,8 +10,9 @@ std::vector<GrippedNode> GripSprings::attach(const KinematicsState& reference_st
                                              const std::vector<std::pair<int, int>>& node_link) {
   std::vector<GrippedNode> out;
   for (const auto& [node, link] : node_link)
-    out.push_back({node, link,
-                   reference_state.T_world_link[link].inverse() * reference_positions.segment<3>(3 * node)});
+    out.push_back(
+        {node, link,
+         reference_state.T_world_link[link].inverse() * reference_positions.segment<3>(3 * node)});
   return out;
 }
 
@@ -64,7 +65,8 @@ void GripEnergy::add_gradient(const Positions& x, Eigen::VectorXd& gradient) con
 
 void GripEnergy::add_hessian(const Positions&, Triplets& hessian, bool) const {
   for (const auto& g : springs_->nodes())
-    for (int d = 0; d < 3; ++d) hessian.emplace_back(3 * g.node + d, 3 * g.node + d, springs_->stiffness());
+    for (int d = 0; d < 3; ++d)
+      hessian.emplace_back(3 * g.node + d, 3 * g.node + d, springs_->stiffness());
 }
 
 }  // namespace shapectl

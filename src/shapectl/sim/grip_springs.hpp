@@ -14,8 +14,8 @@ namespace shapectl {
 
 struct GrippedNode {
   int node = -1;
-  int link = -1;       // the end effector's link
-  Vec3 point_link;     // qᵢ, link frame, metres
+  int link = -1;    // the end effector's link
+  Vec3 point_link;  // qᵢ, link frame, metres
 };
 
 class GripSprings {

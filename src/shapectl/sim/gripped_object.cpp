@@ -10,7 +10,8 @@ namespace {
 std::vector<std::pair<int, int>> node_links(const Scene& scene) {
   std::vector<std::pair<int, int>> out;
   for (const auto& g : scene.grips)
-    for (int node : g.nodes) out.emplace_back(node, scene.robot->end_effectors[g.end_effector].link);
+    for (int node : g.nodes)
+      out.emplace_back(node, scene.robot->end_effectors[g.end_effector].link);
   return out;
 }
 
@@ -22,7 +23,8 @@ void apply_grip_offsets(const Scene& scene, std::vector<GrippedNode>& nodes) {
     const Vec3 tcp = scene.robot->end_effectors[g.end_effector].tcp_link;
     const Eigen::Isometry3d offset_link =
         Eigen::Translation3d(tcp) * g.offset * Eigen::Translation3d(-tcp);
-    for (std::size_t n = 0; n < g.nodes.size(); ++n, ++k) nodes[k].point_link = offset_link * nodes[k].point_link;
+    for (std::size_t n = 0; n < g.nodes.size(); ++n, ++k)
+      nodes[k].point_link = offset_link * nodes[k].point_link;
   }
 }
 }  // namespace
@@ -31,7 +33,8 @@ GrippedObject::GrippedObject(const Scene& scene) : scene_(scene) {
   if (!scene_.robot) throw std::invalid_argument("GrippedObject needs a scene with a robot");
   const auto pairs = node_links(scene_);
   const KinematicsState reference = forward_kinematics(robot(), scene_.robot->reference_joints);
-  std::vector<GrippedNode> gripped = GripSprings::attach(reference, scene_.world_rest_positions(), pairs);
+  std::vector<GrippedNode> gripped =
+      GripSprings::attach(reference, scene_.world_rest_positions(), pairs);
   apply_grip_offsets(scene_, gripped);
   grips_ = std::make_unique<GripSprings>(robot(), std::move(gripped), scene_.grip_stiffness);
   std::vector<int> held;
@@ -60,7 +63,8 @@ const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::Vecto
   state.kinematics_ = forward_kinematics(robot(), joints);
   const GripEnergy grip(*grips_, state.kinematics_);
   const StaticsWorkspace* chord_ws = chord ? chord->workspace_.get() : nullptr;
-  state.statics_ = statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations, chord_ws);
+  state.statics_ =
+      statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations, chord_ws);
   return state.statics_;
 }
 
@@ -97,13 +101,15 @@ Eigen::MatrixXd GrippedObject::sensitivity(ObjectState& state, double stale_step
   return force_response(state, grips_->force_jacobian(state.kinematics_, node_count()), stale_step);
 }
 
-Eigen::MatrixXd GrippedObject::force_response(ObjectState& state, const Eigen::MatrixXd& force_change,
+Eigen::MatrixXd GrippedObject::force_response(ObjectState& state,
+                                              const Eigen::MatrixXd& force_change,
                                               double stale_step) const {
   factored(state, stale_step);
   return statics_->solver().solve_with_factor(*state.workspace_, force_change);
 }
 
-Eigen::VectorXd GrippedObject::adjoint(ObjectState& state, const Eigen::VectorXd& v, double stale_step) const {
+Eigen::VectorXd GrippedObject::adjoint(ObjectState& state, const Eigen::VectorXd& v,
+                                       double stale_step) const {
   factored(state, stale_step);
   const Eigen::VectorXd lambda = statics_->solver().solve_with_factor(*state.workspace_, v);
   return grips_->force_jacobian_transpose_times(state.kinematics_, lambda);

@@ -45,8 +45,8 @@ class GrippedObject {
   const StaticsResult& solve(ObjectState& state, const Eigen::VectorXd& joints,
                              int max_iterations = 0, const ObjectState* chord = nullptr) const;
   // A new state solved at θ = joints from the warm start x, chord steps from `chord`'s factor.
-  ObjectState solve_from(const Eigen::VectorXd& joints, const Positions& x,
-                         int max_iterations = 0, const ObjectState* chord = nullptr) const;
+  ObjectState solve_from(const Eigen::VectorXd& joints, const Positions& x, int max_iterations = 0,
+                         const ObjectState* chord = nullptr) const;
 
   // A warm start for the equilibrium at `to` from the one at `from`: every gripped node of `x`
   // is set to its position in `at_from` moved rigidly with its end effector from `from` to
@@ -69,7 +69,8 @@ class GrippedObject {
   Eigen::MatrixXd force_response(ObjectState& state, const Eigen::MatrixXd& force_change,
                                  double stale_step = 0) const;
   // (dx̂/dθ)ᵀ v by the adjoint method, one solve: λ = H⁻¹ v, result = (∂F/∂θ)ᵀ λ.
-  Eigen::VectorXd adjoint(ObjectState& state, const Eigen::VectorXd& v, double stale_step = 0) const;
+  Eigen::VectorXd adjoint(ObjectState& state, const Eigen::VectorXd& v,
+                          double stale_step = 0) const;
 
  private:
   bool factored(ObjectState& state, double stale_step) const;

@@ -41,18 +41,21 @@ RoundoffScale roundoff_scale(const TetMesh& mesh, const Material& material, doub
   for (const auto& t : mesh.tets())
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b) {
-        const double h = (mesh.rest_positions()[t.nodes[a]] - mesh.rest_positions()[t.nodes[b]]).norm();
+        const double h =
+            (mesh.rest_positions()[t.nodes[a]] - mesh.rest_positions()[t.nodes[b]]).norm();
         h_min = std::min(h_min, h);
         h_max = std::max(h_max, h);
       }
   if (mesh.tets().empty()) return {};
-  const double X = std::max(mesh.bounds_max().cwiseAbs().maxCoeff(), mesh.bounds_min().cwiseAbs().maxCoeff());
+  const double X =
+      std::max(mesh.bounds_max().cwiseAbs().maxCoeff(), mesh.bounds_min().cwiseAbs().maxCoeff());
   const double moduli = std::abs(material.mu) + std::abs(material.kappa);
   const double eps = std::numeric_limits<double>::epsilon();
   const double extent = (mesh.bounds_max() - mesh.bounds_min()).norm();
   RoundoffScale r;
   r.force = 16 * eps * moduli * h_max * (h_max + X);
-  r.energy = 256 * eps * (moduli * mesh.total_volume() * (1 + X / h_min) + std::abs(weight) * (X + extent));
+  r.energy = 256 * eps *
+             (moduli * mesh.total_volume() * (1 + X / h_min) + std::abs(weight) * (X + extent));
   return r;
 }
 

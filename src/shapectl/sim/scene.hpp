@@ -35,7 +35,7 @@ struct NodeSelection {
 
 struct StaticsSettings {
   int max_iterations = 100;
-  double relative_tolerance = 1e-6;  // force tolerance as a fraction of the object's weight
+  double relative_tolerance = 1e-6;        // force tolerance as a fraction of the object's weight
   std::optional<CholeskyBackend> backend;  // "ldlt" | "band" | "cholmod"; default: from the matrix
 };
 
@@ -51,8 +51,8 @@ struct RobotSetup {
   Eigen::VectorXd reference_joints;  // θ⁰, active joints, rad
   std::vector<EndEffector> end_effectors;
   std::shared_ptr<const CollisionModel> collisions;  // may be null: no self-collision term
-  double joint_limit_margin = 0.05;      // rad (m for prismatic)
-  double joint_limit_stiffness = 1e3;    // k of the cubic barrier
+  double joint_limit_margin = 0.05;                  // rad (m for prismatic)
+  double joint_limit_stiffness = 1e3;                // k of the cubic barrier
 };
 
 struct Grip {

@@ -29,7 +29,8 @@ std::string millimetres(double metres) {
 
 std::string grip_field(const Scene& scene, std::size_t g) {
   return "grips[" + std::to_string(g) + "] ('" +
-         scene.robot->end_effectors[static_cast<std::size_t>(scene.grips[g].end_effector)].name + "')";
+         scene.robot->end_effectors[static_cast<std::size_t>(scene.grips[g].end_effector)].name +
+         "')";
 }
 
 // Bounding-box diagonal of the robot's link origins at the reference joints.
@@ -45,9 +46,11 @@ double robot_extent(const RobotSetup& robot) {
 
 void check_object_size(const Scene& scene) {
   const MeshOrigin& origin = scene.mesh_origin;
-  const bool from_file = origin.kind == MeshOrigin::Kind::VolumeFile || origin.kind == MeshOrigin::Kind::SurfaceFile;
+  const bool from_file =
+      origin.kind == MeshOrigin::Kind::VolumeFile || origin.kind == MeshOrigin::Kind::SurfaceFile;
   if (!scene.robot && !from_file) return;  // a box's size is explicit metres
-  check_object_extent(scene.source.string(), origin, scene.object_mesh->bounds_max() - scene.object_mesh->bounds_min(),
+  check_object_extent(scene.source.string(), origin,
+                      scene.object_mesh->bounds_max() - scene.object_mesh->bounds_min(),
                       scene.robot ? &*scene.robot : nullptr);
 }
 
@@ -56,16 +59,20 @@ std::string tet_count_warning(const Scene& scene) {
   if (tets <= tet_warning_count) return "";
   std::string coarsen;
   switch (scene.mesh_origin.kind) {
-    case MeshOrigin::Kind::Box: coarsen = "use fewer cells (" + scene.mesh_origin.field + ".box.cells)"; break;
+    case MeshOrigin::Kind::Box:
+      coarsen = "use fewer cells (" + scene.mesh_origin.field + ".box.cells)";
+      break;
     case MeshOrigin::Kind::SurfaceFile:
-      coarsen = "give a larger " + scene.mesh_origin.field + ".max_tet_volume (m^3) or a larger "
+      coarsen = "give a larger " + scene.mesh_origin.field +
+                ".max_tet_volume (m^3) or a larger "
                 "max_radius_edge_ratio (e.g. 2: fewer added points), or simplify the surface";
       break;
     default: coarsen = "coarsen the mesh where it was made"; break;
   }
   return scene.source.string() + ": " + scene.mesh_origin.field + ": " + std::to_string(tets) +
          " tetrahedra: expect about " + show(expected_seconds_per_target_change(tets), 2) +
-         " s per target change (1,536 tets take ~50 ms, 12,288 ~0.7 s, 50,000 several seconds); to coarsen, " +
+         " s per target change (1,536 tets take ~50 ms, 12,288 ~0.7 s, 50,000 several seconds); to "
+         "coarsen, " +
          coarsen;
 }
 
@@ -73,14 +80,18 @@ std::string tet_count_warning(const Scene& scene) {
 std::string joint_field(const RobotModel& model, const std::string& name) {
   const Joint& joint = model.joints()[static_cast<std::size_t>(model.joint_index(name))];
   if (joint.mimic_master >= 0)
-    return "robot.reference_joints." + model.joints()[static_cast<std::size_t>(joint.mimic_master)].name +
+    return "robot.reference_joints." +
+           model.joints()[static_cast<std::size_t>(joint.mimic_master)].name +
            " (through the mimic joint '" + name + "')";
   if (model.active_index(model.joint_index(name)) >= 0) return "robot.reference_joints." + name;
   return "robot.fixed_joints." + name;
 }
 
 std::string unit_of(const RobotModel& model, const std::string& name) {
-  return model.joints()[static_cast<std::size_t>(model.joint_index(name))].type == JointType::Prismatic ? "m" : "rad";
+  return model.joints()[static_cast<std::size_t>(model.joint_index(name))].type ==
+                 JointType::Prismatic
+             ? "m"
+             : "rad";
 }
 
 void check_joint_limits(const Scene& scene, std::vector<std::string>& warnings) {
@@ -89,14 +100,16 @@ void check_joint_limits(const Scene& scene, std::vector<std::string>& warnings) 
   const auto violations = limit_violations(model, model.full_joints(robot.reference_joints));
   if (!violations.empty()) {
     const LimitViolation& v = violations.front();
-    std::string expected = "a value within the joint's limits [" + show(v.lower, 4) + ", " + show(v.upper, 4) + "] " +
-                           unit_of(model, v.joint) + " (a joint without a value is 0)";
+    std::string expected = "a value within the joint's limits [" + show(v.lower, 4) + ", " +
+                           show(v.upper, 4) + "] " + unit_of(model, v.joint) +
+                           " (a joint without a value is 0)";
     if (violations.size() > 1) {
       expected += "; also outside:";
       for (std::size_t k = 1; k < violations.size(); ++k)
         expected += " " + violations[k].joint + " = " + show(violations[k].value, 4);
     }
-    throw InputError(scene.source.string(), joint_field(model, v.joint), expected, show(v.value, 6));
+    throw InputError(scene.source.string(), joint_field(model, v.joint), expected,
+                     show(v.value, 6));
   }
   // Inside the margin the barrier already pushes at the reference: allowed, but it moves the robot.
   const Eigen::VectorXd lower = model.lower_limits(), upper = model.upper_limits();
@@ -105,8 +118,9 @@ void check_joint_limits(const Scene& scene, std::vector<std::string>& warnings) 
     const double q = robot.reference_joints[k];
     const double gap = std::min(q - lower[k], upper[k] - q);
     if (gap < robot.joint_limit_margin)
-      warnings.push_back(scene.source.string() + ": robot.reference_joints." + names[static_cast<std::size_t>(k)] +
-                         ": " + show(q, 4) + " is within robot.joint_limit_margin (" + show(robot.joint_limit_margin) +
+      warnings.push_back(scene.source.string() + ": robot.reference_joints." +
+                         names[static_cast<std::size_t>(k)] + ": " + show(q, 4) +
+                         " is within robot.joint_limit_margin (" + show(robot.joint_limit_margin) +
                          ") of its limits [" + show(lower[k], 4) + ", " + show(upper[k], 4) +
                          "]: the limit barrier pushes the robot away from the reference pose");
   }
@@ -119,17 +133,22 @@ void check_collisions(const Scene& scene, std::vector<std::string>& warnings) {
   const KinematicsState state = forward_kinematics(*robot.model, robot.reference_joints);
   const SphereClearance closest = collisions.closest_pairs(state, 1).front();
   auto link_of = [&](int sphere) {
-    return robot.model->links()[static_cast<std::size_t>(collisions.spheres()[static_cast<std::size_t>(sphere)].link)].name;
+    return robot.model
+        ->links()[static_cast<std::size_t>(
+            collisions.spheres()[static_cast<std::size_t>(sphere)].link)]
+        .name;
   };
-  const std::string pair = "the closest pair is a sphere of '" + link_of(closest.first) + "' and one of '" +
-                           link_of(closest.second) + "', clearance " + millimetres(closest.clearance);
+  const std::string pair = "the closest pair is a sphere of '" + link_of(closest.first) +
+                           "' and one of '" + link_of(closest.second) + "', clearance " +
+                           millimetres(closest.clearance);
   if (closest.clearance < 0)
-    throw InputError(scene.source.string(), "robot.reference_joints",
-                     "the robot collides with itself at the reference joints (robot.collision_spheres): " + pair +
-                         "; choose reference joints where every checked pair is clear");
+    throw InputError(
+        scene.source.string(), "robot.reference_joints",
+        "the robot collides with itself at the reference joints (robot.collision_spheres): " +
+            pair + "; choose reference joints where every checked pair is clear");
   if (closest.clearance < collisions.margin())
-    warnings.push_back(scene.source.string() + ": robot.reference_joints: " + pair + ", inside the spheres' margin (" +
-                       millimetres(collisions.margin()) +
+    warnings.push_back(scene.source.string() + ": robot.reference_joints: " + pair +
+                       ", inside the spheres' margin (" + millimetres(collisions.margin()) +
                        "): the collision barrier pushes the robot away from the reference pose");
 }
 
@@ -142,22 +161,27 @@ void check_grips(const Scene& scene, std::vector<std::string>& warnings) {
       // Regions are in object coordinates; a region typed in world coordinates misses.
       const Vec3 lo = scene.object_mesh->bounds_min(), hi = scene.object_mesh->bounds_max();
       throw InputError(scene.source.string(), "grips[" + std::to_string(g) + "]",
-                       "the grip region contains no node of the mesh (its nodes span [" + show(lo.x()) + ", " +
-                           show(lo.y()) + ", " + show(lo.z()) + "] to [" + show(hi.x()) + ", " + show(hi.y()) + ", " +
-                           show(hi.z()) + "] m in object coordinates, before object.pose)");
+                       "the grip region contains no node of the mesh (its nodes span [" +
+                           show(lo.x()) + ", " + show(lo.y()) + ", " + show(lo.z()) + "] to [" +
+                           show(hi.x()) + ", " + show(hi.y()) + ", " + show(hi.z()) +
+                           "] m in object coordinates, before object.pose)");
     }
-    const std::string distance = "its centre (the mean of its " + std::to_string(p.node_count) + " nodes) is " +
-                                 millimetres(p.tool_distance) + " from the end effector's tool point at the reference joints";
+    const std::string distance = "its centre (the mean of its " + std::to_string(p.node_count) +
+                                 " nodes) is " + millimetres(p.tool_distance) +
+                                 " from the end effector's tool point at the reference joints";
     if (p.tool_distance > grip_error_distance)
-      throw InputError(scene.source.string(), field,
-                       distance + ", expected at most " + millimetres(grip_error_distance) +
-                           ": grip springs would hold the object where no gripper is; move the region, "
-                           "object.pose or robot.reference_joints so the tool reaches it");
+      throw InputError(
+          scene.source.string(), field,
+          distance + ", expected at most " + millimetres(grip_error_distance) +
+              ": grip springs would hold the object where no gripper is; move the region, "
+              "object.pose or robot.reference_joints so the tool reaches it");
     if (p.tool_distance > grip_warning_distance)
       warnings.push_back(scene.source.string() + ": " + field + ": " + distance + " (more than " +
-                         millimetres(grip_warning_distance) + "): is that where the gripper closes?");
+                         millimetres(grip_warning_distance) +
+                         "): is that where the gripper closes?");
     if (p.node_count < grip_warning_node_count)
-      warnings.push_back(scene.source.string() + ": " + field + ": catches only " + std::to_string(p.node_count) +
+      warnings.push_back(scene.source.string() + ": " + field + ": catches only " +
+                         std::to_string(p.node_count) +
                          " node(s): the object may turn about them; use a larger region");
   }
 }
@@ -168,16 +192,19 @@ void check_grips(const Scene& scene, std::vector<std::string>& warnings) {
 // nearly always a mesh drawn in mm or cm read as metres.
 void check_object_extent(const std::string& source, const MeshOrigin& origin, const Vec3& size,
                          const RobotSetup* robot) {
-  const bool from_file = origin.kind == MeshOrigin::Kind::VolumeFile || origin.kind == MeshOrigin::Kind::SurfaceFile;
+  const bool from_file =
+      origin.kind == MeshOrigin::Kind::VolumeFile || origin.kind == MeshOrigin::Kind::SurfaceFile;
   const double extent = size.norm();
   double limit = max_object_extent;
-  std::string why = "larger than any object shapectl is meant for (limit " + show(max_object_extent) + " m)";
+  std::string why =
+      "larger than any object shapectl is meant for (limit " + show(max_object_extent) + " m)";
   if (robot) {
     const double reach = robot_extent(*robot);
     if (object_reach_factor * reach < limit) {
       limit = std::max(1.0, object_reach_factor * reach);
-      why = "far larger than the robot could hold (limit " + show(limit) + " m: " + show(object_reach_factor) +
-            " x the " + show(reach) + " m its link origins span)";
+      why = "far larger than the robot could hold (limit " + show(limit) +
+            " m: " + show(object_reach_factor) + " x the " + show(reach) +
+            " m its link origins span)";
     }
   }
   if (!(extent > limit)) return;
@@ -185,11 +212,14 @@ void check_object_extent(const std::string& source, const MeshOrigin& origin, co
   if (!from_file) hint = "the box size is in metres";
   else if (origin.units_given) hint = "check its \"units\" or \"scale\"";
   else
-    hint = "mesh coordinates are read as metres: for a mesh drawn in millimetres give {\"file\": ..., \"units\": "
-           "\"mm\"} (or \"cm\", or \"scale\": factor)";
+    hint =
+        "mesh coordinates are read as metres: for a mesh drawn in millimetres give {\"file\": ..., "
+        "\"units\": "
+        "\"mm\"} (or \"cm\", or \"scale\": factor)";
   throw InputError(source, origin.field,
-                   "the object is " + show(extent) + " m across (bounding box " + show(size.x()) + " x " +
-                       show(size.y()) + " x " + show(size.z()) + " m), " + why + "; " + hint);
+                   "the object is " + show(extent) + " m across (bounding box " + show(size.x()) +
+                       " x " + show(size.y()) + " x " + show(size.z()) + " m), " + why + "; " +
+                       hint);
 }
 
 std::vector<GripPlacement> grip_placements(const Scene& scene) {
@@ -202,9 +232,12 @@ std::vector<GripPlacement> grip_placements(const Scene& scene) {
     GripPlacement p{.node_count = static_cast<int>(grip.nodes.size())};
     if (!grip.nodes.empty()) {
       Vec3 centre = Vec3::Zero();
-      for (int i : grip.nodes) centre += scene.T_world_object * scene.object_mesh->rest_positions()[static_cast<std::size_t>(i)];
+      for (int i : grip.nodes)
+        centre +=
+            scene.T_world_object * scene.object_mesh->rest_positions()[static_cast<std::size_t>(i)];
       centre /= static_cast<double>(grip.nodes.size());
-      p.tool_distance = (state.T_world_link[static_cast<std::size_t>(ee.link)] * ee.tcp_link - centre).norm();
+      p.tool_distance =
+          (state.T_world_link[static_cast<std::size_t>(ee.link)] * ee.tcp_link - centre).norm();
     }
     out.push_back(p);
   }
@@ -215,8 +248,9 @@ std::vector<std::string> describe_grips(const Scene& scene) {
   std::vector<std::string> out;
   const auto placements = grip_placements(scene);
   for (std::size_t g = 0; g < placements.size(); ++g)
-    out.push_back(grip_field(scene, g) + ": " + std::to_string(placements[g].node_count) + " nodes, centre " +
-                  millimetres(placements[g].tool_distance) + " from the tool point");
+    out.push_back(grip_field(scene, g) + ": " + std::to_string(placements[g].node_count) +
+                  " nodes, centre " + millimetres(placements[g].tool_distance) +
+                  " from the tool point");
   return out;
 }
 

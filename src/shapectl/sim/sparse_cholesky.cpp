@@ -29,7 +29,8 @@ void use_blas_threads(bool many) {
 struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
   double flops() const {
     double f = 0;
-    for (int j = 0; j < m_nonZerosPerCol.size(); ++j) f += double(m_nonZerosPerCol[j] + 1) * (m_nonZerosPerCol[j] + 1);
+    for (int j = 0; j < m_nonZerosPerCol.size(); ++j)
+      f += double(m_nonZerosPerCol[j] + 1) * (m_nonZerosPerCol[j] + 1);
     return f;
   }
 };

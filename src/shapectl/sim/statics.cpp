@@ -74,7 +74,8 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
   return ok;
 }
 
-bool StaticsSolver::factor(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x) const {
+bool StaticsSolver::factor(const EnergyTerms& terms, StaticsWorkspace& ws,
+                           const Positions& x) const {
   return factor_at(terms, ws, x, false);
 }
 
@@ -86,14 +87,17 @@ SparseMatrix StaticsSolver::hessian(const EnergyTerms& terms, const Positions& x
 }
 
 double StaticsSolver::factor_distance(const StaticsWorkspace& ws, const Positions& x) const {
-  if (!ws.has_factor || ws.factor_x.size() != x.size()) return std::numeric_limits<double>::infinity();
+  if (!ws.has_factor || ws.factor_x.size() != x.size())
+    return std::numeric_limits<double>::infinity();
   double d = 0;
   for (int i = 0; i < node_count_; ++i) d = std::max(d, (x - ws.factor_x).segment<3>(3 * i).norm());
   return d;
 }
 
-Eigen::MatrixXd StaticsSolver::solve_with_factor(const StaticsWorkspace& ws, const Eigen::MatrixXd& rhs) const {
-  if (!ws.has_factor) throw std::runtime_error("the Hessian at the equilibrium is not positive definite");
+Eigen::MatrixXd StaticsSolver::solve_with_factor(const StaticsWorkspace& ws,
+                                                 const Eigen::MatrixXd& rhs) const {
+  if (!ws.has_factor)
+    throw std::runtime_error("the Hessian at the equilibrium is not positive definite");
   Eigen::MatrixXd masked = rhs;
   for (int d = 0; d < masked.rows(); ++d)
     if (fixed_dof_[d]) masked.row(d).setZero();
@@ -115,9 +119,11 @@ std::string StaticsSolver::singular_reason(const StaticsWorkspace& ws) const {
     }
   const double ratio = hi > 0 && std::isfinite(hi) ? lo / hi : 0;
   return "singular system: the Hessian is numerically singular even after projection (smallest/"
-         "largest diagonal stiffness " + sci(ratio) + (ratio < 1e-12
-             ? "; an extreme material, grip stiffness or gravity makes it ill-conditioned)"
-             : "; the held nodes may leave a rigid motion free, e.g. a rotation about one node)");
+         "largest diagonal stiffness " +
+         sci(ratio) +
+         (ratio < 1e-12
+              ? "; an extreme material, grip stiffness or gravity makes it ill-conditioned)"
+              : "; the held nodes may leave a rigid motion free, e.g. a rotation about one node)");
 }
 
 double StaticsSolver::largest_node_step(const Eigen::VectorXd& dx) const {
@@ -130,8 +136,8 @@ double StaticsSolver::energy_noise(double energy) const {
   return std::max(options_.energy_roundoff, 1e-12 * std::abs(energy)) + 1e-300;
 }
 
-bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord, Positions& x,
-                               Point& at, NewtonIterate& log) const {
+bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord,
+                               Positions& x, Point& at, NewtonIterate& log) const {
   // The full step with the earlier factorization, kept while it lowers the energy and cuts the
   // force 4-fold.
   Eigen::VectorXd dx;
@@ -234,7 +240,8 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     }
     if (at.residual <= tolerance && x.allFinite()) {
       result.status = StaticsStatus::Converged;
-      result.reason = "residual " + sci(at.residual) + " N after " + std::to_string(it) + " iterations";
+      result.reason =
+          "residual " + sci(at.residual) + " N after " + std::to_string(it) + " iterations";
       return result;
     }
     if (it == max_iterations) {
@@ -249,7 +256,8 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
       continue;
     }
     may_chord = false;
-    const Eigen::VectorXd dx = newton_direction(terms, ws, x, at.gradient, log, result.factorizations);
+    const Eigen::VectorXd dx =
+        newton_direction(terms, ws, x, at.gradient, log, result.factorizations);
     if (dx.size() == 0) {
       result.status = StaticsStatus::Singular;
       result.reason = singular_reason(ws);

@@ -45,12 +45,12 @@ struct StaticsOptions {
 
 struct NewtonIterate {
   int iteration = 0;
-  double residual = 0;       // largest nodal force norm at the start of the iteration, N
-  double energy = 0;         // J
-  double step = 0;           // largest nodal displacement of the accepted step, m
-  double step_length = 0;    // line-search factor α
-  bool projected = false;    // the PSD-projected Hessian was used
-  bool chord = false;        // an earlier factorization was reused (no new one)
+  double residual = 0;     // largest nodal force norm at the start of the iteration, N
+  double energy = 0;       // J
+  double step = 0;         // largest nodal displacement of the accepted step, m
+  double step_length = 0;  // line-search factor α
+  bool projected = false;  // the PSD-projected Hessian was used
+  bool chord = false;      // an earlier factorization was reused (no new one)
 };
 
 struct StaticsResult {
@@ -58,7 +58,7 @@ struct StaticsResult {
   std::string reason;  // why it stopped, e.g. "residual 3e-2 N after 50 iterations"
   int iterations = 0;
   int factorizations = 0;  // numeric factorizations this solve did
-  double residual = 0;  // largest nodal force norm at the returned state, N
+  double residual = 0;     // largest nodal force norm at the returned state, N
   double energy = 0;
   std::vector<NewtonIterate> log;
   bool converged() const { return status == StaticsStatus::Converged; }
@@ -69,7 +69,8 @@ struct StaticsResult {
 // StaticsSolver::make_workspace. One thread at a time changes it; solving with its factor
 // (solve_with_factor, or as another solve's chord source) is safe from several threads.
 struct StaticsWorkspace {
-  StaticsWorkspace(int dof_count, std::vector<char> fixed_dof, std::optional<SparseCholesky::Backend> backend)
+  StaticsWorkspace(int dof_count, std::vector<char> fixed_dof,
+                   std::optional<SparseCholesky::Backend> backend)
       : assembler(dof_count, std::move(fixed_dof)), cholesky(backend) {}
   // Drops the factorization (the buffers and the symbolic analysis stay).
   void forget_factor() { has_factor = false; }
@@ -123,7 +124,9 @@ class StaticsSolver {
   const std::vector<char>& fixed_dof() const { return fixed_dof_; }
   const StaticsOptions& options() const { return options_; }
   // The tolerance Newton stops at: the larger of force_tolerance and force_roundoff.
-  double effective_tolerance() const { return std::max(options_.force_tolerance, options_.force_roundoff); }
+  double effective_tolerance() const {
+    return std::max(options_.force_tolerance, options_.force_roundoff);
+  }
 
  private:
   // Energy, gradient and largest nodal force at one iterate.
@@ -136,8 +139,9 @@ class StaticsSolver {
   bool chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord, Positions& x, Point& at,
                   NewtonIterate& log) const;
   // Empty when not even the projected Hessian factors.
-  Eigen::VectorXd newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
-                                   const Eigen::VectorXd& g, NewtonIterate& log, int& factorizations) const;
+  Eigen::VectorXd newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
+                                   const Positions& x, const Eigen::VectorXd& g, NewtonIterate& log,
+                                   int& factorizations) const;
   bool line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x, Point& at,
                    NewtonIterate& log) const;
   double largest_node_step(const Eigen::VectorXd& dx) const;
@@ -145,7 +149,8 @@ class StaticsSolver {
   double energy_noise(double energy) const;
   double max_force(const Eigen::VectorXd& gradient) const;
   // Assembles and factors at x into ws; projected = use PSD-projected element Hessians.
-  bool factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x, bool projected) const;
+  bool factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
+                 bool projected) const;
   // Why the projected Hessian factor_at just assembled in ws could not be factored.
   std::string singular_reason(const StaticsWorkspace& ws) const;
 

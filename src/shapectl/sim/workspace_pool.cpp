@@ -2,7 +2,8 @@
 
 namespace shapectl {
 
-std::shared_ptr<WorkspacePool> WorkspacePool::create(std::function<StaticsWorkspace()> make, int keep) {
+std::shared_ptr<WorkspacePool> WorkspacePool::create(std::function<StaticsWorkspace()> make,
+                                                     int keep) {
   return std::shared_ptr<WorkspacePool>(new WorkspacePool(std::move(make), keep));
 }
 

@@ -15,11 +15,13 @@ namespace shapectl {
 class WorkspacePool : public std::enable_shared_from_this<WorkspacePool> {
  public:
   // `make` builds a new workspace when none is free; at most `keep` free ones are kept.
-  static std::shared_ptr<WorkspacePool> create(std::function<StaticsWorkspace()> make, int keep = 4);
+  static std::shared_ptr<WorkspacePool> create(std::function<StaticsWorkspace()> make,
+                                               int keep = 4);
   std::shared_ptr<StaticsWorkspace> acquire();
 
  private:
-  WorkspacePool(std::function<StaticsWorkspace()> make, int keep) : make_(std::move(make)), keep_(keep) {}
+  WorkspacePool(std::function<StaticsWorkspace()> make, int keep)
+      : make_(std::move(make)), keep_(keep) {}
   void release(StaticsWorkspace* ws);
 
   std::function<StaticsWorkspace()> make_;
