@@ -3,6 +3,7 @@
 // (docs/gui.md).
 #include <iostream>
 
+#include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/link/make_robot_link.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
@@ -23,6 +24,7 @@ struct ServeArgs {
   std::string web_root;
   std::string scenes_dir;
   double rate = 30;
+  std::string world;  // the simulated real object (docs/calibration.md)
 };
 
 void run_serve(const ServeArgs& args) {
@@ -54,6 +56,17 @@ void run_serve(const ServeArgs& args) {
     link->start();
   }
   server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get());
+  if (!args.world.empty()) {
+    if (args.robot != "sim")
+      throw InputError("serve", "--world", "--robot sim (a real robot holds a real object)");
+    const Scene model = load_scene(scene), world = load_scene(args.world);
+    SimulatedCamera camera;  // markers on the target nodes, set at every tick
+    try {
+      session.set_world(std::make_unique<SimulatedWorld>(world, model, camera, 10.0));
+    } catch (const std::invalid_argument& e) {
+      throw InputError(args.world, "object", e.what());
+    }
+  }
   server::Server server(session, options);
   std::cout << "shapectl serve: open " << server.url() << " (scene " << session.scene_name()
             << "; Ctrl-C stops)" << std::endl;
@@ -86,6 +99,11 @@ void add_serve_command(CLI::App& app) {
                   "Directory with index.html (default: the repository's web/)");
   cmd->add_option("--scenes-dir", args->scenes_dir,
                   "Scenes offered for switching (default: scenes/)");
+  cmd->add_option(
+         "--world", args->world,
+         "WORLD.json: simulate the real object (with --robot sim); a camera observes the target "
+         "nodes 10 times a second and the page's feedback switch closes the loop")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--rate", args->rate, "State messages per second to each page")
       ->check(CLI::Range(1.0, 120.0))
       ->capture_default_str();

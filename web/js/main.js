@@ -141,7 +141,8 @@ function onState(state) {
 
   $('feedback').checked = !!state.feedback;
   $('observed').textContent = state.observations
-    ? `${state.observations} observations · model error ${mm(state.model_error)} mm · observed error ${mm(state.observed_error)} mm`
+    ? `${state.observations} observations · model error ${mm(state.model_error)} mm · observed error ${mm(state.observed_error)} mm` +
+      (state.true_error === null || state.true_error === undefined ? '' : ` · true error (simulated world) ${mm(state.true_error)} mm`)
     : 'no observations yet';
 
   if (state.link) {

@@ -299,6 +299,31 @@ void Session::tick() {
   history_.push_back({t, snapshot_->error.mean, t - last_edit_time_ < editing_window});
   while (history_.size() > history_capacity) history_.pop_front();
   if (link_) link_->set_target(snapshot_->joints, snapshot_->safe);
+  if (world_ && link_) observe_world(t);
+}
+
+void Session::set_world(std::unique_ptr<SimulatedWorld> world) {
+  if (!link_)
+    throw InputError("serve", "--world", "a robot link (--robot sim) holding the world's object");
+  world_ = std::move(world);
+  scenes_.erase(std::remove_if(scenes_.begin(), scenes_.end(),
+                               [&](const SceneEntry& e) { return e.name != scene_name_; }),
+                scenes_.end());
+  scene_description_ = describe_scene();  // its list of scenes
+}
+
+void Session::observe_world(double time) {
+  const LinkStatus st = link_->status();
+  if (st.measured.size() != snapshot_->joints.size()) return;  // no feedback yet
+  world_->camera().marker_nodes = snapshot_->targets.nodes;
+  const std::optional<ObservationFrame> frame = world_->step(time, st.measured);
+  true_error_ = world_->true_error(snapshot_->targets);
+  if (!frame || frame->markers.empty()) return;
+  ShapeObservation o;
+  o.joints = frame->joints;
+  o.time = time;
+  for (const ObservedMarker& m : frame->markers) o.markers.emplace_back(m.node, m.position);
+  controller_->observe(o);
 }
 
 bool Session::busy() const { return snapshot_->status == ControllerStatus::Optimizing; }
@@ -377,6 +402,7 @@ std::string Session::state_message(int clients) const {
       {"model_error", finite_or_null(s.model_error)},
       {"observed_error", finite_or_null(s.observed_error)},
       {"observed_markers", observed_markers_json(s.observed_markers)},
+      {"true_error", world_ ? finite_or_null(true_error_) : nlohmann::json()},
       {"clients", clients},
       {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)}};
   return m.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/control/controller.hpp>
 #include <shapectl/server/protocol.hpp>
 
@@ -54,8 +55,13 @@ class Session {
   // Validates and applies one client message; never throws for bad input.
   Reply handle(std::string_view text);
 
-  // Called at the streaming rate: samples the history, forwards θ to the link.
+  // Called at the streaming rate: samples the history, forwards θ to the link, and with a
+  // simulated world settles it at the link's measured joints and sends its camera's
+  // observations (markers on the current target nodes) to the controller.
   void tick();
+  // `serve --world`: the simulated real object; needs a link (its measured joints) and holds
+  // only for the scene it was made for (the session then offers no other).
+  void set_world(std::unique_ptr<SimulatedWorld> world);
   // JSON "scene" message: static description (robot geometry, mesh triangles, grips, scene
   // list, limits, history). Sent on connect and after a scene switch.
   std::string scene_message() const;
@@ -77,6 +83,7 @@ class Session {
   ProtocolContext context() const;
   nlohmann::json describe_scene() const;
   double now() const;
+  void observe_world(double time);
 
   std::vector<SceneEntry> scenes_;
   std::string scene_name_;
@@ -94,6 +101,8 @@ class Session {
   std::chrono::steady_clock::time_point started_;
   double last_edit_time_ = -1e9;
   std::deque<HistorySample> history_;
+  std::unique_ptr<SimulatedWorld> world_;
+  double true_error_ = NAN;  // the world's, at the last tick (NaN without a world or targets)
 };
 
 }  // namespace shapectl::server
