@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <shapectl/calib/live_observation.hpp>
 #include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/control/controller.hpp>
 #include <shapectl/control/targets_file.hpp>
@@ -215,11 +216,7 @@ void observe_world(SimulatedWorld& world, Controller& controller, const Controll
   if (st.measured.size() != snap.joints.size()) return;  // no feedback from the robot yet
   const std::optional<ObservationFrame> frame = world.step(time, st.measured);
   if (!frame) return;
-  ShapeObservation o;
-  o.joints = frame->joints;
-  o.time = time;
-  for (const ObservedMarker& m : frame->markers) o.markers.emplace_back(m.node, m.position);
-  controller.observe(o);
+  controller.observe(live_observation(*frame));
   if (log)
     log->write("observation", {{"time", time},
                                {"true_error", world.true_error(snap.targets)},

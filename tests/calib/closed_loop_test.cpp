@@ -7,6 +7,7 @@
 #include <random>
 
 #include <shapectl/calib/joint_path.hpp>
+#include <shapectl/calib/live_observation.hpp>
 #include <shapectl/calib/simulated_camera.hpp>
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
@@ -125,10 +126,7 @@ TEST(ClosedLoop, TheControllerWithFeedbackOnReachesTheTargetsOnTheObservedBar) {
     truth = world.solve_from(s->joints, truth.positions());
     ASSERT_TRUE(truth.statics().converged()) << truth.statics().reason;
     const ObservationFrame frame = camera.observe(world.mesh(), truth.positions(), s->joints, rng);
-    ShapeObservation o;
-    o.joints = s->joints;
-    for (const ObservedMarker& m : frame.markers) o.markers.emplace_back(m.node, m.position);
-    controller.observe(o);
+    controller.observe(live_observation(frame));
   }
   controller.step_once();
   s = controller.snapshot();

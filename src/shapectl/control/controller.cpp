@@ -107,7 +107,8 @@ struct Controller::State {
     objective = std::make_unique<ReducedObjective>(
         objective->with_targets(feedback_on ? feedback->corrected(user_targets) : user_targets));
   }
-  void take(const ShapeObservation& observation);
+  // Takes an observation into the feedback; true when the optimizer was re-aimed.
+  bool take(const ShapeObservation& observation);
   // Whether the corrected targets moved past the threshold from those aimed at now.
   bool moved_enough(const ShapeTargets& corrected) const;
   void iterate();
@@ -166,10 +167,7 @@ void Controller::State::apply(Inbox in) {
     feedback_on = *in.feedback;
     aim();
   }
-  const std::vector<Vec3> aimed_before = objective->targets().positions;
-  if (in.observation) take(*in.observation);
-  const bool reaimed =
-      in.observation && feedback_on && objective->targets().positions != aimed_before;
+  const bool reaimed = in.observation && take(*in.observation);
   if (in.clear || in.targets || in.centerline || in.reset || in.feedback || reaimed) {
     objective->rescore(current);
     optimizer->reset();
@@ -177,13 +175,13 @@ void Controller::State::apply(Inbox in) {
   idle = false;
 }
 
-void Controller::State::take(const ShapeObservation& observation) {
+bool Controller::State::take(const ShapeObservation& observation) {
   // The model's prediction at the joints the observation was taken at (the robot may lag θ*).
   Evaluation predicted = objective->evaluate(observation.joints, current.positions, 0, &current);
   if (!predicted.statics.converged()) {
     last_error =
         "observation ignored: no equilibrium at its joints (" + predicted.statics.reason + ")";
-    return;
+    return false;
   }
   feedback->observe(observation.markers, predicted.positions);
   observed_markers = observation.markers;
@@ -194,7 +192,9 @@ void Controller::State::take(const ShapeObservation& observation) {
     for (int k = 0; k < user_targets.size(); ++k)
       if (user_targets.nodes[k] == node) sum += (y - user_targets.positions[k]).norm(), ++count;
   observed_error = count ? sum / count : NAN;
-  if (feedback_on && moved_enough(feedback->corrected(user_targets))) aim();
+  if (!feedback_on || !moved_enough(feedback->corrected(user_targets))) return false;
+  aim();
+  return true;
 }
 
 bool Controller::State::moved_enough(const ShapeTargets& corrected) const {

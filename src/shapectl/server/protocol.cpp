@@ -1,6 +1,6 @@
 #include <shapectl/server/protocol.hpp>
 
-#include <shapectl/calib/observations.hpp>
+#include <shapectl/calib/live_observation.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -187,11 +187,7 @@ ShapeObservation read_observation(const JsonInput& frame, const ProtocolContext&
     frame.fail_problem(
         "a frame without markers: the live loop uses markers (point clouds go to shapectl "
         "calibrate)");
-  ShapeObservation o;
-  o.joints = f.joints;
-  o.time = f.time.value_or(0);
-  for (const ObservedMarker& m : f.markers) o.markers.emplace_back(m.node, m.position);
-  return o;
+  return live_observation(f);
 }
 
 // The keys a command of this type may have, each read and checked into `c`.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <fstream>
 
+#include <shapectl/calib/live_observation.hpp>
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
@@ -319,11 +320,7 @@ void Session::observe_world(double time) {
   const std::optional<ObservationFrame> frame = world_->step(time, st.measured);
   true_error_ = world_->true_error(snapshot_->targets);
   if (!frame || frame->markers.empty()) return;
-  ShapeObservation o;
-  o.joints = frame->joints;
-  o.time = time;
-  for (const ObservedMarker& m : frame->markers) o.markers.emplace_back(m.node, m.position);
-  controller_->observe(o);
+  controller_->observe(live_observation(*frame));
 }
 
 bool Session::busy() const { return snapshot_->status == ControllerStatus::Optimizing; }
