@@ -114,9 +114,13 @@ function onState(state) {
   // "converged" means stationary; away from the targets that is no success to show in green.
   const missed = state.status === ControllerStatus.Converged && state.targets.length > 0 &&
     state.error.mean !== null && state.error.mean > REACHED;
+  const mm = (v) => (v === null || v === undefined ? '–' : (1000 * v).toFixed(2));
+  // With observations of the real object, "reached" is about the real object, not the model.
+  const realMiss = state.status === ControllerStatus.Converged && state.observations > 0 &&
+    state.observed_error !== null && state.observed_error > REACHED;
   if (missed) setBadge('status', `${state.status}, not reached`, 'busy');
+  else if (realMiss) setBadge('status', `${state.status}, real object ${mm(state.observed_error)} mm off`, 'busy');
   else setBadge('status', state.status, STATUS_BADGE[state.status]);
-  const mm = (v) => (v === null ? '–' : (1000 * v).toFixed(2));
   $('error-mean').textContent = state.targets.length ? mm(state.error.mean) : '–';
   $('error-max').textContent = state.targets.length ? mm(state.error.max) : '–';
   $('rate').textContent = (state.iterations_per_second ?? 0).toFixed(0);
