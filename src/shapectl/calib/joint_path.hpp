@@ -7,7 +7,8 @@
 
 namespace shapectl {
 
-// Throws std::runtime_error naming the step when an equilibrium on the way is not found.
+// A step where Newton does not converge is halved (up to 4 times). Throws std::runtime_error
+// with Newton's reason when an equilibrium on the way is not found even so.
 ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::VectorXd& joints,
                                    double max_step = 0.05);
 

@@ -9,6 +9,7 @@ namespace shapectl {
 inline ShapeObservation live_observation(const ObservationFrame& frame) {
   ShapeObservation o;
   o.joints = frame.joints;
+  o.sigma = frame.sigma;
   o.time = frame.time.value_or(0);
   for (const ObservedMarker& m : frame.markers) o.markers.emplace_back(m.node, m.position);
   return o;

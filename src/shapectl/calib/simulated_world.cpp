@@ -23,9 +23,13 @@ SimulatedWorld::SimulatedWorld(const Scene& world, const Scene& model, Simulated
 
 std::optional<ObservationFrame> SimulatedWorld::step(double time,
                                                      const Eigen::VectorXd& measured_joints) {
-  ObjectState next = object_.solve_from(measured_joints, state_->positions());
-  if (!next.statics().converged()) next = equilibrium_along_path(object_, measured_joints);
-  state_.emplace(std::move(next));
+  // A robot standing still leaves the world as it is: no solve (it shares the cores with the
+  // controller it is testing).
+  if (measured_joints != state_->joints()) {
+    ObjectState next = object_.solve_from(measured_joints, state_->positions());
+    if (!next.statics().converged()) next = equilibrium_along_path(object_, measured_joints);
+    state_.emplace(std::move(next));
+  }
   if (time < next_time_) return std::nullopt;
   next_time_ = std::max(next_time_ + period_, time);
   ObservationFrame frame =

@@ -120,8 +120,9 @@ struct Controller::State {
   bool replace_model(const Scene& model);
   // Takes an observation into the feedback; true when the optimizer was re-aimed.
   bool take(const ShapeObservation& observation);
-  // Whether the corrected targets moved past the threshold from those aimed at now.
-  bool moved_enough(const ShapeTargets& corrected) const;
+  // Whether the corrected targets moved (RMS over the targets) past the threshold, or past
+  // what the estimate's noise explains for observations of noise `sigma`, from those aimed at.
+  bool moved_enough(const ShapeTargets& corrected, double sigma) const;
   void iterate();
   void publish();
   void run();
@@ -238,18 +239,23 @@ bool Controller::State::take(const ShapeObservation& observation) {
     for (int k = 0; k < user_targets.size(); ++k)
       if (user_targets.nodes[k] == node) sum += (y - user_targets.positions[k]).norm(), ++count;
   observed_error = count ? sum / count : NAN;
-  if (!feedback_on || !moved_enough(feedback->corrected(user_targets))) return false;
+  if (!feedback_on || !moved_enough(feedback->corrected(user_targets), observation.sigma))
+    return false;
   aim();
   return true;
 }
 
-bool Controller::State::moved_enough(const ShapeTargets& corrected) const {
+bool Controller::State::moved_enough(const ShapeTargets& corrected, double sigma) const {
   const ShapeTargets& aimed = objective->targets();
   if (aimed.size() != corrected.size()) return true;
+  if (aimed.size() == 0) return false;
+  double sum = 0;
   for (int k = 0; k < aimed.size(); ++k)
-    if ((aimed.positions[k] - corrected.positions[k]).norm() > options.feedback.retarget_threshold)
-      return true;
-  return false;
+    sum += (aimed.positions[k] - corrected.positions[k]).squaredNorm();
+  // The filtered estimate's own noise (3 axes) is σ·√(3g/(2−g)): twice that is noise, not news.
+  const double g = options.feedback.gain;
+  const double noise = sigma * std::sqrt(3 * g / (2 - g));
+  return std::sqrt(sum / aimed.size()) > std::max(options.feedback.retarget_threshold, 2 * noise);
 }
 
 void Controller::State::iterate() {
@@ -439,6 +445,8 @@ void Controller::observe(ShapeObservation observation) {
   if (!observation.joints.allFinite()) throw InputError("observation", "joints", "finite values");
   if (observation.markers.empty())
     throw InputError("observation", "markers", "at least one marker");
+  if (!(observation.sigma > 0 && std::isfinite(observation.sigma)))
+    throw InputError("observation", "sigma", "a positive number of metres", observation.sigma);
   for (std::size_t k = 0; k < observation.markers.size(); ++k) {
     const auto& [node, position] = observation.markers[k];
     const std::string where = "markers[" + std::to_string(k) + "]";

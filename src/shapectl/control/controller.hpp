@@ -32,7 +32,8 @@ struct ControllerOptions {
 struct ShapeObservation {
   Eigen::VectorXd joints;
   std::vector<std::pair<int, Vec3>> markers;
-  double time = 0;  // s, as the observer stamped it
+  double sigma = 0.001;  // m, the markers' noise (standard deviation per axis)
+  double time = 0;       // s, as the observer stamped it
 };
 
 // What the controller is doing, as published.

@@ -25,8 +25,9 @@ struct FeedbackOptions {
   // Per observation, in (0, 1]: the estimate's noise is σ·√(g/(2−g)) (0.33σ at 0.2), and it
   // settles in ~1/g observations (5 at 0.2: half a second at a camera's 10 Hz).
   double gain = 0.2;
-  // The optimizer is re-aimed only when a corrected target moves by more than this (m): noise
-  // must not keep the robot chasing.
+  // The optimizer is re-aimed only when the corrected targets move (RMS) by more than this
+  // (m), or by more than twice the estimate's noise at the observations' σ: noise must not
+  // keep the robot chasing.
   double retarget_threshold = 0.0002;
   double max_correction = 0.05;  // m, per node
   int neighbours = 4;            // observed nodes an unobserved node's estimate comes from
