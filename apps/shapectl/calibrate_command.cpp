@@ -1,5 +1,5 @@
 // shapectl calibrate SCENE.json --observations OBS.json --out CALIBRATED.json
-//   [--fit youngs_modulus,poisson_ratio,density,grip_offsets] [--report REPORT.json]
+//   [--fit youngs_modulus,poisson_ratio,density,grip_offsets,object_pose] [--report REPORT.json]
 // Fits the scene's physical parameters to observed frames of the real object
 // (docs/calibration.md) and writes the scene with the fitted values.
 #include <iostream>
@@ -19,9 +19,34 @@ namespace {
 
 struct CalibrateArgs {
   std::string scene, observations, out, report;
-  std::string fit = "youngs_modulus,grip_offsets";
+  std::string fit;  // default: default_fit(scene)
   int max_iterations = 30;
 };
+
+// A robot's grips are where the real object is held off; a clamp is where the scene puts it.
+const char* default_fit(const Scene& scene) {
+  return scene.robot ? "youngs_modulus,grip_offsets" : "youngs_modulus,object_pose";
+}
+
+// The parameters to fit; --fit names one the scene does not have → InputError naming --fit.
+FitSelection fit_selection(const CalibrateArgs& args, const Scene& scene) {
+  const std::string list = args.fit.empty() ? default_fit(scene) : args.fit;
+  FitSelection fit;
+  try {
+    fit = parse_fit_selection(list);
+  } catch (const std::invalid_argument&) {
+    throw InputError("--fit", "",
+                     "a comma-separated list of youngs_modulus, poisson_ratio, density, "
+                     "grip_offsets, object_pose",
+                     list);
+  }
+  try {
+    const ParameterSpace space(scene, fit);  // refuses what the scene does not have
+  } catch (const std::invalid_argument& e) {
+    throw InputError("--fit", "", std::string(e.what()) + " (" + args.scene + ")");
+  }
+  return fit;
+}
 
 nlohmann::ordered_json report_json(const CalibrationResult& r) {
   nlohmann::ordered_json out;
@@ -81,19 +106,11 @@ void print_summary(const CalibrationResult& r) {
 void run_calibrate(const CalibrateArgs& args) {
   const Scene scene = load_scene(args.scene);
   print_scene_notes(scene);
-  if (!scene.robot)
-    throw InputError(args.scene, "robot", "a robot holding the object (missing key)");
-  FitSelection fit;
-  try {
-    fit = parse_fit_selection(args.fit);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(
-        "--fit", "",
-        "a comma-separated list of youngs_modulus, poisson_ratio, density, grip_offsets", args.fit);
-  }
+  const FitSelection fit = fit_selection(args, scene);
   const Observations observations =
-      load_observations(args.observations, {.node_count = scene.object_mesh->node_count(),
-                                            .robot = scene.robot->model.get()});
+      load_observations(args.observations,
+                        {.node_count = scene.object_mesh->node_count(),
+                         .robot = scene.robot ? scene.robot->model.get() : nullptr});
   CalibrationResult result;
   try {
     result = calibrate(scene, observations, fit, {.max_iterations = args.max_iterations});
@@ -116,9 +133,9 @@ void run_calibrate(const CalibrateArgs& args) {
 
 void add_calibrate_command(CLI::App& app) {
   auto args = std::make_shared<CalibrateArgs>();
-  auto* cmd =
-      app.add_subcommand("calibrate",
-                         "Fit material and grip offsets to observations of the real object");
+  auto* cmd = app.add_subcommand(
+      "calibrate",
+      "Fit material, grip offsets or the object's pose to observations of the real object");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
   cmd->add_option("--observations", args->observations, "OBSERVATIONS.json (docs/calibration.md)")
       ->required();
@@ -126,8 +143,9 @@ void add_calibrate_command(CLI::App& app) {
       ->required();
   cmd->add_option(
       "--fit", args->fit,
-      "parameters to fit, comma-separated: youngs_modulus, poisson_ratio, density, grip_offsets "
-      "(default youngs_modulus,grip_offsets)");
+      "parameters to fit, comma-separated: youngs_modulus, poisson_ratio, density, grip_offsets, "
+      "object_pose (default youngs_modulus,grip_offsets with a robot, "
+      "youngs_modulus,object_pose for an object held by fixed nodes alone)");
   cmd->add_option("--report", args->report,
                   "REPORT.json: values, standard deviations, residuals, identifiability");
   cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")

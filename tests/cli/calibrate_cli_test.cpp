@@ -1,5 +1,5 @@
 // The `shapectl calibrate` contract: a calibrated scene every command accepts, a report, and
-// bad observations named.
+// bad observations named; for a robot's scene and for one held by fixed nodes alone.
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
@@ -12,6 +12,7 @@
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/scene_io/scene_writer.hpp>
+#include <shapectl/sim/object_statics.hpp>
 
 #include "support/test_support.hpp"
 
@@ -22,6 +23,16 @@ using test::run_cli;
 using test::TempDir;
 
 const std::filesystem::path kCantilever = test::source_path("scenes/yumi_cantilever.json");
+const std::filesystem::path kClamped = test::source_path("scenes/foam_bar_clamped.json");
+
+// One frame of OBS.json: its markers and σ, and its joints by `names` (none without a robot).
+nlohmann::json frame_json(const ObservationFrame& f, const std::vector<std::string>& names) {
+  nlohmann::json frame = {{"markers", nlohmann::json::array()}, {"sigma", f.sigma}};
+  for (std::size_t j = 0; j < names.size(); ++j) frame["joints"][names[j]] = f.joints[j];
+  for (const ObservedMarker& m : f.markers)
+    frame["markers"].push_back({{"node", m.node}, {"position", vec3_json(m.position)}});
+  return frame;
+}
 
 // OBS.json of a "real" cantilever 1.8× stiffer and gripped 3 mm off, 15 markers at 3 poses.
 nlohmann::json synthetic_observations(const Scene& model) {
@@ -38,16 +49,10 @@ nlohmann::json synthetic_observations(const Scene& model) {
   for (double swing : {0.0, 0.15, -0.1}) {
     Eigen::VectorXd joints = model.robot->reference_joints;
     joints[0] += swing, joints[6] += 2 * swing;
-    const ObservationFrame f =
-        camera.observe(world.mesh(), equilibrium_along_path(world, joints).positions(), joints,
-                       rng);
-    nlohmann::json frame = {{"joints", nlohmann::json::object()},
-                            {"markers", nlohmann::json::array()},
-                            {"sigma", f.sigma}};
-    for (std::size_t j = 0; j < names.size(); ++j) frame["joints"][names[j]] = joints[j];
-    for (const ObservedMarker& m : f.markers)
-      frame["markers"].push_back({{"node", m.node}, {"position", vec3_json(m.position)}});
-    frames.push_back(frame);
+    frames.push_back(
+        frame_json(camera.observe(world.mesh(), equilibrium_along_path(world, joints).positions(),
+                                  joints, rng),
+                   names));
   }
   return {{"frames", frames}};
 }
@@ -79,6 +84,9 @@ TEST_F(CalibrateCli, WritesASceneEveryCommandAcceptsAndAReport) {
   EXPECT_GT(r["parameters"][0]["standard_deviation"].get<double>(), 0);
   EXPECT_EQ(r["frames"].size(), 3u);
   EXPECT_LT(r["rms_after"].get<double>(), r["rms_before"].get<double>());
+  // The object's pose was not fitted: it stays as the file wrote it.
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(out))["object"]["pose"],
+            nlohmann::json::parse(test::read_text(kCantilever))["object"]["pose"]);
   const auto statics = run_cli({"statics", out, "--out", (dir.path() / "statics.json").string()});
   EXPECT_EQ(statics.exit_code, 0) << statics.err;
 }
@@ -125,6 +133,95 @@ TEST_F(CalibrateCli, BadObservationsExitOneNamingTheField) {
     EXPECT_NE(run.err.find(c.field), std::string::npos) << c.what << ": " << run.err;
     EXPECT_FALSE(std::filesystem::exists(out)) << c.what << ": nothing written";
   }
+}
+
+// A scene without a robot: the clamped foam bar's stiffness and clamp pose, the fitted pose in
+// a scene every command accepts, and frames that must not name joints.
+
+// The "real" bar: 1.5× stiffer, its clamp 3 mm and 2° off the scene's placement.
+Scene true_clamped_bar(const Scene& model) {
+  Scene truth = model;
+  truth.material = material_from_youngs(1.5 * youngs_modulus_of(model.material),
+                                        poisson_ratio_of(model.material), model.material.density);
+  truth.T_world_object =
+      Eigen::Translation3d(0.003, 0, 0) * Eigen::AngleAxisd(2 * M_PI / 180, Vec3::UnitY());
+  return truth;
+}
+
+// OBS.json of the clamped bar: two frames of the true equilibrium, 15 markers each, no joints.
+nlohmann::json clamped_observations(const Scene& truth) {
+  Positions x = truth.world_rest_positions();
+  const ObjectStatics statics(truth);
+  EXPECT_TRUE(statics.solve(x).converged());
+  SimulatedCamera camera;
+  for (int node = 3; node < statics.mesh().node_count(); node += 28)
+    camera.marker_nodes.push_back(node);
+  std::mt19937 rng(5);
+  nlohmann::json frames = nlohmann::json::array();
+  for (int k = 0; k < 2; ++k)
+    frames.push_back(frame_json(camera.observe(statics.mesh(), x, Eigen::VectorXd(), rng), {}));
+  return {{"frames", frames}};
+}
+
+class CalibrateFixedCli : public ::testing::Test {
+ protected:
+  TempDir dir;
+  Scene model = load_scene(kClamped);
+  Scene truth = true_clamped_bar(model);
+  std::filesystem::path observations = dir.write("obs.json", clamped_observations(truth).dump());
+  std::string out = (dir.path() / "calibrated.json").string();
+  std::string report = (dir.path() / "report.json").string();
+};
+
+TEST_F(CalibrateFixedCli, FitsStiffnessAndClampPoseIntoASceneEveryCommandAccepts) {
+  const auto run = run_cli({"calibrate", kClamped.string(), "--observations", observations.string(),
+                            "--out", out, "--report", report});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json r = nlohmann::json::parse(test::read_text(report));
+  ASSERT_EQ(r["parameters"].size(), 1u + 6u);  // the default for a clamped scene: E and pose
+  EXPECT_EQ(r["parameters"][1]["name"], "object_pose.x");
+  EXPECT_TRUE(r["converged"].get<bool>());
+  EXPECT_EQ(r["frames"].size(), 2u);
+  const Scene calibrated = load_scene(out);
+  EXPECT_NEAR(youngs_modulus_of(calibrated.material), youngs_modulus_of(truth.material),
+              4 * r["parameters"][0]["standard_deviation"].get<double>());
+  EXPECT_LT((calibrated.T_world_object.translation() - truth.T_world_object.translation()).norm(),
+            0.0005);
+  EXPECT_LT(Eigen::AngleAxisd(calibrated.T_world_object.linear() *
+                              truth.T_world_object.linear().transpose())
+                .angle(),
+            0.5 * M_PI / 180);
+  EXPECT_TRUE(nlohmann::json::parse(test::read_text(out))["object"].contains("pose"));
+  const auto statics = run_cli({"statics", out, "--out", (dir.path() / "statics.json").string()});
+  EXPECT_EQ(statics.exit_code, 0) << statics.err;
+}
+
+TEST_F(CalibrateFixedCli, AFrameWithJointsExitsOneNamingTheField) {
+  nlohmann::json bad = nlohmann::json::parse(test::read_text(observations));
+  bad["frames"][1]["joints"] = {{"yumi_joint_1_l", 0.1}};
+  const auto file = dir.write("bad.json", bad.dump());
+  const auto run =
+      run_cli({"calibrate", kClamped.string(), "--observations", file.string(), "--out", out});
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("bad.json: frames[1].joints: the scene has no robot"), std::string::npos)
+      << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST_F(CalibrateFixedCli, ParametersTheSceneDoesNotHaveExitOneNamingFit) {
+  const auto grips = run_cli({"calibrate", kClamped.string(), "--observations",
+                              observations.string(), "--out", out, "--fit", "grip_offsets"});
+  EXPECT_EQ(grips.exit_code, 1) << grips.err;
+  EXPECT_NE(grips.err.find("--fit: grip_offsets: the scene has no grips"), std::string::npos)
+      << grips.err;
+  const std::string gripped = test::source_path("scenes/yumi_bar.json").string();
+  const auto pose = run_cli({"calibrate", gripped, "--observations", observations.string(), "--out",
+                             out, "--fit", "youngs_modulus,object_pose"});
+  EXPECT_EQ(pose.exit_code, 1) << pose.err;
+  EXPECT_NE(pose.err.find("--fit: object_pose: the object is held by the robot's grips alone"),
+            std::string::npos)
+      << pose.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace

@@ -7,7 +7,7 @@
 
 #include <Eigen/SVD>
 
-#include <shapectl/calib/joint_path.hpp>
+#include <shapectl/calib/equilibria.hpp>
 #include <shapectl/calib/observation_residuals.hpp>
 
 namespace shapectl {
@@ -18,8 +18,7 @@ using Kind = ParameterCoordinate::Kind;
 
 // The frames' residuals with the model at one set of parameters.
 struct FitPoint {
-  PhysicalParameters parameters;
-  std::vector<Positions> positions;  // each frame's equilibrium
+  Equilibria equilibria;  // the parameters and each frame's equilibrium
   std::vector<FrameResiduals> frames;
   std::vector<double> cutoffs;  // each frame's outlier cut-off
   double cost = 0;
@@ -65,44 +64,28 @@ class CalibrationProblem {
         options_(options),
         surface_(scene.object_mesh->surface_triangles()) {}
 
-  // The fit at p. Equilibria start from `warm` (a frame's earlier equilibrium) or, without one
-  // or when that fails, walk from the reference joints. New cut-offs are chosen from the
-  // result when `cutoffs` is empty; the Jacobian is formed when asked.
-  FitPoint evaluate(const PhysicalParameters& p, const std::vector<Positions>& warm,
+  // The fit at p. Equilibria start from `warm`'s (see frame_equilibria). New cut-offs are
+  // chosen from the result when `cutoffs` is empty; the Jacobian is formed when asked.
+  FitPoint evaluate(const PhysicalParameters& p, const Equilibria* warm,
                     const std::vector<double>& cutoffs, bool with_jacobian) {
-    const GrippedObject object(p.applied_to(scene_));
     FitPoint out;
-    out.parameters = p;
+    out.equilibria =
+        frame_equilibria(scene_, space_, p, observations_, warm,
+                         {.with_sensitivity = with_jacobian, .path_step = options_.path_step});
+    const Equilibrium* surface_at = nullptr;  // frames of a fixed scene share one equilibrium
     for (std::size_t k = 0; k < observations_.frames.size(); ++k) {
       const ObservationFrame& frame = observations_.frames[k];
-      ObjectState state = equilibrium(object, frame.joints, warm.empty() ? nullptr : &warm[k], k);
-      surface_.update(state.positions());
+      const Equilibrium& e = *out.equilibria.frames[k];
+      if (&e != surface_at) surface_.update(e.positions), surface_at = &e;
       const double cutoff = cutoffs.empty() ? outlier_cutoff(frame, surface_) : cutoffs[k];
-      Eigen::MatrixXd dx_dz;
-      if (with_jacobian)
-        dx_dz = object.force_response(state, space_.force_derivatives(object, state, p));
-      out.frames.push_back(frame_residuals(frame, state.positions(), surface_, cutoff, dx_dz));
+      out.frames.push_back(frame_residuals(frame, e.positions, surface_, cutoff, e.dx_dz));
       out.cutoffs.push_back(cutoff);
       out.cost += out.frames.back().cost();
-      out.positions.push_back(state.positions());
     }
     return out;
   }
 
  private:
-  ObjectState equilibrium(const GrippedObject& object, const Eigen::VectorXd& joints,
-                          const Positions* warm, std::size_t frame) const {
-    if (warm) {
-      ObjectState state = object.solve_from(joints, *warm);
-      if (state.statics().converged() && object.stable(state)) return state;
-    }
-    try {
-      return equilibrium_along_path(object, joints, options_.path_step);
-    } catch (const std::runtime_error& e) {
-      throw std::runtime_error("frame " + std::to_string(frame) + ": " + e.what());
-    }
-  }
-
   const Scene& scene_;
   const Observations& observations_;
   const ParameterSpace& space_;
@@ -116,8 +99,10 @@ int hold_rank(Kind kind) {
     case Kind::LogDensity: return 0;
     case Kind::PoissonLogit: return 1;
     case Kind::LogYoungsModulus: return 2;
-    case Kind::GripRotation: return 3;
-    case Kind::GripTranslation: return 4;
+    case Kind::GripRotation:
+    case Kind::PoseRotation: return 3;
+    case Kind::GripTranslation:
+    case Kind::PoseTranslation: return 4;
   }
   return 5;
 }
@@ -158,14 +143,27 @@ std::vector<int> identifiable_coordinates(const ParameterSpace& space, const Eig
   return active;
 }
 
+// Frames whose joints do not fit the scene (observations read for another scene).
+void check_frames(const Scene& scene, const Observations& observations) {
+  const Eigen::Index joints = scene.robot ? scene.robot->model->active_count() : 0;
+  for (std::size_t k = 0; k < observations.frames.size(); ++k)
+    if (observations.frames[k].joints.size() != joints)
+      throw std::invalid_argument("frame " + std::to_string(k) + ": " +
+                                  std::to_string(observations.frames[k].joints.size()) +
+                                  " joint values for a scene with " + std::to_string(joints) +
+                                  " active joints");
+}
+
 Eigen::MatrixXd columns(const Eigen::MatrixXd& J, const std::vector<int>& active) {
   Eigen::MatrixXd out(J.rows(), active.size());
   for (std::size_t a = 0; a < active.size(); ++a) out.col(a) = J.col(active[a]);
   return out;
 }
 
-// The value a coordinate reports: the physical parameter, or the offset's component.
-double reported_value(const ParameterCoordinate& c, const PhysicalParameters& p) {
+// The value a coordinate reports: the physical parameter, the offset's component, the pose's
+// position or its rotation from the `initial` pose (a rotation vector, world axes).
+double reported_value(const ParameterCoordinate& c, const PhysicalParameters& p,
+                      const PhysicalParameters& initial) {
   switch (c.kind) {
     case Kind::LogYoungsModulus: return p.youngs_modulus;
     case Kind::PoissonLogit: return p.poisson_ratio;
@@ -173,6 +171,11 @@ double reported_value(const ParameterCoordinate& c, const PhysicalParameters& p)
     case Kind::GripTranslation: return p.grip_offsets[c.grip].translation()[c.axis];
     case Kind::GripRotation: {
       const Eigen::AngleAxisd r(p.grip_offsets[c.grip].linear());
+      return (r.angle() * r.axis())[c.axis];
+    }
+    case Kind::PoseTranslation: return p.object_pose.translation()[c.axis];
+    case Kind::PoseRotation: {
+      const Eigen::AngleAxisd r(p.object_pose.linear() * initial.object_pose.linear().transpose());
       return (r.angle() * r.axis())[c.axis];
     }
   }
@@ -184,8 +187,10 @@ const char* unit_of(Kind kind) {
     case Kind::LogYoungsModulus: return "Pa";
     case Kind::PoissonLogit: return "";
     case Kind::LogDensity: return "kg/m^3";
-    case Kind::GripTranslation: return "m";
-    case Kind::GripRotation: return "rad";
+    case Kind::GripTranslation:
+    case Kind::PoseTranslation: return "m";
+    case Kind::GripRotation:
+    case Kind::PoseRotation: return "rad";
   }
   return "";
 }
@@ -195,14 +200,14 @@ const char* unit_of(Kind kind) {
 CalibrationResult calibrate(const Scene& scene, const Observations& observations,
                             const FitSelection& fit, const CalibrationOptions& options) {
   const auto started = std::chrono::steady_clock::now();
-  if (!scene.robot) throw std::invalid_argument("calibration needs a scene with a robot and grips");
   if (observations.frames.empty()) throw std::invalid_argument("no observed frames");
+  check_frames(scene, observations);
   const ParameterSpace space(scene, fit);
   CalibrationProblem problem(scene, observations, space, options);
   const PhysicalParameters initial = PhysicalParameters::of(scene);
 
   CalibrationResult result;
-  FitPoint at = problem.evaluate(initial, {}, {}, true);
+  FitPoint at = problem.evaluate(initial, nullptr, {}, true);
   const FitPoint before = at;
   const std::vector<int> active =
       identifiable_coordinates(space, at.jacobian(), options.identifiability_threshold,
@@ -229,14 +234,15 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
       }
       FitPoint next;
       try {
-        next = problem.evaluate(space.advanced(at.parameters, dz), at.positions, at.cutoffs, false);
+        next = problem.evaluate(space.advanced(at.equilibria.parameters, dz), &at.equilibria,
+                                at.cutoffs, false);
       } catch (const std::runtime_error&) {
         lambda *= 4;  // a step too far for statics: shorter
         continue;
       }
       if (next.cost < at.cost) {
         const double decrease = (at.cost - next.cost) / std::max(at.cost, 1e-300);
-        at = problem.evaluate(next.parameters, next.positions, {}, true);
+        at = problem.evaluate(next.equilibria.parameters, &next.equilibria, {}, true);
         lambda = std::max(lambda / 3, 1e-12);
         accepted = true;
         result.iterations = iteration + 1;
@@ -266,14 +272,14 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
     const ParameterCoordinate& c = space.coordinates()[k];
     FittedParameter f{.name = c.name,
                       .unit = unit_of(c.kind),
-                      .initial = reported_value(c, initial),
-                      .fitted = reported_value(c, at.parameters)};
+                      .initial = reported_value(c, initial, initial),
+                      .fitted = reported_value(c, at.equilibria.parameters, initial)};
     const auto a = std::find(active.begin(), active.end(), k);
     f.held = a == active.end();
     if (!f.held) {
       const Eigen::Index i = a - active.begin();
       f.standard_deviation =
-          space.physical_per_coordinate(c, at.parameters) * std::sqrt(covariance(i, i));
+          space.physical_per_coordinate(c, at.equilibria.parameters) * std::sqrt(covariance(i, i));
     }
     result.parameters.push_back(f);
   }
@@ -290,8 +296,8 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
   const Eigen::Index rows = at.residuals().size();
   const Eigen::Index dof = rows - static_cast<Eigen::Index>(active.size());
   result.chi_squared_per_dof = dof > 0 ? at.residuals().squaredNorm() / double(dof) : 0;
-  result.fitted = at.parameters;
-  result.scene = at.parameters.applied_to(scene);
+  result.fitted = at.equilibria.parameters;
+  result.scene = result.fitted.applied_to(scene);
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return result;

@@ -1,8 +1,9 @@
 #pragma once
 // Fits physical parameters (calib/model_parameters.hpp) to observed frames of the real object:
 // Levenberg–Marquardt on the noise-weighted residuals of every frame jointly
-// (calib/observation_residuals.hpp), each frame its own equilibrium at its joints, Jacobians
-// from the exact parameter sensitivities dx̂/dz = H⁻¹ ∂F/∂z.
+// (calib/observation_residuals.hpp), each frame its own equilibrium at its joints (a scene held
+// by fixed nodes alone: the one equilibrium, calib/equilibria.hpp), Jacobians from the exact
+// parameter sensitivities dx̂/dz.
 //
 // Identifiability first: the Jacobian at the start, its columns scaled by each coordinate's
 // typical size, is split by SVD; a direction whose standard deviation (the noise-weighted
@@ -23,7 +24,8 @@ namespace shapectl {
 struct CalibrationOptions {
   int max_iterations = 30;
   // Largest standard deviation, in units of the coordinate scales (10 % for material
-  // parameters, 1 mm and 0.01 rad for grip offsets), of a determined direction.
+  // parameters, 1 mm and 0.01 rad for grip offsets and the object's pose), of a determined
+  // direction.
   double identifiability_threshold = 0.1;
   // Steps to walk the joints from the reference configuration to a frame's (rad, largest joint).
   double path_step = 0.05;
@@ -31,8 +33,10 @@ struct CalibrationOptions {
 
 struct FittedParameter {
   std::string name;
-  std::string unit;    // "Pa", "", "kg/m^3", "m", "rad"
-  double initial = 0;  // physical value (grip offsets: the coordinate's, in m or rad)
+  std::string unit;  // "Pa", "", "kg/m^3", "m", "rad"
+  // Physical value; grip offsets: the coordinate's, in m or rad; the object's pose: its
+  // position (m), and its rotation from the scene's as a rotation vector in world axes (rad).
+  double initial = 0;
   double fitted = 0;
   double standard_deviation = 0;  // from the Gauss–Newton covariance with the frames' σ; 0 if held
   bool held = false;              // not identifiable from these observations: kept at `initial`
@@ -63,8 +67,9 @@ struct CalibrationResult {
   double seconds = 0;
 };
 
-// Throws std::invalid_argument for a scene without a robot or observations that do not match
-// it, std::runtime_error when a frame's equilibrium cannot be found.
+// Throws std::invalid_argument for a selection the scene does not allow (ParameterSpace) or
+// observations that do not match it (joints of another robot, or joints without one),
+// std::runtime_error when a frame's equilibrium cannot be found.
 CalibrationResult calibrate(const Scene& scene, const Observations& observations,
                             const FitSelection& fit, const CalibrationOptions& options = {});
 

@@ -25,6 +25,12 @@ Eigen::Matrix3d rotation_of(const Vec3& rotation_vector) {
   return Eigen::AngleAxisd(angle, rotation_vector / angle).toRotationMatrix();
 }
 
+// T moved on the left about its own origin: (exp([dr]) R, t + dt).
+void move(Eigen::Isometry3d& T, const Vec3& dt, const Vec3& dr) {
+  T.linear() = rotation_of(dr) * T.linear();
+  T.translation() += dt;
+}
+
 // ∂E_elastic/∂x for a material with only μ = 1 (or only κ = 1): the energy is linear in both.
 Eigen::VectorXd unit_elastic_gradient(const TetMesh& mesh, const Positions& x, double mu,
                                       double kappa) {
@@ -38,6 +44,27 @@ const char* axis_name(bool rotation, int axis) {
   return names[rotation][axis];
 }
 
+// Six coordinates of a rigid motion: 1 cm and 0.1 rad are changes worth noticing.
+void add_motion_coordinates(std::vector<ParameterCoordinate>& out, Kind translation, Kind rotation,
+                            int grip, const std::string& prefix) {
+  for (int r = 0; r < 2; ++r)
+    for (int axis = 0; axis < 3; ++axis)
+      out.push_back(
+          {r ? rotation : translation, grip, axis, prefix + axis_name(r, axis), r ? 0.1 : 0.01});
+}
+
+// Why the object's pose cannot be fitted in this scene; empty when it can.
+std::string object_pose_refusal(const Scene& scene) {
+  if (scene.robot && scene.fixed)
+    return "object_pose: the object is held by the robot's grips as well as by fixed nodes; its "
+           "pose is fitted only for scenes held by fixed nodes alone";
+  if (scene.robot)
+    return "object_pose: the object is held by the robot's grips alone, which tie it to the "
+           "grippers: its pose follows the joints (fit grip_offsets for where they hold it)";
+  if (!scene.fixed) return "object_pose: the scene has no fixed nodes to place";
+  return "";
+}
+
 }  // namespace
 
 FitSelection parse_fit_selection(const std::string& list) {
@@ -49,10 +76,11 @@ FitSelection parse_fit_selection(const std::string& list) {
     else if (item == "poisson_ratio") s.poisson_ratio = true;
     else if (item == "density") s.density = true;
     else if (item == "grip_offsets") s.grip_offsets = true;
+    else if (item == "object_pose") s.object_pose = true;
     else
       throw std::invalid_argument(
           "unknown parameter \"" + item +
-          "\" (expected youngs_modulus, poisson_ratio, density or grip_offsets)");
+          "\" (expected youngs_modulus, poisson_ratio, density, grip_offsets or object_pose)");
   }
   if (s.empty())
     throw std::invalid_argument("no parameter to fit (expected a comma-separated list)");
@@ -65,6 +93,7 @@ PhysicalParameters PhysicalParameters::of(const Scene& scene) {
   p.poisson_ratio = poisson_ratio_of(scene.material);
   p.density = scene.material.density;
   for (const Grip& g : scene.grips) p.grip_offsets.push_back(g.offset);
+  p.object_pose = scene.T_world_object;
   return p;
 }
 
@@ -72,6 +101,7 @@ Scene PhysicalParameters::applied_to(const Scene& scene) const {
   Scene out = scene;
   out.material = material_from_youngs(youngs_modulus, poisson_ratio, density);
   for (std::size_t k = 0; k < out.grips.size(); ++k) out.grips[k].offset = grip_offsets[k];
+  out.T_world_object = object_pose;
   return out;
 }
 
@@ -84,13 +114,16 @@ ParameterSpace::ParameterSpace(const Scene& scene, const FitSelection& selection
   if (selection.grip_offsets) {
     if (scene.grips.empty()) throw std::invalid_argument("grip_offsets: the scene has no grips");
     for (std::size_t g = 0; g < scene.grips.size(); ++g) {
-      const std::string prefix =
-          "grip_offsets." + scene.robot->end_effectors[scene.grips[g].end_effector].name + ".";
-      for (int rotation = 0; rotation < 2; ++rotation)
-        for (int axis = 0; axis < 3; ++axis)
-          coordinates_.push_back({rotation ? Kind::GripRotation : Kind::GripTranslation, int(g),
-                                  axis, prefix + axis_name(rotation, axis), rotation ? 0.1 : 0.01});
+      const std::string& hand = scene.robot->end_effectors[scene.grips[g].end_effector].name;
+      add_motion_coordinates(coordinates_, Kind::GripTranslation, Kind::GripRotation, int(g),
+                             "grip_offsets." + hand + ".");
     }
+  }
+  if (selection.object_pose) {
+    const std::string refusal = object_pose_refusal(scene);
+    if (!refusal.empty()) throw std::invalid_argument(refusal);
+    add_motion_coordinates(coordinates_, Kind::PoseTranslation, Kind::PoseRotation, -1,
+                           "object_pose.");
   }
 }
 
@@ -98,6 +131,7 @@ PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p,
                                             const Eigen::VectorXd& dz) const {
   PhysicalParameters out = p;
   std::vector<Vec3> dt(p.grip_offsets.size(), Vec3::Zero()), dr = dt;
+  Vec3 pose_dt = Vec3::Zero(), pose_dr = Vec3::Zero();
   for (int k = 0; k < size(); ++k) {
     const ParameterCoordinate& c = coordinates_[k];
     switch (c.kind) {
@@ -110,13 +144,12 @@ PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p,
       }
       case Kind::GripTranslation: dt[c.grip][c.axis] = dz[k]; break;
       case Kind::GripRotation: dr[c.grip][c.axis] = dz[k]; break;
+      case Kind::PoseTranslation: pose_dt[c.axis] = dz[k]; break;
+      case Kind::PoseRotation: pose_dr[c.axis] = dz[k]; break;
     }
   }
-  for (std::size_t g = 0; g < out.grip_offsets.size(); ++g) {
-    Eigen::Isometry3d& O = out.grip_offsets[g];
-    O.linear() = rotation_of(dr[g]) * O.linear();
-    O.translation() += dt[g];
-  }
+  for (std::size_t g = 0; g < out.grip_offsets.size(); ++g) move(out.grip_offsets[g], dt[g], dr[g]);
+  move(out.object_pose, pose_dt, pose_dr);
   return out;
 }
 
@@ -126,42 +159,62 @@ double ParameterSpace::physical_per_coordinate(const ParameterCoordinate& c,
     case Kind::LogYoungsModulus: return p.youngs_modulus;
     case Kind::LogDensity: return p.density;
     case Kind::PoissonLogit: return p.poisson_ratio * (1 - 2 * p.poisson_ratio);
-    case Kind::GripTranslation:
-    case Kind::GripRotation: return 1;
+    default: return 1;  // m and rad: the coordinates themselves
   }
-  return 1;
 }
 
-Eigen::MatrixXd ParameterSpace::force_derivatives(const GrippedObject& object,
-                                                  const ObjectState& state,
+Eigen::MatrixXd ParameterSpace::force_derivatives(const ObjectStatics& statics, const Scene& scene,
+                                                  const Positions& x,
                                                   const PhysicalParameters& p) const {
-  const Positions& x = state.positions();
-  const Scene& scene = object.scene();
   Eigen::MatrixXd dF = Eigen::MatrixXd::Zero(x.size(), size());
   // Elasticity is linear in (μ, κ); E scales both, so ∂F/∂ln E = −∂E_elastic/∂x.
   const double nu = p.poisson_ratio, E = p.youngs_modulus;
-  const Eigen::VectorXd g_mu = unit_elastic_gradient(object.mesh(), x, 1, 0);
-  const Eigen::VectorXd g_kappa = unit_elastic_gradient(object.mesh(), x, 0, 1);
+  const Eigen::VectorXd g_mu = unit_elastic_gradient(statics.mesh(), x, 1, 0);
+  const Eigen::VectorXd g_kappa = unit_elastic_gradient(statics.mesh(), x, 0, 1);
   const Material m = scene.material;
   // dμ/dν and dκ/dν of material_from_youngs.
   const double dmu_dnu = -E / (2 * (1 + nu) * (1 + nu));
   const double dkappa_dnu = E * (1 + 2 * nu * nu) / std::pow((1 + nu) * (1 - 2 * nu), 2);
   const double dnu_ds = nu * (1 - 2 * nu);
+  // Gravity's force mᵢ g: ∝ ρ, and turned by −δr when the scene turns by δr.
+  Eigen::VectorXd weight = Eigen::VectorXd::Zero(x.size());
+  Gravity(statics.mesh(), m.density, scene.gravity).add_gradient(x, weight);
+  weight = -weight;
   for (int k = 0; k < size(); ++k) {
     const ParameterCoordinate& c = coordinates_[k];
     switch (c.kind) {
       case Kind::LogYoungsModulus: dF.col(k) = -(m.mu * g_mu + m.kappa * g_kappa); break;
       case Kind::PoissonLogit: dF.col(k) = -(dmu_dnu * g_mu + dkappa_dnu * g_kappa) * dnu_ds; break;
-      case Kind::LogDensity: {
-        Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
-        Gravity(object.mesh(), m.density, scene.gravity).add_gradient(x, g);
-        dF.col(k) = -g;
+      case Kind::LogDensity: dF.col(k) = weight; break;
+      case Kind::PoseRotation:
+        for (Eigen::Index i = 0; i < x.size() / 3; ++i)
+          dF.col(k).segment<3>(3 * i) = Vec3(weight.segment<3>(3 * i)).cross(Vec3::Unit(c.axis));
         break;
-      }
-      case Kind::GripTranslation:
-      case Kind::GripRotation: break;  // below
+      default: break;  // grip and pose translation columns: no force on the object itself
     }
   }
+  return dF;
+}
+
+Eigen::MatrixXd ParameterSpace::pose_motion(const Positions& x, const PhysicalParameters& p) const {
+  Eigen::MatrixXd dx = Eigen::MatrixXd::Zero(x.size(), size());
+  const Vec3 origin = p.object_pose.translation();
+  for (int k = 0; k < size(); ++k) {
+    const ParameterCoordinate& c = coordinates_[k];
+    if (c.kind != Kind::PoseTranslation && c.kind != Kind::PoseRotation) continue;
+    for (Eigen::Index i = 0; i < x.size() / 3; ++i)
+      dx.col(k).segment<3>(3 * i) = c.kind == Kind::PoseTranslation
+                                        ? Vec3(Vec3::Unit(c.axis))
+                                        : Vec3::Unit(c.axis).cross(x.segment<3>(3 * i) - origin);
+  }
+  return dx;
+}
+
+Eigen::MatrixXd ParameterSpace::force_derivatives(const GrippedObject& object,
+                                                  const ObjectState& state,
+                                                  const PhysicalParameters& p) const {
+  const Scene& scene = object.scene();
+  Eigen::MatrixXd dF = force_derivatives(object.statics(), scene, state.positions(), p);
   // Grip springs: Fᵢ = −K (xᵢ − aᵢ), aᵢ = T_link(θ) pᵢ with pᵢ = tcp + t + R uᵢ in the link
   // frame. Moving the offset: ∂aᵢ/∂δt = R_link, ∂aᵢ/∂δr = −R_link [pᵢ − tcp − t]×.
   const std::vector<GrippedNode>& gripped = object.grips().nodes();

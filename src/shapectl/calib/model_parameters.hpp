@@ -2,10 +2,15 @@
 // The physical parameters calibration can fit, and their coordinates z: Young's modulus and
 // density as logarithms (positive), Poisson's ratio as s with ν = ½·logistic(s) (inside
 // (0, ½)), each grip's offset as 3 translations (m) and 3 rotations (rad) applied on the left,
-// O ← (exp([δr]) R, t + δt), about the TCP in the end effector's frame.
+// O ← (exp([δr]) R, t + δt), about the TCP in the end effector's frame; the object's pose
+// T_world_object (scenes held by fixed nodes alone) the same way, in world axes about the
+// object frame's origin o: the whole scene, clamp included, moved by δ.
 //
 // For equilibria x̂ the forces' derivatives ∂F/∂z (F = −∂E/∂x) give the parameter sensitivity
-// dx̂/dz = H⁻¹ ∂F/∂z (GrippedObject::force_response), exactly as dx̂/dθ.
+// dx̂/dz = H⁻¹ ∂F/∂z (GrippedObject::force_response), exactly as dx̂/dθ. The object's pose
+// adds a rigid part: moving the scene by δ moves its equilibrium by δ, under gravity turned
+// by R_δᵀ in the object's frame, so x̂(δ) = δ ∘ y(R_δᵀ g) and at δ = 0
+//   dx̂ᵢ/dδt = I,   dx̂ᵢ/dδr = −[x̂ᵢ − o]× + H⁻¹ ∂F/∂δr,   ∂Fᵢ/∂δr = mᵢ [g]× = [Fᵢ_gravity]×.
 #include <string>
 #include <vector>
 
@@ -14,41 +19,58 @@
 
 namespace shapectl {
 
-// What a calibration fits; parsed from "youngs_modulus,poisson_ratio,density,grip_offsets".
+// What a calibration fits.
 struct FitSelection {
   bool youngs_modulus = false;
   bool poisson_ratio = false;
   bool density = false;
   bool grip_offsets = false;
-  bool empty() const { return !(youngs_modulus || poisson_ratio || density || grip_offsets); }
+  bool object_pose = false;
+  bool empty() const {
+    return !(youngs_modulus || poisson_ratio || density || grip_offsets || object_pose);
+  }
 };
+// Parsed from "youngs_modulus,poisson_ratio,density,grip_offsets,object_pose".
 // Throws std::invalid_argument naming the unknown entry and the known ones.
 FitSelection parse_fit_selection(const std::string& list);
 
 struct PhysicalParameters {
   double youngs_modulus = 0;  // Pa
   double poisson_ratio = 0;
-  double density = 0;                           // kg/m^3
-  std::vector<Eigen::Isometry3d> grip_offsets;  // one per scene grip
+  double density = 0;                                             // kg/m^3
+  std::vector<Eigen::Isometry3d> grip_offsets;                    // one per scene grip
+  Eigen::Isometry3d object_pose = Eigen::Isometry3d::Identity();  // T_world_object
 
   static PhysicalParameters of(const Scene& scene);
-  // The scene with these values (material and grip offsets); everything else unchanged.
+  // The scene with these values (material, grip offsets, pose); everything else unchanged.
   Scene applied_to(const Scene& scene) const;
 };
 
 // One coordinate of z.
 struct ParameterCoordinate {
-  enum class Kind { LogYoungsModulus, PoissonLogit, LogDensity, GripTranslation, GripRotation };
+  enum class Kind {
+    LogYoungsModulus,
+    PoissonLogit,
+    LogDensity,
+    GripTranslation,
+    GripRotation,
+    PoseTranslation,
+    PoseRotation
+  };
   Kind kind;
-  int grip = -1;     // for grip coordinates
-  int axis = -1;     // 0..2 for grip coordinates (the TCP frame's x, y, z)
-  std::string name;  // "youngs_modulus", "grip_offsets.left.x", "grip_offsets.left.rx"
+  int grip = -1;  // for grip coordinates
+  int axis = -1;  // 0..2 for grip and pose coordinates (the TCP frame's or the world's x, y, z)
+  // "youngs_modulus", "grip_offsets.left.x", "grip_offsets.left.rx", "object_pose.rz"
+  std::string name;
   // Typical size of a change worth noticing: 1 (a factor e) for the logarithms, 1 cm, 0.1 rad.
   double scale = 1;
 };
 
 class ParameterSpace {
  public:
+  // Throws std::invalid_argument when the scene has nothing a selected parameter moves: no
+  // grips for grip_offsets; for object_pose, an object the robot's grips hold (they tie it to
+  // the grippers, which are where the joints put them).
   ParameterSpace(const Scene& scene, const FitSelection& selection);
   const std::vector<ParameterCoordinate>& coordinates() const { return coordinates_; }
   int size() const { return static_cast<int>(coordinates_.size()); }
@@ -58,6 +80,13 @@ class ParameterSpace {
   // ∂F/∂z at the equilibrium `state` of `object` (built from p.applied_to(scene)): 3n × size().
   Eigen::MatrixXd force_derivatives(const GrippedObject& object, const ObjectState& state,
                                     const PhysicalParameters& p) const;
+  // ∂F/∂z of the object's own forces (elasticity, gravity) at x, for `statics` built from
+  // `scene` = p.applied_to(original): 3n × size(), grip columns zero.
+  Eigen::MatrixXd force_derivatives(const ObjectStatics& statics, const Scene& scene,
+                                    const Positions& x, const PhysicalParameters& p) const;
+  // The rigid part of dx̂/dz at the equilibrium x: −[xᵢ − o]× for pose rotations, I for pose
+  // translations, zero for the other coordinates (3n × size()).
+  Eigen::MatrixXd pose_motion(const Positions& x, const PhysicalParameters& p) const;
   // dν/ds etc.: the derivative of the physical value a coordinate moves (Pa, 1, kg/m^3, m,
   // rad) with respect to the coordinate, for reporting standard deviations in physical units.
   double physical_per_coordinate(const ParameterCoordinate& c, const PhysicalParameters& p) const;

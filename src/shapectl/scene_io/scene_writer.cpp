@@ -2,6 +2,8 @@
 
 #include <shapectl/io/input_file.hpp>
 #include <shapectl/io/json_eigen.hpp>
+#include <shapectl/io/json_input.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
 
 namespace shapectl {
 
@@ -24,6 +26,13 @@ void rebase_member(nlohmann::ordered_json& object, const char* key,
     object[key] = rebased(object[key].get<std::string>(), from_dir, to_dir);
 }
 
+// The object's pose as `object` (the file's) gives it; the identity without one.
+Eigen::Isometry3d written_pose(const nlohmann::ordered_json& object,
+                               const std::filesystem::path& source) {
+  if (!object.contains("pose")) return Eigen::Isometry3d::Identity();
+  return read_pose(JsonInput(nlohmann::json(object["pose"]), source.string(), "object.pose"));
+}
+
 }  // namespace
 
 nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source,
@@ -40,6 +49,9 @@ nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& sourc
     material["poisson_ratio"] = poisson_ratio_of(scene.material);
   }
   material["density"] = scene.material.density;
+  // A pose the file gives stays as written unless it changed (rpy would round it).
+  if (scene.T_world_object.matrix() != written_pose(j["object"], source).matrix())
+    j["object"]["pose"] = scene_pose_json(scene.T_world_object);
   for (std::size_t k = 0; k < scene.grips.size(); ++k) {
     nlohmann::ordered_json& grip = j["grips"][k];
     if (scene.grips[k].offset.matrix() == Eigen::Matrix4d::Identity()) grip.erase("offset");
