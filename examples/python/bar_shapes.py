@@ -1,11 +1,19 @@
-"""What the examples share: the default scene (the YuMi holding the foam bar) and a family of
-target shapes for a bar, centre-lines bent up and sideways."""
+"""What the examples share: the default scene (the YuMi holding the foam bar), their command
+line's start, and a family of target shapes for a bar, centre-lines bent up and sideways."""
 
+import argparse
 from pathlib import Path
 
 import numpy as np
 
 DEFAULT_SCENE = Path(__file__).resolve().parents[2] / "scenes" / "yumi_bar.json"
+
+
+def argument_parser(doc):
+    """An example's command line: its docstring's first paragraph, and --scene."""
+    parser = argparse.ArgumentParser(description=doc.split("\n\n")[0])
+    parser.add_argument("--scene", default=DEFAULT_SCENE, help="SCENE.json (default: the bar)")
+    return parser
 
 
 def bar_ends(scene):

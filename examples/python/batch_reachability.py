@@ -11,7 +11,6 @@ The workers need the shapectl package and the files the scene names at the same 
 (docs/python.md).
 """
 
-import argparse
 import json
 import math
 import sys
@@ -20,12 +19,11 @@ import numpy as np
 
 import shapectl
 import shapectl.batch as batch
-from bar_shapes import DEFAULT_SCENE, bent_centerline
+from bar_shapes import argument_parser, bent_centerline
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scene", default=DEFAULT_SCENE, help="SCENE.json (default: the bar)")
+    parser = argument_parser(__doc__)
     parser.add_argument("--lifts", type=int, default=40, help="grid steps of the lift")
     parser.add_argument("--shifts", type=int, default=50, help="grid steps of the shift")
     parser.add_argument("--max-lift", type=float, default=0.12, help="m")

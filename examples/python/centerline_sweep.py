@@ -5,7 +5,6 @@ Writes the chart (PNG) and the numbers (.npz beside it).
     PYTHONPATH=build/python python3 examples/python/centerline_sweep.py --out sweep.png
 """
 
-import argparse
 from pathlib import Path
 
 import matplotlib
@@ -15,12 +14,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 import shapectl  # noqa: E402
-from bar_shapes import DEFAULT_SCENE, bent_centerline  # noqa: E402
+from bar_shapes import argument_parser, bent_centerline  # noqa: E402
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scene", default=DEFAULT_SCENE, help="SCENE.json (default: the bar)")
+    parser = argument_parser(__doc__)
     parser.add_argument("--max-lift", type=float, default=0.12, help="largest bend, m")
     parser.add_argument("--steps", type=int, default=13, help="bends from 0 to --max-lift")
     parser.add_argument("--out", default="sweep.png", help="the chart (PNG); NAME.npz beside")

@@ -8,17 +8,14 @@ The file: joints (N, m) rad, positions (N, n, 3) m, min_clearance (N,) m, joint_
 rest_positions (n, 3), tets (t, 4).
 """
 
-import argparse
-
 import numpy as np
 
 import shapectl
-from bar_shapes import DEFAULT_SCENE
+from bar_shapes import argument_parser
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scene", default=DEFAULT_SCENE, help="SCENE.json (default: the bar)")
+    parser = argument_parser(__doc__)
     parser.add_argument("--samples", type=int, default=200, help="joint samples to try")
     parser.add_argument("--spread", type=float, default=0.05,
                         help="each joint uniform within ± this of its reference, rad")

@@ -4,20 +4,17 @@ shape error fell, per iteration and over time, to a PNG.
     PYTHONPATH=build/python python3 examples/python/solve_convergence.py --out convergence.png
 """
 
-import argparse
-
 import matplotlib
 
 matplotlib.use("Agg")  # files only, no display
 import matplotlib.pyplot as plt  # noqa: E402
 
 import shapectl  # noqa: E402
-from bar_shapes import DEFAULT_SCENE, bent_centerline  # noqa: E402
+from bar_shapes import argument_parser, bent_centerline  # noqa: E402
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--scene", default=DEFAULT_SCENE, help="SCENE.json (default: the bar)")
+    parser = argument_parser(__doc__)
     parser.add_argument("--lift", type=float, default=0.04, help="bend up at mid-bar, m")
     parser.add_argument("--shift", type=float, default=0.02, help="bend sideways, m")
     parser.add_argument("--out", default="convergence.png", help="the plot (PNG)")

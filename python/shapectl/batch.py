@@ -93,14 +93,15 @@ class _Progress:
 
     def __init__(self, total, stream):
         self.total, self.stream, self.done, self.failed = total, stream, 0, 0
-        self.every = 1 if stream is not None and stream.isatty() else max(1, total // 10)
+        self.tty = stream is not None and stream.isatty()
+        self.every = 1 if self.tty else max(1, total // 10)
 
     def count(self, row):
         self.done += 1
         self.failed += row["status"] == "failed"
         if self.stream is None or (self.done % self.every and self.done != self.total):
             return
-        end = "\r" if self.every == 1 and self.done != self.total else "\n"
+        end = "\r" if self.tty and self.done != self.total else "\n"
         self.stream.write(f"batch: {self.done}/{self.total} solves, {self.failed} failed{end}")
         self.stream.flush()
 

@@ -10,9 +10,9 @@ namespace shapectl::python {
 
 namespace {
 
-struct Calibration {
-  CalibrationResult result;
-  SceneHandle scene;
+// The library's result with the calibrated scene as Python holds scenes.
+struct Calibration : CalibrationResult {
+  SceneHandle calibrated;
 };
 
 Observations observations_from(const py::handle& in, const Scene& scene) {
@@ -67,15 +67,15 @@ Calibration run_calibrate(const SceneHandle& s, const py::object& observations_i
   py::gil_scoped_release release;
   Calibration out;
   try {
-    out.result = calibrate(scene, observations, fit, {.max_iterations = max_iterations});
+    static_cast<CalibrationResult&>(out) =
+        calibrate(scene, observations, fit, {.max_iterations = max_iterations});
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const std::runtime_error& e) {  // a frame's equilibrium not found
     throw SolverError(std::string("calibrate: ") + e.what());
   }
-  if (!finite(out.result))
-    throw SolverError("calibrate: the result is not finite (" + out.result.reason + ")");
-  out.scene = scene_handle(out.result.scene, s.document);
+  if (!finite(out)) throw SolverError("calibrate: the result is not finite (" + out.reason + ")");
+  out.calibrated = scene_handle(out.scene, s.document);
   return out;
 }
 
@@ -126,36 +126,25 @@ void bind_calibration(py::module_& m) {
   py::class_<Calibration>(m, "CalibrationResult",
                           "What `shapectl calibrate` computes: REPORT.json's fields and the "
                           "calibrated scene.")
-      .def_readonly("scene", &Calibration::scene,
+      .def_readonly("scene", &Calibration::calibrated,
                     "The scene with the fitted values (its to_dict() is CALIBRATED.json).")
-      .def_property_readonly(
-          "converged", [](const Calibration& c) { return c.result.converged; },
+      .def_readonly(
+          "converged", &CalibrationResult::converged,
           "Whether the fit converged (the CLI exits 2 when not, with the best values so far).")
-      .def_property_readonly(
-          "reason", [](const Calibration& c) { return c.result.reason; }, "Why it stopped.")
-      .def_property_readonly(
-          "iterations", [](const Calibration& c) { return c.result.iterations; },
-          "Levenberg–Marquardt iterations.")
-      .def_property_readonly(
-          "seconds", [](const Calibration& c) { return c.result.seconds; }, "Time taken, s.")
-      .def_property_readonly(
-          "parameters", [](const Calibration& c) { return c.result.parameters; },
-          "One FittedParameter per fitted coordinate (held ones included, marked).")
-      .def_property_readonly(
-          "identifiability", [](const Calibration& c) { return c.result.unidentified; },
-          "One UnidentifiedDirection per combination the observations cannot determine.")
-      .def_property_readonly(
-          "rms_before", [](const Calibration& c) { return c.result.rms_before; },
-          "RMS residual over all frames before, m.")
-      .def_property_readonly(
-          "rms_after", [](const Calibration& c) { return c.result.rms_after; },
-          "RMS residual over all frames after, m.")
-      .def_property_readonly(
-          "chi_squared_per_dof", [](const Calibration& c) { return c.result.chi_squared_per_dof; },
-          "χ²/dof: about 1 when the model fits to the noise level.")
-      .def_property_readonly(
-          "frames", [](const Calibration& c) { return c.result.frames; },
-          "One FrameFit per observed frame.");
+      .def_readonly("reason", &CalibrationResult::reason, "Why it stopped.")
+      .def_readonly("iterations", &CalibrationResult::iterations, "Levenberg–Marquardt iterations.")
+      .def_readonly("seconds", &CalibrationResult::seconds, "Time taken, s.")
+      .def_readonly("parameters", &CalibrationResult::parameters,
+                    "One FittedParameter per fitted coordinate (held ones included, marked).")
+      .def_readonly("identifiability", &CalibrationResult::unidentified,
+                    "One UnidentifiedDirection per combination the observations cannot determine.")
+      .def_readonly("rms_before", &CalibrationResult::rms_before,
+                    "RMS residual over all frames before, m.")
+      .def_readonly("rms_after", &CalibrationResult::rms_after,
+                    "RMS residual over all frames after, m.")
+      .def_readonly("chi_squared_per_dof", &CalibrationResult::chi_squared_per_dof,
+                    "χ²/dof: about 1 when the model fits to the noise level.")
+      .def_readonly("frames", &CalibrationResult::frames, "One FrameFit per observed frame.");
 
   m.def("calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
         py::arg("fit") = "youngs_modulus,grip_offsets", py::arg("max_iterations") = 30,
