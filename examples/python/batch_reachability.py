@@ -4,9 +4,9 @@ PREFIX.npz and PREFIX.csv, one row per target set, with its reachable error, the
 a task that failed, why.
 
 On this machine (a LocalCluster of --workers processes):
-    PYTHONPATH=build/python python3 examples/python/batch_reachability.py --out reach
+    PYTHONPATH=build/python /usr/bin/python3 examples/python/batch_reachability.py --out reach
 On a running cluster (dask-scheduler on one node, dask-worker tcp://HOST:8786 on each):
-    python3 examples/python/batch_reachability.py --scheduler tcp://HOST:8786 --out reach
+    /usr/bin/python3 examples/python/batch_reachability.py --scheduler tcp://HOST:8786 --out reach
 The workers need the shapectl package and the files the scene names at the same paths
 (docs/python.md).
 """

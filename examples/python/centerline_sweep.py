@@ -2,7 +2,7 @@
 sideways) and chart how close the robot can bring the bar to each: the reachable error.
 Writes the chart (PNG) and the numbers (.npz beside it).
 
-    PYTHONPATH=build/python python3 examples/python/centerline_sweep.py --out sweep.png
+    PYTHONPATH=build/python /usr/bin/python3 examples/python/centerline_sweep.py --out sweep.png
 """
 
 from pathlib import Path

@@ -2,7 +2,7 @@
 the bar's equilibrium at each, to one .npz. Samples whose statics do not converge or whose pose
 collides with itself are left out (and counted).
 
-    PYTHONPATH=build/python python3 examples/python/make_dataset.py --samples 200 --out bar.npz
+    PYTHONPATH=build/python /usr/bin/python3 examples/python/make_dataset.py --samples 200 --out bar.npz
 
 The file: joints (N, m) rad, positions (N, n, 3) m, min_clearance (N,) m, joint_names (m,),
 rest_positions (n, 3), tets (t, 4).

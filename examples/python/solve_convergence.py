@@ -1,7 +1,7 @@
 """Solve for a target shape (the bar bent up and sideways) with both optimizers and plot how the
 shape error fell, per iteration and over time, to a PNG.
 
-    PYTHONPATH=build/python python3 examples/python/solve_convergence.py --out convergence.png
+    PYTHONPATH=build/python /usr/bin/python3 examples/python/solve_convergence.py --out convergence.png
 """
 
 import matplotlib
