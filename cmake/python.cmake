@@ -1,6 +1,7 @@
 # python/: the `shapectl` Python module (pybind11 + numpy from Debian) and its pytest tests.
-# Built into build/python/shapectl/ (the package: __init__.py, stubs and the compiled _shapectl):
-# `PYTHONPATH=build/python python3 -c "import shapectl"`.
+# Built into build/python/shapectl/ (the package: __init__.py, batch.py, stubs and the compiled
+# _shapectl): `PYTHONPATH=build/python python3 -c "import shapectl"`; cmake/install.cmake
+# installs it. docs/python.md is its guide.
 
 # Debian's interpreter: pybind11-dev, python3-numpy and python3-pytest are installed for it, while
 # the `python3` first on PATH may be another one (pyenv) without them.
@@ -37,7 +38,7 @@ set_target_properties(shapectl_python PROPERTIES
   OUTPUT_NAME _shapectl
   LIBRARY_OUTPUT_DIRECTORY ${shapectl_python_dir}/shapectl
   UNITY_BUILD ${SHAPECTL_UNITY_BUILD})
-target_link_libraries(shapectl_python PRIVATE shapectl_control shapectl_scene_io shapectl_sim shapectl_robot shapectl_io)
+target_link_libraries(shapectl_python PRIVATE shapectl_calib shapectl_control shapectl_scene_io shapectl_sim shapectl_robot shapectl_io)
 target_compile_options(shapectl_python PRIVATE -Wno-subobject-linkage)
 
 # The pure-Python part of the package (and its stubs) beside the compiled module.
@@ -47,11 +48,18 @@ foreach(file IN LISTS python_package_files)
   configure_file(${file} ${shapectl_python_dir}/shapectl/${name} COPYONLY)
 endforeach()
 
-# pytest, as one CTest test; it runs the CLI to compare against it.
+# pytest, as two CTest tests: the module (it runs the CLI to compare against it), and
+# shapectl.batch with the examples in examples/python (they need python3-matplotlib,
+# python3-dask and python3-distributed).
 if(SHAPECTL_BUILD_TESTS)
+  set(python_test_dir ${PROJECT_SOURCE_DIR}/tests/python)
+  set(python_example_tests ${python_test_dir}/test_batch.py ${python_test_dir}/test_examples.py)
+  list(TRANSFORM python_example_tests PREPEND "--ignore=" OUTPUT_VARIABLE python_ignores)
   add_test(NAME python_tests
-    COMMAND ${Python3_EXECUTABLE} -m pytest -q -p no:cacheprovider ${PROJECT_SOURCE_DIR}/tests/python)
-  set_tests_properties(python_tests PROPERTIES
+    COMMAND ${Python3_EXECUTABLE} -m pytest -q -p no:cacheprovider ${python_test_dir} ${python_ignores})
+  add_test(NAME python_examples
+    COMMAND ${Python3_EXECUTABLE} -m pytest -q -p no:cacheprovider ${python_example_tests})
+  set_tests_properties(python_tests python_examples PROPERTIES
     ENVIRONMENT "PYTHONPATH=${shapectl_python_dir};SHAPECTL_CLI=$<TARGET_FILE:shapectl_cli>;SHAPECTL_SOURCE_DIR=${PROJECT_SOURCE_DIR}"
-    TIMEOUT 300)
+    TIMEOUT 600)
 endif()

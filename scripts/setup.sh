@@ -17,6 +17,7 @@ packages=(
   libprotobuf-dev protobuf-compiler
   clang-format
   pybind11-dev python3-dev python3-numpy python3-pytest
+  python3-matplotlib python3-dask python3-distributed
 )
 
 missing=()

@@ -1,8 +1,10 @@
 """shapectl: shape control of elastic objects held by a robot, from Python.
 
-The library's model and algorithms (the same code as the `shapectl` command): load a scene, solve
-the object's statics at joint angles, take sensitivities dx/dθ, the robot's kinematics, optimize
-joints for a target shape, or run the continuous controller in a background thread.
+The library's model and algorithms (the same code as the `shapectl` command): load a scene (from
+a file or a dict of the same schema), solve the object's statics at joint angles, take
+sensitivities dx/dθ, the robot's kinematics, optimize joints for a target shape, run the
+continuous controller in a background thread, or calibrate the model to observations.
+Many independent solves on a Dask cluster: shapectl.batch (imported on its own; needs dask).
 
 Arrays are float64 numpy arrays: positions (n, 3) in metres, world frame, mesh node order;
 joints (m,) in radians, in the scene's active-joint order; sensitivities (3n, m).
@@ -15,8 +17,11 @@ Long computations release the GIL, so other Python threads run meanwhile.
 """
 
 from ._shapectl import (
+    CalibrationResult,
     Controller,
     ControllerSnapshot,
+    FittedParameter,
+    FrameFit,
     GrippedObject,
     HistoryEntry,
     Kinematics,
@@ -31,14 +36,19 @@ from ._shapectl import (
     SpherePair,
     StaticsResult,
     StaticsSolution,
+    UnidentifiedDirection,
+    calibrate,
     kinematics,
     solve,
     statics,
 )
 
 __all__ = [
+    "CalibrationResult",
     "Controller",
     "ControllerSnapshot",
+    "FittedParameter",
+    "FrameFit",
     "GrippedObject",
     "HistoryEntry",
     "Kinematics",
@@ -53,6 +63,8 @@ __all__ = [
     "SpherePair",
     "StaticsResult",
     "StaticsSolution",
+    "UnidentifiedDirection",
+    "calibrate",
     "kinematics",
     "solve",
     "statics",

@@ -38,6 +38,9 @@ class Robot:
 class Scene:
     @staticmethod
     def load(path: Union[str, os.PathLike]) -> Scene: ...
+    @staticmethod
+    def from_dict(d: Mapping[str, Any], base_dir: Union[str, os.PathLike] = ".") -> Scene: ...
+    def to_dict(self, base_dir: Optional[Union[str, os.PathLike]] = None) -> Dict[str, Any]: ...
     source: str
     node_count: int
     tet_count: int
@@ -189,3 +192,42 @@ class Controller:
     def close(self) -> None: ...
     def __enter__(self) -> Controller: ...
     def __exit__(self, *args: Any) -> None: ...
+
+class FittedParameter:
+    name: str
+    unit: str
+    initial: float
+    fitted: float
+    standard_deviation: Optional[float]
+    identifiable: bool
+
+class UnidentifiedDirection:
+    not_determined: Dict[str, float]
+    standard_deviation_in_scales: float
+    held_at_initial_value: str
+
+class FrameFit:
+    rms_before: float
+    rms_after: float
+    markers: int
+    points: int
+    inlier_points_after: int
+
+class CalibrationResult:
+    scene: Scene
+    converged: bool
+    reason: str
+    iterations: int
+    seconds: float
+    parameters: List[FittedParameter]
+    identifiability: List[UnidentifiedDirection]
+    rms_before: float
+    rms_after: float
+    chi_squared_per_dof: float
+    frames: List[FrameFit]
+
+Observations = Union[str, os.PathLike, Mapping[str, Any]]
+
+def calibrate(scene: Scene, observations: Observations, *,
+              fit: Union[str, Sequence[str]] = "youngs_modulus,grip_offsets",
+              max_iterations: int = 30) -> CalibrationResult: ...

@@ -5,6 +5,7 @@
 // (n, 3), joints (m,), sensitivities (3n, m), rotations (3, 3).
 #include <map>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -40,8 +41,20 @@ class SolverError : public std::runtime_error {
 struct SceneHandle {
   std::shared_ptr<const Scene> scene;
   std::shared_ptr<const GrippedObject> object;  // null without a robot
-  const GrippedObject& gripped() const;         // InputError if the scene has no robot
+  // A scene given as a dict: its JSON text, file names absolute. Null: scene->source is its file.
+  std::shared_ptr<const std::string> document;
+  const GrippedObject& gripped() const;  // InputError if the scene has no robot
 };
+
+// The handle of a scene read from a file (no document) or a dict; builds the gripped object.
+SceneHandle scene_handle(Scene scene, std::shared_ptr<const std::string> document = nullptr);
+// A dict of SCENE.json's schema, file names relative to `base_dir`, read as load_scene reads a
+// file; messages name it "scene".
+SceneHandle scene_from_dict(const py::handle& d, const std::filesystem::path& base_dir);
+// The scene as a dict of SCENE.json's schema with its current values (scene_json_with_values):
+// file names absolute, or relative to `base_dir` when given.
+py::object scene_to_dict(const SceneHandle& s,
+                         const std::optional<std::filesystem::path>& base_dir);
 
 // A robot model and, optionally, its collision spheres.
 struct RobotHandle {
@@ -65,6 +78,9 @@ std::vector<Vec3> points_from(const py::handle& array, const std::string& what);
 // JOINTS.json) or an (m,) array.
 Eigen::VectorXd joints_from(const py::handle& joints, const RobotModel& robot,
                             const Eigen::VectorXd& defaults);
+// A str or os.PathLike as a path; InputError naming `what` and `expected` for anything else.
+std::filesystem::path path_from(const py::handle& value, const std::string& what,
+                                const std::string& expected);
 // A TARGETS.json path (str or os.PathLike) or a dict of its schema, read as the CLI reads the
 // file; `source` receives the name messages use (the path, or "targets" for a dict).
 TargetsInput read_targets_from(const py::handle& targets, int node_count, std::string& source);
@@ -81,5 +97,6 @@ void bind_statics(py::module_& m);
 void bind_kinematics(py::module_& m);
 void bind_solve(py::module_& m);
 void bind_controller(py::module_& m);
+void bind_calibration(py::module_& m);
 
 }  // namespace shapectl::python

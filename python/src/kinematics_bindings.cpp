@@ -71,7 +71,8 @@ Kinematics robot_kinematics(const RobotHandle& r, const py::object& joints_in,
   const Eigen::VectorXd joints =
       joints_from(joints_in, robot, Eigen::VectorXd::Zero(robot.active_count()));
   std::optional<std::filesystem::path> spheres_path;
-  if (!spheres.is_none()) spheres_path = py::cast<std::filesystem::path>(spheres);
+  if (!spheres.is_none())
+    spheres_path = path_from(spheres, "spheres", "a collision spheres JSON path");
   py::gil_scoped_release release;
   std::optional<CollisionModel> loaded;
   if (spheres_path) loaded = CollisionModel::load_json_file(robot, *spheres_path);

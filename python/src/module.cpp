@@ -90,12 +90,19 @@ Eigen::VectorXd joints_from(const py::handle& joints, const RobotModel& robot,
   return Eigen::Map<const Eigen::VectorXd>(a.data(), a.size());
 }
 
+std::filesystem::path path_from(const py::handle& value, const std::string& what,
+                                const std::string& expected) {
+  if (!py::isinstance<py::str>(value) && !py::hasattr(value, "__fspath__"))
+    throw InputError(what, "", expected, std::string(py::str(py::type::of(value))));
+  return py::cast<std::filesystem::path>(value);
+}
+
 TargetsInput read_targets_from(const py::handle& targets, int node_count, std::string& source) {
   if (py::isinstance<py::dict>(targets)) {
     source = "targets";
     return read_targets(JsonInput(json_from(targets, source), source), node_count);
   }
-  const auto path = py::cast<std::filesystem::path>(targets);
+  const auto path = path_from(targets, "targets", "a TARGETS.json path or a dict of its schema");
   source = path.string();
   return load_targets(path, node_count);
 }
@@ -153,4 +160,5 @@ PYBIND11_MODULE(_shapectl, m) {
   bind_kinematics(m);
   bind_solve(m);
   bind_controller(m);
+  bind_calibration(m);
 }

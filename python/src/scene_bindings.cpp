@@ -7,14 +7,8 @@ namespace shapectl::python {
 namespace {
 
 SceneHandle load(const std::filesystem::path& path) {
-  SceneHandle handle;
-  {
-    py::gil_scoped_release release;  // a large mesh or TetGen can take a while
-    auto scene = std::make_shared<const Scene>(load_scene(path));
-    if (scene->robot) handle.object = std::make_shared<const GrippedObject>(*scene);
-    handle.scene = std::move(scene);
-  }
-  return handle;
+  py::gil_scoped_release release;  // a large mesh or TetGen can take a while
+  return scene_handle(load_scene(path));
 }
 
 std::vector<std::vector<int>> grip_nodes(const Scene& scene) {
@@ -84,9 +78,22 @@ void bind_scene(py::module_& m) {
           "load", &load, py::arg("path"),
           "Reads and checks SCENE.json (paths in it are relative to it). Raises ValueError "
           "with the CLI's message (file, field, expected, found) for bad or implausible input.")
+      .def_static(
+          "from_dict", &scene_from_dict, py::arg("d"), py::arg("base_dir") = ".",
+          "A scene from a dict of SCENE.json's schema (e.g. json.load of a scene file, or "
+          "to_dict()), read and checked exactly as a file: its file names (object.mesh, "
+          "robot.urdf, robot.collision_spheres) are relative to `base_dir` (default: the current "
+          "directory). Raises ValueError with the CLI's message, the file's name replaced by "
+          "'scene'.")
+      .def("to_dict", &scene_to_dict, py::arg("base_dir") = py::none(),
+           "The scene as a dict of SCENE.json's schema with this scene's values (a calibrated "
+           "scene's fitted material and grip offsets; the rest as its file or dict gave it): "
+           "file names absolute, or relative to `base_dir` when given. Scene.from_dict(d, "
+           "base_dir) reads it back; json.dump writes it as a scene file. A scene loaded from a "
+           "file reads that file again.")
       .def_property_readonly(
           "source", [](const SceneHandle& s) { return s.scene->source.string(); },
-          "The scene file.")
+          "The scene file ('scene' for a scene from a dict).")
       .def_property_readonly(
           "node_count", [](const SceneHandle& s) { return s.scene->object_mesh->node_count(); },
           "Mesh nodes n (positions arrays are (n, 3), in file order).")

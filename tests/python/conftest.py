@@ -7,6 +7,9 @@ PYTHONPATH=build/python /usr/bin/python3 -m pytest tests/python
 import json
 import os
 import subprocess
+import sys
+import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -64,3 +67,40 @@ def bar_scene():
     import shapectl
 
     return shapectl.Scene.load(BAR)
+
+
+def counted_during(call, attempts=10):
+    """Runs call() in a thread (again, up to `attempts` times, until it is seen) while another
+    thread counts, with no forced GIL switches: the counter can advance during a call only if the
+    call released the GIL; it sleeps between counts, so the caller's thread gets the GIL back.
+    Returns how far it advanced during each call."""
+    counter = {"n": 0, "stop": False}
+
+    def count():
+        while not counter["stop"]:
+            counter["n"] += 1
+            time.sleep(0.0002)
+
+    advanced = []
+
+    def call_until_counted():
+        for _ in range(attempts):
+            before = counter["n"]
+            call()
+            advanced.append(counter["n"] - before)
+            if advanced[-1] > 0:
+                return
+
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(100.0)
+    try:
+        counter_thread = threading.Thread(target=count)
+        counter_thread.start()
+        caller = threading.Thread(target=call_until_counted)
+        caller.start()
+        caller.join()
+        counter["stop"] = True
+        counter_thread.join()
+    finally:
+        sys.setswitchinterval(interval)
+    return advanced

@@ -1,15 +1,12 @@
 """solve() from Python agrees with `shapectl solve`; errors match the CLI's; the GIL is released."""
 
 import json
-import sys
-import threading
-import time
 
 import numpy as np
 import pytest
 
 import shapectl
-from conftest import BAR, YUMI_SPHERES, YUMI_URDF
+from conftest import BAR, YUMI_SPHERES, YUMI_URDF, counted_during
 
 
 def lifted_targets(scene, lift=0.01, every=53):
@@ -78,6 +75,9 @@ def test_bad_targets_raise_value_error_with_the_cli_message(cli, write_json, bar
     with pytest.raises(ValueError) as from_dict:
         shapectl.solve(bar_scene, {"targets": [{"node": 425, "position": [0, 0, 0]}]})
     assert str(from_dict.value) == run.error_message().replace(str(path), "targets")
+    with pytest.raises(ValueError, match="targets: expected a TARGETS.json path or a dict of its "
+                                         "schema, got <class 'int'>"):
+        shapectl.solve(bar_scene, 7)
     with pytest.raises(ValueError, match="optimizer: expected one of the optimizer names, got newton"):
         shapectl.solve(bar_scene, lifted_targets(bar_scene), optimizer="newton")
 
@@ -99,36 +99,7 @@ def test_failed_reference_statics_raise_solver_error_like_the_cli(cli, write_jso
 
 
 def test_a_solve_in_a_thread_does_not_block_other_python_threads(bar_scene):
-    # With no forced GIL switches, the counter thread can run during a solve only if the solve
-    # released the GIL; it sleeps between counts, so the solve's thread gets the GIL back.
     targets = lifted_targets(bar_scene, lift=0.03, every=17)
-    counter = {"n": 0, "stop": False}
-
-    def count():
-        while not counter["stop"]:
-            counter["n"] += 1
-            time.sleep(0.0002)
-
-    advanced = []
-
-    def solve_until_counted():
-        for _ in range(10):  # more solves only if the counter thread never got a turn
-            before = counter["n"]
-            shapectl.solve(bar_scene, targets, optimizer="lbfgs", max_iterations=5)
-            advanced.append(counter["n"] - before)
-            if advanced[-1] > 0:
-                return
-
-    interval = sys.getswitchinterval()
-    sys.setswitchinterval(100.0)
-    try:
-        counter_thread = threading.Thread(target=count)
-        counter_thread.start()
-        solver_thread = threading.Thread(target=solve_until_counted)
-        solver_thread.start()
-        solver_thread.join()
-        counter["stop"] = True
-        counter_thread.join()
-    finally:
-        sys.setswitchinterval(interval)
+    advanced = counted_during(
+        lambda: shapectl.solve(bar_scene, targets, optimizer="lbfgs", max_iterations=5))
     assert advanced and advanced[-1] > 0, advanced

@@ -1,0 +1,163 @@
+"""Many independent solves fanned out over a Dask cluster, gathered into one table.
+
+    import shapectl, shapectl.batch as batch
+    scene = shapectl.Scene.load("scenes/yumi_bar.json")
+    with batch.connect() as client:               # a LocalCluster; connect("tcp://host:8786")
+        rows = batch.solve_many(client, scene, target_sets, max_iterations=30)
+    batch.write_table(rows, "reach", scene.joint_names)     # reach.npz and reach.csv
+
+Every task gives exactly one row, in the order of `target_sets`: a solve that ends (converged
+or not) is "done" with its numbers; bad targets, a failed solve, an exception or a lost worker
+make it "failed" with the reason in `error`. Nothing is dropped.
+
+The scene travels with the tasks as a dict (Scene.to_dict(): file names absolute), and each
+worker process loads it once. On a multi-machine cluster the files it names (URDF, collision
+spheres, mesh files) must be at the same paths on every node: shared storage, or shapectl's data
+installed under the same prefix everywhere; the bundled scenes' meshes are boxes, inside the dict.
+"""
+
+import contextlib
+import csv
+import json
+import math
+import os
+import socket
+import sys
+import threading
+import time
+
+import numpy as np
+
+import shapectl
+
+# The numeric and text fields of a row (besides "joints"), in table order.
+FIELDS = ("task", "status", "termination", "converged", "iterations", "error_mean", "error_max",
+          "min_clearance", "objective", "seconds", "worker", "error")
+
+_scenes = {}  # on a worker: scene dict (as JSON text) -> Scene, loaded once per process
+_scenes_lock = threading.Lock()
+
+
+@contextlib.contextmanager
+def connect(scheduler=None, workers=2, threads_per_worker=1):
+    """A dask.distributed Client: of the running scheduler at `scheduler` ("tcp://host:8786"),
+    or of a LocalCluster of `workers` processes with `threads_per_worker` threads each (one
+    thread: a solve keeps a core busy). Closes what it opened."""
+    from distributed import Client, LocalCluster
+
+    if scheduler:
+        with Client(scheduler) as client:
+            yield client
+        return
+    with LocalCluster(n_workers=workers, threads_per_worker=threads_per_worker, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        yield client
+
+
+def _scene(scene_dict):
+    key = json.dumps(scene_dict, sort_keys=True)
+    with _scenes_lock:
+        if key not in _scenes:
+            _scenes.clear()  # one study at a time: keep memory bounded
+            _scenes[key] = shapectl.Scene.from_dict(scene_dict)
+        return _scenes[key]
+
+
+def _row(task, **fields):
+    row = {"task": task, "status": "failed", "termination": "", "converged": False,
+           "iterations": -1, "error_mean": math.nan, "error_max": math.nan,
+           "min_clearance": math.nan, "objective": math.nan, "seconds": math.nan,
+           "worker": "", "error": "", "joints": []}
+    row.update(fields)
+    return row
+
+
+def solve_task(task, targets, scene, options):
+    """One solve on a worker: the row of task number `task` (see the module's docstring)."""
+    worker = f"{socket.gethostname()}:{os.getpid()}"
+    start = time.perf_counter()
+    try:
+        result = shapectl.solve(_scene(scene), targets, **options)
+    except (ValueError, shapectl.SolverError) as e:
+        return _row(task, worker=worker, error=f"{type(e).__name__}: {e}")
+    return _row(task, status="done", termination=result.termination, converged=result.converged,
+                iterations=result.iterations, error_mean=result.error_mean,
+                error_max=result.error_max,
+                min_clearance=math.nan if result.min_clearance is None else result.min_clearance,
+                objective=result.objective, seconds=time.perf_counter() - start, worker=worker,
+                joints=result.joints.tolist())
+
+
+class _Progress:
+    """A counter on `stream`: rewritten in place on a terminal, a line per tenth otherwise."""
+
+    def __init__(self, total, stream):
+        self.total, self.stream, self.done, self.failed = total, stream, 0, 0
+        self.tty = stream is not None and stream.isatty()
+        self.every = 1 if self.tty else max(1, total // 10)
+
+    def count(self, row):
+        self.done += 1
+        self.failed += row["status"] == "failed"
+        if self.stream is None or (self.done % self.every and self.done != self.total):
+            return
+        end = "\r" if self.tty and self.done != self.total else "\n"
+        self.stream.write(f"batch: {self.done}/{self.total} solves, {self.failed} failed{end}")
+        self.stream.flush()
+
+
+def solve_many(client, scene, target_sets, progress=sys.stderr, **options):
+    """shapectl.solve(scene, targets, **options) for every entry of `target_sets` (dicts of the
+    TARGETS.json schema) on the cluster behind `client`; returns one row per entry, in order.
+    scene: a Scene (sent as to_dict()) or a dict of the scene schema with absolute file names.
+    progress: where the counter goes (None: nowhere)."""
+    scene_dict = scene.to_dict() if isinstance(scene, shapectl.Scene) else scene
+    from distributed import as_completed
+
+    # The scene once to every worker, not once per task.
+    [scene_on_workers] = client.scatter([scene_dict], broadcast=True, hash=False)
+    futures = client.map(solve_task, range(len(target_sets)), target_sets,
+                         scene=scene_on_workers, options=options, pure=False)
+    task_of = {future.key: task for task, future in enumerate(futures)}
+    rows = [None] * len(futures)
+    counter = _Progress(len(futures), progress)
+    for future in as_completed(futures):
+        task = task_of[future.key]
+        if future.status == "finished":
+            rows[task] = future.result()
+        else:  # an exception the task did not expect, a worker lost, a cancelled task
+            try:
+                reason = future.exception()
+            except Exception as e:  # cancelled: no exception to fetch
+                reason = e
+            rows[task] = _row(task, error=f"{type(reason).__name__}: {reason}")
+        future.release()
+        counter.count(rows[task])
+    return rows
+
+
+def table(rows, joint_names):
+    """The rows as columns: numpy arrays named as FIELDS (plus any other keys the rows share, e.g.
+    a study's parameters, first), and "joints" of shape (tasks, m), NaN for failed tasks."""
+    extra = [key for key in rows[0] if key not in FIELDS and key != "joints"] if rows else []
+    columns = {key: np.array([row[key] for row in rows]) for key in extra + list(FIELDS)}
+    joints = np.full((len(rows), len(joint_names)), math.nan)
+    for i, row in enumerate(rows):
+        if len(row["joints"]):
+            joints[i] = row["joints"]
+    columns["joints"] = joints
+    columns["joint_names"] = np.array(joint_names)
+    return columns
+
+
+def write_table(rows, prefix, joint_names):
+    """PREFIX.npz (table()'s arrays) and PREFIX.csv (one line per task, a column per joint)."""
+    columns = table(rows, joint_names)
+    np.savez(f"{prefix}.npz", **columns)
+    names = [key for key in columns if key not in ("joints", "joint_names", "error")]
+    with open(f"{prefix}.csv", "w", newline="") as out:
+        writer = csv.writer(out)
+        writer.writerow(names + list(joint_names) + ["error"])
+        for i in range(len(rows)):
+            writer.writerow([columns[key][i] for key in names] + list(columns["joints"][i])
+                            + [columns["error"][i]])

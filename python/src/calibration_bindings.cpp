@@ -1,0 +1,160 @@
+// shapectl.calibrate: what `shapectl calibrate` computes, the fields of its REPORT.json and the
+// calibrated scene (CALIBRATED.json is its to_dict()).
+#include <cmath>
+
+#include <shapectl/calib/calibration.hpp>
+
+#include "bindings.hpp"
+
+namespace shapectl::python {
+
+namespace {
+
+// The library's result with the calibrated scene as Python holds scenes.
+struct Calibration : CalibrationResult {
+  SceneHandle calibrated;
+};
+
+Observations observations_from(const py::handle& in, const Scene& scene) {
+  const ObservationContext context{.node_count = scene.object_mesh->node_count(),
+                                   .robot = scene.robot->model.get(),
+                                   .allow_points_files = true};
+  if (py::isinstance<py::dict>(in))
+    return read_observations(JsonInput(json_from(in, "observations"), "observations"), context);
+  return load_observations(path_from(in, "observations",
+                                     "an OBSERVATIONS.json path or a dict of its schema"),
+                           context);
+}
+
+// "youngs_modulus,grip_offsets" or ["youngs_modulus", "grip_offsets"], checked as --fit.
+FitSelection fit_from(const py::handle& fit) {
+  std::string list;
+  if (py::isinstance<py::str>(fit)) {
+    list = py::cast<std::string>(fit);
+  } else {
+    for (const auto& name : fit) {
+      if (!list.empty()) list += ',';
+      list += py::cast<std::string>(name);
+    }
+  }
+  try {
+    return parse_fit_selection(list);
+  } catch (const std::invalid_argument&) {
+    throw InputError(
+        "fit", "", "a comma-separated list of youngs_modulus, poisson_ratio, density, grip_offsets",
+        list);
+  }
+}
+
+bool finite(const CalibrationResult& r) {
+  bool ok = std::isfinite(r.rms_before) && std::isfinite(r.rms_after) &&
+            std::isfinite(r.chi_squared_per_dof);
+  for (const FittedParameter& p : r.parameters)
+    ok = ok && std::isfinite(p.fitted) && std::isfinite(p.standard_deviation);
+  return ok;
+}
+
+Calibration run_calibrate(const SceneHandle& s, const py::object& observations_in,
+                          const py::object& fit_in, int max_iterations) {
+  const Scene& scene = *s.scene;
+  if (!scene.robot)
+    throw InputError(scene.source.string(), "robot", "a robot holding the object (missing key)");
+  const FitSelection fit = fit_from(fit_in);
+  if (max_iterations < 1 || max_iterations > 1000)
+    throw InputError("max_iterations", "", "a number from 1 to 1000", max_iterations);
+  const Observations observations = observations_from(observations_in, scene);
+
+  py::gil_scoped_release release;
+  Calibration out;
+  try {
+    static_cast<CalibrationResult&>(out) =
+        calibrate(scene, observations, fit, {.max_iterations = max_iterations});
+  } catch (const std::invalid_argument&) {
+    throw;
+  } catch (const std::runtime_error& e) {  // a frame's equilibrium not found
+    throw SolverError(std::string("calibrate: ") + e.what());
+  }
+  if (!finite(out)) throw SolverError("calibrate: the result is not finite (" + out.reason + ")");
+  out.calibrated = scene_handle(out.scene, s.document);
+  return out;
+}
+
+}  // namespace
+
+void bind_calibration(py::module_& m) {
+  py::class_<FittedParameter>(m, "FittedParameter", "One calibrated parameter (REPORT.json).")
+      .def_readonly("name", &FittedParameter::name,
+                    "'youngs_modulus', 'poisson_ratio', 'density' or 'grip_offsets.<ee>.x' … "
+                    "'.rz'.")
+      .def_readonly("unit", &FittedParameter::unit, "'Pa', '', 'kg/m^3', 'm' or 'rad'.")
+      .def_readonly("initial", &FittedParameter::initial, "The scene's value.")
+      .def_readonly("fitted", &FittedParameter::fitted, "The calibrated value.")
+      .def_property_readonly(
+          "standard_deviation",
+          [](const FittedParameter& p) -> std::optional<double> {
+            if (p.held) return std::nullopt;
+            return p.standard_deviation;
+          },
+          "Its standard deviation (from the frames' sigma); None when held.")
+      .def_property_readonly(
+          "identifiable", [](const FittedParameter& p) { return !p.held; },
+          "False: the observations cannot determine it; held at its initial value.");
+
+  py::class_<UnidentifiedDirection>(
+      m, "UnidentifiedDirection",
+      "A combination of parameters the observations cannot determine (REPORT.json's "
+      "identifiability).")
+      .def_property_readonly(
+          "not_determined",
+          [](const UnidentifiedDirection& d) {
+            return std::map<std::string, double>(d.combination.begin(), d.combination.end());
+          },
+          "The combination: {parameter coordinate: weight}.")
+      .def_readonly("standard_deviation_in_scales", &UnidentifiedDirection::standard_deviation,
+                    "Its standard deviation in units of the coordinates' typical scales.")
+      .def_readonly("held_at_initial_value", &UnidentifiedDirection::held,
+                    "The parameter kept at its initial value for it.");
+
+  py::class_<FrameFit>(m, "FrameFit", "The fit of one observed frame.")
+      .def_readonly("rms_before", &FrameFit::rms_before, "RMS residual before, m.")
+      .def_readonly("rms_after", &FrameFit::rms_after, "RMS residual after, m.")
+      .def_readonly("markers", &FrameFit::markers, "Markers observed.")
+      .def_readonly("points", &FrameFit::points, "Cloud points observed.")
+      .def_readonly("inlier_points_after", &FrameFit::inlier_points_after,
+                    "Cloud points counted as inliers at the end.");
+
+  py::class_<Calibration>(m, "CalibrationResult",
+                          "What `shapectl calibrate` computes: REPORT.json's fields and the "
+                          "calibrated scene.")
+      .def_readonly("scene", &Calibration::calibrated,
+                    "The scene with the fitted values (its to_dict() is CALIBRATED.json).")
+      .def_readonly(
+          "converged", &CalibrationResult::converged,
+          "Whether the fit converged (the CLI exits 2 when not, with the best values so far).")
+      .def_readonly("reason", &CalibrationResult::reason, "Why it stopped.")
+      .def_readonly("iterations", &CalibrationResult::iterations, "Levenberg–Marquardt iterations.")
+      .def_readonly("seconds", &CalibrationResult::seconds, "Time taken, s.")
+      .def_readonly("parameters", &CalibrationResult::parameters,
+                    "One FittedParameter per fitted coordinate (held ones included, marked).")
+      .def_readonly("identifiability", &CalibrationResult::unidentified,
+                    "One UnidentifiedDirection per combination the observations cannot determine.")
+      .def_readonly("rms_before", &CalibrationResult::rms_before,
+                    "RMS residual over all frames before, m.")
+      .def_readonly("rms_after", &CalibrationResult::rms_after,
+                    "RMS residual over all frames after, m.")
+      .def_readonly("chi_squared_per_dof", &CalibrationResult::chi_squared_per_dof,
+                    "χ²/dof: about 1 when the model fits to the noise level.")
+      .def_readonly("frames", &CalibrationResult::frames, "One FrameFit per observed frame.");
+
+  m.def("calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
+        py::arg("fit") = "youngs_modulus,grip_offsets", py::arg("max_iterations") = 30,
+        "Fits the scene's physical parameters to observations of the real object, as `shapectl "
+        "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
+        "of its schema (numpy arrays allowed; a points_file relative to the current "
+        "directory). fit: a comma-separated string or a list of youngs_modulus, poisson_ratio, "
+        "density, grip_offsets. Raises ValueError for bad input (the CLI's message; a dict is "
+        "named 'observations'), SolverError when a frame's equilibrium cannot be found. Releases "
+        "the GIL while it runs.");
+}
+
+}  // namespace shapectl::python
