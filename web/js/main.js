@@ -3,6 +3,7 @@
 import { Connection } from './connection.js';
 import { View3D } from './view3d.js';
 import { ConvergencePlot } from './plot.js';
+import { CalibrationPanel } from './calibration_panel.js';
 import { Command, ControllerStatus } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
@@ -27,7 +28,14 @@ const view = new View3D($('view'), {
   sketch: (points) => command(Command.SetCenterline, { points }).then(() => setSketchMode(false)),
   select: (node) => { $('delete').disabled = node === null; },
 });
-const plot = new ConvergencePlot($('plot'));
+const plot = new ConvergencePlot($('plot'), $('plot-legend'));
+const calibration = new CalibrationPanel({
+  button: $('calibrate'), auto: $('auto-calibration'), status: $('calibration-status'), model: $('model'),
+  table: $('calibration-result'), summary: $('calibration-summary'), error: $('calibration-error'),
+}, {
+  calibrate: () => command(Command.Calibrate),
+  setAutomatic: (on) => command(Command.SetAutoCalibration, { on }),
+});
 
 const connection = new Connection(`ws://${location.host}/ws`, {
   open: () => setBadge('connection', 'connected', 'ok'),
@@ -108,7 +116,7 @@ function onState(state) {
   page.stats.stateTimes.push(performance.now());
   if (page.stats.stateTimes.length > 200) page.stats.stateTimes.shift();
   view.setState(state);
-  plot.add(state.time, state.error.mean, state.editing);
+  plot.add(state.time, plotValues(state), state.editing);
   drawPlot();
 
   // "converged" means stationary; away from the targets that is no success to show in green.
@@ -149,11 +157,20 @@ function onState(state) {
       (state.true_error === null || state.true_error === undefined ? '' : ` · true error (simulated world) ${mm(state.true_error)} mm`)
     : 'no observations yet';
 
+  calibration.update(state);
+
   if (state.link) {
     const l = state.link;
     $('link-status').textContent = `${l.kind}: ${l.connected ? 'connected' : 'no feedback'}, ${l.armed ? 'ARMED' : 'disarmed'}` +
       (l.reason ? ` — ${l.reason}` : '');
   }
+}
+
+// The plot's values, in the order of plot.js's SERIES; the real object's errors only once it
+// was observed (before, the server sends 0).
+function plotValues(state) {
+  const observed = state.observations > 0;
+  return [state.error.mean, state.true_error ?? null, observed ? state.model_error : null, observed ? state.observed_error : null];
 }
 
 let plotPending = false;
@@ -184,6 +201,7 @@ $('face-bar').onclick = () => { if (page.scene?.bar) view.faceBar(page.scene.bar
 $('show-wireframe').onchange = (e) => view.setWireframe(e.target.checked);
 $('show-spheres').onchange = (e) => view.setSpheresVisible(e.target.checked);
 $('show-robot').onchange = (e) => view.setRobotVisible(e.target.checked);
+$('show-points').onchange = (e) => view.setObservedPointsVisible(e.target.checked);
 $('scene-select').onchange = (e) => command(Command.LoadScene, { scene: e.target.value });
 $('feedback').onchange = (e) => command(Command.SetFeedback, { on: e.target.checked });
 $('arm').onclick = () => command(Command.Arm);
@@ -203,6 +221,8 @@ window.shapectl = {
   get stats() { return page.stats; },
   get ready() { return !!(page.scene && page.state && view.positions && view.frames > 2); },
   get arrowCount() { return view.arrowCount; },
+  get frames() { return view.frames; },
+  get observedPointsDrawn() { return view.observedPointsDrawn; },
   get selected() { return view.selected; },
   nodePosition: (node) => view.nodePosition(node).toArray(),
   positions: () => Array.from(view.positions ?? []),
@@ -211,4 +231,5 @@ window.shapectl = {
   setLayers: ({ robot = true, object = true } = {}) => { view.setRobotVisible(robot); view.setObjectVisible(object); view.render(); },
   objectCentroid: () => view.objectCentroid().toArray(),
   cameraDirection: () => view.cameraDirection(),
+  observedPoints: () => view.observedPoints(),
 };
