@@ -20,6 +20,11 @@ function parameterLabel(name) {
 
 const mm = (m) => (Number.isFinite(m) ? (1000 * m).toFixed(2) : '–');
 
+// Writes only changes: states arrive 30 times a second.
+function setText(element, text) {
+  if (element.textContent !== text) element.textContent = text;
+}
+
 function cell(text, className) {
   const td = document.createElement('td');
   td.textContent = text;
@@ -53,7 +58,7 @@ export class CalibrationPanel {
     this.showControls();
     this.showResult(this.calibration?.result ?? null);
     const error = this.calibration?.error ?? '';
-    if (this.elements.error.textContent !== error) this.elements.error.textContent = error;
+    setText(this.elements.error, error);
     this.elements.error.hidden = !error;
   }
 
@@ -64,7 +69,7 @@ export class CalibrationPanel {
       : '';
     const m = this.elements.model;
     if (m.textContent === line) return;
-    m.textContent = line;
+    setText(m, line);
     m.title = (model?.grip_offsets ?? []).map((g) =>
       `${g.end_effector} grip offset: ${g.position.map((v) => formatValue(v, Unit.Metre, 2)).join(', ')} mm, ` +
       `${g.rpy.map((v) => formatValue(v, Unit.Radian, 2)).join(', ')}°`).join('\n');
@@ -74,14 +79,14 @@ export class CalibrationPanel {
     const c = this.calibration, { button, auto, status } = this.elements;
     const busy = this.requesting || !!c?.running;
     button.disabled = busy || !c || c.frames === 0;
-    button.textContent = busy ? 'Calibrating…' : 'Calibrate';
+    setText(button, busy ? 'Calibrating…' : 'Calibrate');
     button.classList.toggle('busy', busy);
-    button.setAttribute('aria-busy', String(busy));
+    button.ariaBusy = String(busy);
     auto.disabled = !c;
     auto.checked = !!c?.automatic;
-    status.textContent = !c ? 'no calibration in this session'
+    setText(status, !c ? 'no calibration in this session'
       : c.frames === 0 ? 'no observed frames yet'
-      : `${c.frames} frame${c.frames === 1 ? '' : 's'}${busy ? ', calibrating…' : ''}`;
+      : `${c.frames} frame${c.frames === 1 ? '' : 's'}${busy ? ', calibrating…' : ''}`);
   }
 
   showResult(result) {
