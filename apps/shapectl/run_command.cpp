@@ -1,17 +1,24 @@
 // shapectl run SCENE.json --targets TARGETS.json [--robot sim|egm] [--arm] [--log LOG.jsonl]
 //              [--until-settled] [--timeout S] [link options]
-//              [--world WORLD.json [--camera-rate HZ] [--camera-sigma M] [--no-feedback]]
+//              [--world WORLD.json [--camera-rate HZ] [--camera-sigma M] [--camera-points N]
+//                                  [--camera-outliers F]]
+//              [--observations-udp PORT [--observations-address ADDR]]
+//              [--no-feedback] [--no-online-calibration] [--fit LIST]
 // The controller and the robot link without a GUI: the optimizer's best θ goes to the link
 // whenever it changes; the link's governor moves the robot (only if armed). With
 // --until-settled it exits 0 once the optimizer has converged and the robot has arrived, or 2
 // with the reason when that cannot happen (optimizer stuck, link disarmed, timeout).
+// Observed frames (the simulated world's camera, or UDP datagrams from a real one) close the
+// loop: model-error feedback on their markers and, in the background, calibration of the
+// --fit parameters from a sliding window of them (calib/online_calibration.hpp).
 #include <chrono>
 #include <iostream>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
-#include <shapectl/calib/live_observation.hpp>
+#include <shapectl/calib/observation_receiver.hpp>
+#include <shapectl/calib/online_calibration.hpp>
 #include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/control/controller.hpp>
 #include <shapectl/control/targets_file.hpp>
@@ -23,6 +30,7 @@
 #include <shapectl/link/stop_signal.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 
+#include "closed_loop_options.hpp"
 #include "commands.hpp"
 #include "result_json.hpp"
 
@@ -42,13 +50,16 @@ struct RunArgs {
   std::string robot = "sim";  // a LinkKind name
   LinkConfig link;
   double watchdog_ms = 100;
-  // The simulated real object (calib/simulated_world.hpp): its camera observes markers on the
-  // target nodes; with feedback on, the controller closes the loop on them.
-  std::string world;
-  double camera_rate = 10;       // observations per second
-  double camera_sigma = 0.0003;  // m
-  bool feedback = true;
+  ClosedLoopArgs loop;  // the simulated world, feedback, online calibration
+  // A real camera's frames: one JSON frame per UDP datagram (calib/observation_receiver.hpp).
+  int observations_udp = -1;  // port; -1: none
+  std::string observations_address = "127.0.0.1";
 };
+
+// Whether frames will arrive: only then do feedback and calibration matter.
+bool observed(const RunArgs& args) {
+  return !args.loop.world.empty() || args.observations_udp >= 0;
+}
 
 nlohmann::json link_json(const LinkStatus& s) {
   return {{"kind", s.kind},
@@ -88,27 +99,37 @@ void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
 struct RunInputs {
   Scene scene;
   TargetsInput targets;
-  std::unique_ptr<SimulatedWorld> world;  // --world
+  std::unique_ptr<SimulatedWorld> world;          // --world
+  std::unique_ptr<ObservationReceiver> receiver;  // --observations-udp
+  OnlineCalibrationOptions calibration;
 };
+
+std::unique_ptr<ObservationReceiver> make_receiver(const RunArgs& args, const Scene& scene) {
+  if (args.observations_udp < 0) return nullptr;
+  auto receiver =
+      std::make_unique<ObservationReceiver>(args.observations_address, args.observations_udp,
+                                            ObservationContext{.node_count =
+                                                                   scene.object_mesh->node_count(),
+                                                               .robot = scene.robot->model.get(),
+                                                               .allow_points_files = false});
+  std::cerr << "run: observations on udp " << args.observations_address << ":" << receiver->port()
+            << "\n";
+  return receiver;
+}
 
 // --world: the "real" object, observed on the target nodes (the centre-line's too).
 std::unique_ptr<SimulatedWorld> make_world(const RunArgs& args, const Scene& model,
                                            const ShapeTargets& targets) {
-  if (args.world.empty()) return nullptr;
+  if (args.loop.world.empty()) return nullptr;
   if (args.link.kind != LinkKind::Sim)
     throw InputError("run", "--world", "--robot sim (a real robot holds a real object)");
-  if (!(args.camera_rate > 0 && args.camera_rate <= 1000))
-    throw InputError("run", "--camera-rate", "0 < rate <= 1000 per second", args.camera_rate);
-  if (!(args.camera_sigma >= 0 && args.camera_sigma <= 0.1))
-    throw InputError("run", "--camera-sigma", "0 <= sigma <= 0.1 m", args.camera_sigma);
-  const Scene world = load_scene(args.world);
-  SimulatedCamera camera;
+  SimulatedCamera camera = simulated_camera(args.loop, "run");
   camera.marker_nodes = targets.nodes;
-  camera.sigma = args.camera_sigma;
+  const Scene world = load_scene(args.loop.world);
   try {
-    return std::make_unique<SimulatedWorld>(world, model, camera, args.camera_rate);
+    return std::make_unique<SimulatedWorld>(world, model, camera, args.loop.camera_rate);
   } catch (const std::invalid_argument& e) {
-    throw InputError(args.world, "object", e.what());
+    throw InputError(args.loop.world, "object", e.what());
   }
 }
 
@@ -123,7 +144,9 @@ RunInputs load_run_inputs(RunArgs& args) {
   args.link.sim_initial_joints = scene.robot->reference_joints;
   if (args.timeout < 0) throw InputError("run", "--timeout", "a number >= 0", args.timeout);
   std::unique_ptr<SimulatedWorld> world = make_world(args, scene, targets.targets);
-  return {std::move(scene), std::move(targets), std::move(world)};
+  OnlineCalibrationOptions calibration = online_calibration_options(args.loop, "run");
+  std::unique_ptr<ObservationReceiver> receiver = make_receiver(args, scene);
+  return {std::move(scene), std::move(targets), std::move(world), std::move(receiver), calibration};
 }
 
 // The session log if --log names one, opened with a "session" event; else null.
@@ -209,25 +232,63 @@ bool observed_at_targets(const ControllerSnapshot& s) {
   return !s.feedback || (s.observations > 0 && s.observed_error < 1e-3);
 }
 
-// --world: the world settles at the robot's measured joints; a due observation goes to the
-// controller and the log (with the world's true error, which only a simulation knows).
-void observe_world(SimulatedWorld& world, Controller& controller, const ControllerSnapshot& snap,
-                   const LinkStatus& st, double time, SessionLog* log) {
-  if (st.measured.size() != snap.joints.size()) return;  // no feedback from the robot yet
-  const std::optional<ObservationFrame> frame = world.step(time, st.measured);
-  if (!frame) return;
-  controller.observe(live_observation(*frame));
-  if (log)
-    log->write("observation", {{"time", time},
-                               {"true_error", world.true_error(snap.targets)},
-                               {"observed_error", snap.observed_error},
-                               {"model_error", snap.model_error}});
+// The observed frames and where they go: the simulated world's camera and/or UDP datagrams,
+// into the closed loop (feedback and online calibration) and the log.
+struct Observers {
+  SimulatedWorld* world = nullptr;
+  ObservationReceiver* receiver = nullptr;
+  OnlineCalibration* calibration = nullptr;
+  std::uint64_t reported_rejections = 0;
+};
+
+void log_observation(SessionLog* log, const ObservationFrame& frame, double time,
+                     const ControllerSnapshot& snap, const SimulatedWorld* world) {
+  if (!log) return;
+  nlohmann::json event = {{"time", time},
+                          {"markers", frame.markers.size()},
+                          {"points", frame.points.size()},
+                          {"observed_error", snap.observed_error},
+                          {"model_error", snap.model_error}};
+  if (world) event["true_error"] = world->true_error(snap.targets);
+  log->write("observation", event);
+}
+
+// The world settles at the robot's measured joints; due frames, and every datagram waiting,
+// go to the closed loop; a finished calibration goes to the controller (and the log).
+void observe(Observers& o, const ControllerSnapshot& snap, const LinkStatus& st, double time,
+             SessionLog* log) {
+  std::vector<ObservationFrame> frames;
+  if (o.world && st.measured.size() == snap.joints.size())  // feedback from the robot
+    if (std::optional<ObservationFrame> frame = o.world->step(time, st.measured))
+      frames.push_back(std::move(*frame));
+  if (o.receiver) {
+    for (ObservationFrame& f : o.receiver->receive()) frames.push_back(std::move(f));
+    if (o.receiver->rejected() > o.reported_rejections) {
+      std::cerr << "run: observation rejected (" << o.receiver->rejected()
+                << " so far): " << o.receiver->last_rejection() << "\n";
+      o.reported_rejections = o.receiver->rejected();
+    }
+  }
+  for (const ObservationFrame& frame : frames) {
+    if (frame.markers.empty() && frame.points.empty()) continue;
+    o.calibration->observe(frame);
+    log_observation(log, frame, time, snap, o.world);
+  }
+  const std::uint64_t runs = o.calibration->status().runs;
+  o.calibration->poll(time);
+  const OnlineCalibrationStatus c = o.calibration->status();
+  if (c.runs > runs && log)
+    log->write("calibration", {{"time", time},
+                               {"applied", c.applied},
+                               {"error", c.error},
+                               {"rms_before", c.result ? c.result->rms_before : NAN},
+                               {"rms_after", c.result ? c.result->rms_after : NAN}});
 }
 
 // Sends each new snapshot's θ to the link (and the log) and prints progress, until settled,
 // failed, timed out or stopped by a signal.
 RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLink& link,
-                            SessionLog* log, const RunClock& clock, SimulatedWorld* world) {
+                            SessionLog* log, const RunClock& clock, Observers& observers) {
   RunOutcome outcome;
   std::uint64_t seen = 0;
   std::string last_report;
@@ -241,7 +302,7 @@ RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLi
       if (log) log_snapshot(*log, snap);
     }
     const LinkStatus st = link.status();
-    if (world) observe_world(*world, controller, snap, st, clock.elapsed(), log);
+    observe(observers, snap, st, clock.elapsed(), log);
     const std::string report = progress_report(snap, st);
     if (report != last_report) {
       std::cerr << "run: " << clock.elapsed() << " s: " << report << " (error "
@@ -277,7 +338,7 @@ LinkStatus stop_run(RobotLink& link, Controller& controller, const std::string& 
 
 // What `run` prints on stdout.
 nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status,
-                          RobotLink& link, const SimulatedWorld* world) {
+                          RobotLink& link, const Observers& observers) {
   const ControllerSnapshot& snap = *outcome.snapshot;
   nlohmann::json result = {{"settled", outcome.settled},         {"status", to_string(snap.status)},
                            {"error_mean", snap.error.mean},      {"error_max", snap.error.max},
@@ -292,12 +353,24 @@ nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_sta
   }
   if (snap.observations > 0) {
     result["observations"] = snap.observations;
+    result["observations_ignored"] = snap.observations_ignored;
     result["feedback"] = snap.feedback;
     result["model_error"] = snap.model_error;
     result["observed_error"] =
         std::isfinite(snap.observed_error) ? nlohmann::json(snap.observed_error) : nullptr;
   }
-  if (world) result["true_error"] = world->true_error(snap.targets);
+  if (snap.model_updates > 0 || observers.calibration->status().runs > 0) {
+    const OnlineCalibrationStatus c = observers.calibration->status();
+    result["calibration"] = {{"runs", c.runs},
+                             {"applied", c.applied_runs},
+                             {"youngs_modulus", youngs_modulus_of(snap.material)},
+                             {"density", snap.material.density},
+                             {"error", c.error}};
+  }
+  if (observers.receiver)
+    result["datagrams"] = {{"received", observers.receiver->received()},
+                           {"rejected", observers.receiver->rejected()}};
+  if (observers.world) result["true_error"] = observers.world->true_error(snap.targets);
   if (!outcome.failure.empty()) result["reason"] = outcome.failure;
   return result;
 }
@@ -308,16 +381,17 @@ void run(RunArgs args) {
   const auto link = make_run_link(args, inputs.scene, log);
   Controller controller(inputs.scene);
   set_run_targets(controller, inputs.targets, log.get());
-  if (inputs.world) controller.set_feedback(args.feedback);
+  if (observed(args)) controller.set_feedback(args.loop.feedback);
+  OnlineCalibration calibration(controller, inputs.scene, inputs.calibration);
+  Observers observers{inputs.world.get(), inputs.receiver.get(), &calibration};
   install_stop_signal_handlers();
   controller.start();
   link->start();
   const RunClock clock;
   if (args.arm) arm_when_ready(*link, clock);  // throws if it cannot
-  const RunOutcome outcome =
-      follow_optimizer(args, controller, *link, log.get(), clock, inputs.world.get());
+  const RunOutcome outcome = follow_optimizer(args, controller, *link, log.get(), clock, observers);
   const LinkStatus final_status = stop_run(*link, controller, outcome.failure);
-  const nlohmann::json result = run_result(outcome, final_status, *link, inputs.world.get());
+  const nlohmann::json result = run_result(outcome, final_status, *link, observers);
   if (log) log->write("end", {{"settled", outcome.settled}, {"reason", outcome.failure}});
   std::cout << result.dump(2) << "\n";
   if (!outcome.failure.empty()) throw SolverFailure(outcome.failure);
@@ -355,17 +429,13 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--egm-right-port", args->link.egm_right_port,
                   "UDP port of the right arm (ROB_R)")
       ->capture_default_str();
-  cmd->add_option("--world", args->world,
-                  "WORLD.json: simulate the real object (true material, grip offsets; same mesh) "
-                  "with --robot sim; "
-                  "a camera observes markers on the target nodes")
-      ->check(CLI::ExistingFile);
-  cmd->add_option("--camera-rate", args->camera_rate, "--world: observations per second")
+  add_closed_loop_options(*cmd, args->loop);
+  cmd->add_option("--observations-udp", args->observations_udp,
+                  "PORT: observed frames from a camera program, one JSON frame per datagram "
+                  "(docs/calibration.md)");
+  cmd->add_option("--observations-address", args->observations_address,
+                  "local address for --observations-udp")
       ->capture_default_str();
-  cmd->add_option("--camera-sigma", args->camera_sigma, "--world: marker noise, m")
-      ->capture_default_str();
-  cmd->add_flag("--feedback,!--no-feedback", args->feedback,
-                "--world: close the loop on the observations (default) or not (open loop)");
   cmd->callback([args] { run(*args); });
 }
 

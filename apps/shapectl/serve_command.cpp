@@ -10,6 +10,7 @@
 #include <shapectl/server/server.hpp>
 #include <shapectl/server/web_paths.hpp>
 
+#include "closed_loop_options.hpp"
 #include "commands.hpp"
 
 namespace shapectl::cli {
@@ -24,7 +25,7 @@ struct ServeArgs {
   std::string web_root;
   std::string scenes_dir;
   double rate = 30;
-  std::string world;  // the simulated real object (docs/calibration.md)
+  ClosedLoopArgs loop;  // the simulated real object, the online calibration
 };
 
 void run_serve(const ServeArgs& args) {
@@ -55,16 +56,19 @@ void run_serve(const ServeArgs& args) {
     link = make_robot_link(config, *description.robot->model, description.robot->collisions);
     link->start();
   }
-  server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get());
-  if (!args.world.empty()) {
+  server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(), {},
+                          online_calibration_options(args.loop, "serve"));
+  if (!args.loop.world.empty()) {
     if (args.robot != "sim")
       throw InputError("serve", "--world", "--robot sim (a real robot holds a real object)");
-    const Scene model = load_scene(scene), world = load_scene(args.world);
-    SimulatedCamera camera;  // markers on the target nodes, set at every tick
+    const Scene model = load_scene(scene), world = load_scene(args.loop.world);
+    // Markers on the target nodes, set at every tick.
+    const SimulatedCamera camera = simulated_camera(args.loop, "serve");
     try {
-      session.set_world(std::make_unique<SimulatedWorld>(world, model, camera, 10.0));
+      session.set_world(
+          std::make_unique<SimulatedWorld>(world, model, camera, args.loop.camera_rate));
     } catch (const std::invalid_argument& e) {
-      throw InputError(args.world, "object", e.what());
+      throw InputError(args.loop.world, "object", e.what());
     }
   }
   server::Server server(session, options);
@@ -99,11 +103,7 @@ void add_serve_command(CLI::App& app) {
                   "Directory with index.html (default: the repository's web/)");
   cmd->add_option("--scenes-dir", args->scenes_dir,
                   "Scenes offered for switching (default: scenes/)");
-  cmd->add_option(
-         "--world", args->world,
-         "WORLD.json: simulate the real object (with --robot sim); a camera observes the target "
-         "nodes 10 times a second and the page's feedback switch closes the loop")
-      ->check(CLI::ExistingFile);
+  add_closed_loop_options(*cmd, args->loop);
   cmd->add_option("--rate", args->rate, "State messages per second to each page")
       ->check(CLI::Range(1.0, 120.0))
       ->capture_default_str();

@@ -77,8 +77,9 @@ TEST_F(ClosedLoopCli, FeedbackBringsTheWorldToTargetsTheOpenLoopMisses) {
   const nlohmann::json open = run({"--no-feedback"});
   EXPECT_GE(open["true_error"].get<double>(), 5e-3) << "the model alone misses by millimetres";
 
+  // Feedback alone (no online calibration): the model stays as the scene says.
   const std::filesystem::path log = dir.path() / "closed.jsonl";
-  const nlohmann::json closed = run({"--log", log.string()});
+  const nlohmann::json closed = run({"--log", log.string(), "--no-online-calibration"});
   ASSERT_TRUE(closed["settled"].get<bool>());
   EXPECT_LT(closed["true_error"].get<double>(), 1e-3);
   EXPECT_LT(closed["observed_error"].get<double>(), 1e-3);
@@ -119,6 +120,38 @@ TEST_F(ClosedLoopCli, FeedbackBringsTheWorldToTargetsTheOpenLoopMisses) {
                 link["acceleration"][j].get<double>() * T * T * (1 + 1e-9) + 1e-12)
           << "tick " << k << ", joint " << j;
     }
+}
+
+// Feedback and the online calibration together: the model learns the world on the way.
+TEST_F(ClosedLoopCli, TheOnlineCalibrationLearnsTheWorldWhileTheLoopReachesTheTargets) {
+  const std::filesystem::path log = dir.path() / "calibrated.jsonl";
+  const nlohmann::json r = run({"--log", log.string()});
+  ASSERT_TRUE(r["settled"].get<bool>()) << r.dump();
+  EXPECT_LT(r["true_error"].get<double>(), 1e-3);
+  ASSERT_TRUE(r.contains("calibration")) << r.dump();
+  EXPECT_GE(r["calibration"]["applied"].get<int>(), 1) << r.dump();
+  EXPECT_LT(r["model_error"].get<double>(), 1e-3) << "the calibrated model predicts the world";
+  const auto calibrations = log_events(log, "calibration");
+  ASSERT_FALSE(calibrations.empty());
+  EXPECT_LT(calibrations.front()["rms_after"].get<double>(),
+            calibrations.front()["rms_before"].get<double>());
+}
+
+TEST_F(ClosedLoopCli, BadClosedLoopOptionsNameTheOption) {
+  const std::vector<std::pair<std::vector<std::string>, std::string>> cases = {
+      {{"--fit", "stiffness"}, "--fit"},
+      {{"--camera-outliers", "1.5"}, "--camera-outliers"},
+      {{"--camera-points", "-3"}, "--camera-points"},
+      {{"--observations-udp", "70000"}, "--observations-udp"},
+      {{"--observations-udp", "0", "--observations-address", "nowhere"}, "--observations-udp"},
+  };
+  for (const auto& [extra, option] : cases) {
+    std::vector<std::string> all = args;
+    all.insert(all.end(), extra.begin(), extra.end());
+    const auto r = run_cli(all);
+    EXPECT_EQ(r.exit_code, 1) << option << ": " << r.err;
+    EXPECT_NE(r.err.find(option), std::string::npos) << r.err;
+  }
 }
 
 TEST_F(ClosedLoopCli, AWorldNeedsTheSimulatedRobotAndTheModelsMesh) {

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <thread>
+
 #include "support/controller_wait.hpp"
 #include "support/test_support.hpp"
 
@@ -75,8 +78,7 @@ TEST_F(SessionTest, ObserveFeedsTheClosedLoopAndBadObservationsChangeNothing) {
   bad[0]["markers"][0]["node"] = 100000;
   bad[1]["joints"].erase(first->joint_names[3]);
   bad[2]["points_file"] = "/etc/passwd";
-  bad[3].erase("markers");
-  bad[3]["points"] = {{0.4, 0, 0.3}};
+  bad[3].erase("markers");  // nothing observed
   bad[4]["markers"][0]["position"][1] = "nan";
   for (const auto& b : bad) {
     const auto r = observe(b);
@@ -95,6 +97,52 @@ TEST_F(SessionTest, ObserveFeedsTheClosedLoopAndBadObservationsChangeNothing) {
   EXPECT_NEAR(state["model_error"].get<double>(), 0.002, 1e-6);
   ASSERT_EQ(state["observed_markers"].size(), 1u);
   EXPECT_EQ(state["observed_markers"][0][0], 5);
+}
+
+TEST_F(SessionTest, ObservedFramesFeedTheCalibrationWhichTheClientsCanRunAndFollow) {
+  const auto first = session.controller().snapshot();
+  nlohmann::json joints = nlohmann::json::object();
+  for (std::size_t j = 0; j < first->joint_names.size(); ++j)
+    joints[first->joint_names[j]] = first->joints[j];
+  EXPECT_TRUE(session.handle(R"({"type":"set_auto_calibration","on":false})").ok);
+  auto r = session.handle(R"({"type":"calibrate","id":4})");
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.text.find("no observed frames yet"), std::string::npos) << r.text;
+  EXPECT_EQ(reply_json(r)["id"], 4);
+
+  // A depth camera's frame: points only, on the model's own surface 1 mm lower.
+  nlohmann::json points = nlohmann::json::array();
+  for (int node = 0; node < 40; ++node) {
+    const Vec3 p = first->positions.segment<3>(3 * node) - Vec3(0, 0, 0.001);
+    points.push_back({p.x(), p.y(), p.z()});
+  }
+  const nlohmann::json frame = {{"joints", joints}, {"points", points}};
+  r = session.handle(nlohmann::json{{"type", "observe"}, {"frame", frame}}.dump());
+  ASSERT_TRUE(r.ok) << r.text;
+  session.tick();
+  auto state = nlohmann::json::parse(session.state_message(1));
+  EXPECT_EQ(state["observed_points"].size(), 40u);
+  EXPECT_FALSE(state["calibration"]["automatic"].get<bool>());
+  EXPECT_EQ(state["calibration"]["frames"], 1);
+  EXPECT_TRUE(state["calibration"]["result"].is_null());
+  EXPECT_EQ(state["model"]["youngs_modulus"].get<double>(),
+            youngs_modulus_of(session.controller().scene().material));
+
+  ASSERT_TRUE(session.handle(R"({"type":"calibrate"})").ok);
+  for (int k = 0; k < 6000 && state["calibration"]["runs"] == 0; ++k) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    session.tick();
+    state = nlohmann::json::parse(session.state_message(1));
+  }
+  const nlohmann::json& result = state["calibration"]["result"];
+  ASSERT_FALSE(result.is_null()) << state["calibration"].dump();
+  ASSERT_FALSE(result["parameters"].empty());
+  EXPECT_EQ(result["parameters"][0]["name"], "youngs_modulus");
+  EXPECT_EQ(result["parameters"][0]["unit"], "Pa");
+  EXPECT_GT(result["rms_before"].get<double>(), 0);
+  EXPECT_TRUE(result["applied"].is_boolean());
+  EXPECT_FALSE(session.handle(R"({"type":"calibrate","extra":1})").ok);
+  EXPECT_FALSE(session.handle(R"({"type":"set_auto_calibration","on":"yes"})").ok);
 }
 
 TEST_F(SessionTest, SecondSetTargetMovesTheFirstAndRemoveTargetDeletesIt) {

@@ -23,9 +23,10 @@ struct Inbox {
   bool reset = false;
   std::optional<ShapeObservation> observation;  // the newest only: an older one is stale
   std::optional<bool> feedback;
+  std::optional<Scene> model;
   bool empty() const {
     return !targets && !centerline && !clear && !paused && !jog && !reset && !observation &&
-           !feedback;
+           !feedback && !model;
   }
 };
 
@@ -58,7 +59,10 @@ bool parse(std::string_view name, ControllerStatus* status) {
 struct Controller::State {
   Scene scene;
   ControllerOptions options;
-  std::unique_ptr<GrippedObject> object;
+  // The object as loaded, for callers on other threads (mesh, robot, sizes: never replaced),
+  // and the model the worker solves with (set_model replaces it).
+  std::shared_ptr<const GrippedObject> loaded;
+  std::shared_ptr<const GrippedObject> object;
   std::unique_ptr<ReducedObjective> objective;
   std::unique_ptr<Optimizer> optimizer;
   std::optional<BarAxis> bar_axis;
@@ -82,6 +86,10 @@ struct Controller::State {
   std::vector<std::pair<int, Vec3>> observed_markers;
   double observed_error = 0;
   std::uint64_t observations = 0;
+  std::optional<ShapeObservation> last_observation;  // the newest one taken
+  std::uint64_t observations_ignored = 0;
+  std::string observation_problem;
+  std::uint64_t model_updates = 0;
 
   mutable std::mutex inbox_mutex;
   std::condition_variable inbox_changed;
@@ -107,6 +115,9 @@ struct Controller::State {
     objective = std::make_unique<ReducedObjective>(
         objective->with_targets(feedback_on ? feedback->corrected(user_targets) : user_targets));
   }
+  // Swaps in a new model at the current θ; false (last_error set) when it has no stable
+  // equilibrium there.
+  bool replace_model(const Scene& model);
   // Takes an observation into the feedback; true when the optimizer was re-aimed.
   bool take(const ShapeObservation& observation);
   // Whether the corrected targets moved past the threshold from those aimed at now.
@@ -118,7 +129,7 @@ struct Controller::State {
 };
 
 void Controller::State::validate(const ShapeTargets& t) const {
-  check_targets(t, object->node_count(), "targets");
+  check_targets(t, loaded->node_count(), "targets");
 }
 
 void Controller::State::apply(Inbox in) {
@@ -162,29 +173,64 @@ void Controller::State::apply(Inbox in) {
       last_error = "jog refused: statics " + e.statics.reason;
     }
   }
-  if (in.reset) feedback->reset(), observed_markers.clear();
+  if (in.reset) feedback->reset(), observed_markers.clear(), last_observation.reset();
+  const bool remodelled = in.model && replace_model(*in.model);
   if (in.feedback) {
     feedback_on = *in.feedback;
     aim();
   }
   const bool reaimed = in.observation && take(*in.observation);
-  if (in.clear || in.targets || in.centerline || in.reset || in.feedback || reaimed) {
+  if (in.clear || in.targets || in.centerline || in.reset || in.feedback || reaimed || remodelled) {
     objective->rescore(current);
     optimizer->reset();
   }
   idle = false;
 }
 
+bool Controller::State::replace_model(const Scene& model) {
+  auto next_object = std::make_shared<const GrippedObject>(model);
+  auto next_objective =
+      std::make_unique<ReducedObjective>(*next_object, objective->targets(), objective->options());
+  // No chord steps from the old model's factorization: it belongs to another Hessian.
+  Evaluation next = next_objective->evaluate(current.joints, current.positions);
+  if (!next.statics.converged() || !next_objective->confirm_stable(next)) {
+    last_error = "model update refused: no stable equilibrium at the current joints (" +
+                 next.statics.reason + ")";
+    return false;
+  }
+  if (last_observation) {
+    const Eigen::VectorXd& joints = last_observation->joints;
+    const Evaluation before = objective->evaluate(joints, current.positions, 0, &current);
+    const Evaluation after = next_objective->evaluate(joints, next.positions, 0, &next);
+    if (before.statics.converged() && after.statics.converged())
+      feedback->model_changed(before.positions, after.positions);
+  }
+  current = std::move(next);
+  objective = std::move(next_objective);  // before the object it refers to
+  object = std::move(next_object);
+  ++model_updates;
+  last_error.clear();
+  if (feedback_on) aim();
+  return true;
+}
+
 bool Controller::State::take(const ShapeObservation& observation) {
-  // The model's prediction at the joints the observation was taken at (the robot may lag θ*).
-  Evaluation predicted = objective->evaluate(observation.joints, current.positions, 0, &current);
+  // The model's prediction at the joints the observation was taken at (the robot may lag θ*),
+  // from the current shape with the gripped nodes carried along.
+  Positions x = current.positions;
+  object->carry_gripped_nodes(current.joints, observation.joints, current.positions, x);
+  Evaluation predicted = objective->evaluate(observation.joints, x, 0, &current);
   if (!predicted.statics.converged()) {
-    last_error =
+    // Not the optimizer's failure: the loop goes on with the next observation.
+    ++observations_ignored;
+    observation_problem =
         "observation ignored: no equilibrium at its joints (" + predicted.statics.reason + ")";
     return false;
   }
+  observation_problem.clear();
   feedback->observe(observation.markers, predicted.positions);
   observed_markers = observation.markers;
+  last_observation = observation;
   ++observations;
   double sum = 0;
   int count = 0;
@@ -260,6 +306,11 @@ void Controller::State::publish() {
   s->model_error = feedback->last_model_error();
   s->observed_error = observed_error;
   s->observations = observations;
+  s->material = object->scene().material;
+  for (const Grip& g : object->scene().grips) s->grip_offsets.push_back(g.offset);
+  s->model_updates = model_updates;
+  s->observations_ignored = observations_ignored;
+  s->observation_problem = observation_problem;
   s->status = paused                         ? ControllerStatus::Paused
               : objective->targets().empty() ? ControllerStatus::Idle
               : !idle                        ? ControllerStatus::Optimizing
@@ -291,7 +342,8 @@ Controller::Controller(const Scene& scene, ControllerOptions options)
   State& s = *state_;
   s.scene = scene;
   s.options = options;
-  s.object = std::make_unique<GrippedObject>(s.scene);
+  s.loaded = std::make_shared<const GrippedObject>(s.scene);
+  s.object = s.loaded;
   s.objective = std::make_unique<ReducedObjective>(*s.object);
   s.optimizer = make_optimizer(options.optimizer, options.gradient);
   s.bar_axis = find_bar_axis(s.object->mesh());
@@ -303,8 +355,8 @@ Controller::Controller(const Scene& scene, ControllerOptions options)
 Controller::~Controller() { stop(); }
 
 const Scene& Controller::scene() const { return state_->scene; }
-const TetMesh& Controller::mesh() const { return state_->object->mesh(); }
-const RobotModel& Controller::robot() const { return state_->object->robot(); }
+const TetMesh& Controller::mesh() const { return state_->loaded->mesh(); }
+const RobotModel& Controller::robot() const { return state_->loaded->robot(); }
 
 void Controller::start() {
   if (state_->running.exchange(true)) return;
@@ -366,10 +418,10 @@ void Controller::set_paused(bool paused) {
 }
 
 void Controller::set_joints(const Eigen::VectorXd& joints) {
-  if (joints.size() != state_->object->joint_count())
+  if (joints.size() != state_->loaded->joint_count())
     throw InputError("joints", "",
                      "one value per active joint (" +
-                         std::to_string(state_->object->joint_count()) + ")");
+                         std::to_string(state_->loaded->joint_count()) + ")");
   if (!joints.allFinite()) throw InputError("joints", "", "finite values");
   {
     std::lock_guard lock(state_->inbox_mutex);
@@ -380,7 +432,7 @@ void Controller::set_joints(const Eigen::VectorXd& joints) {
 }
 
 void Controller::observe(ShapeObservation observation) {
-  const int joints = state_->object->joint_count(), nodes = state_->object->node_count();
+  const int joints = state_->loaded->joint_count(), nodes = state_->loaded->node_count();
   if (observation.joints.size() != joints)
     throw InputError("observation", "joints",
                      "one value per active joint (" + std::to_string(joints) + ")");
@@ -400,6 +452,20 @@ void Controller::observe(ShapeObservation observation) {
 
 void Controller::set_feedback(bool on) {
   post(*state_, [&](Inbox& in) { in.feedback = on; });
+}
+
+void Controller::set_model(const Scene& model) {
+  const Scene& loaded = state_->scene;
+  const auto other = [](const std::string& what) {
+    throw InputError("model", what,
+                     "the controller's object (only material and grip offsets may differ)");
+  };
+  if (!model.object_mesh || model.object_mesh->node_count() != loaded.object_mesh->node_count())
+    other("object.mesh");
+  if (!model.robot || model.robot->model->active_count() != loaded.robot->model->active_count())
+    other("robot");
+  if (model.grips.size() != loaded.grips.size()) other("grips");
+  post(*state_, [&](Inbox& in) { in.model = model; });
 }
 
 void Controller::reset() {

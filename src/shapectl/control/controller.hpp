@@ -78,6 +78,14 @@ struct ControllerSnapshot {
   double model_error = 0;
   double observed_error = 0;
   std::uint64_t observations = 0;
+  // Observations the model could not predict (no equilibrium at their joints), and why the
+  // newest was ignored (empty when it was taken).
+  std::uint64_t observations_ignored = 0;
+  std::string observation_problem;
+  // The model the optimizer works with: the scene's values until set_model replaces them.
+  Material material;
+  std::vector<Eigen::Isometry3d> grip_offsets;  // one per grip
+  std::uint64_t model_updates = 0;
 };
 
 class Controller {
@@ -87,7 +95,7 @@ class Controller {
   Controller(const Controller&) = delete;
   Controller& operator=(const Controller&) = delete;
 
-  const Scene& scene() const;
+  const Scene& scene() const;   // as loaded; the current model's values are in the snapshot
   const TetMesh& mesh() const;  // placed rest mesh (node order = file order)
   const RobotModel& robot() const;
 
@@ -113,6 +121,12 @@ class Controller {
   // number finite (InputError otherwise, nothing changed); joints of the robot's size.
   void observe(ShapeObservation observation);
   void set_feedback(bool on);
+  // A better model of the same object (a calibration's: material, density, grip offsets; same
+  // mesh, robot and grips). The controller continues from the same θ: the equilibrium is
+  // solved anew there and the feedback's estimate moved with the model
+  // (ModelErrorFeedback::model_changed), so the robot sees no jump. Refused, with last_error
+  // set, when the new model has no stable equilibrium at θ. InputError for another object.
+  void set_model(const Scene& model);
 
   std::shared_ptr<const ControllerSnapshot> snapshot() const;
   // Blocks until a snapshot with sequence > `after` exists, or the timeout passes.

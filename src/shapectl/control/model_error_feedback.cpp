@@ -22,6 +22,14 @@ void ModelErrorFeedback::observe(const std::vector<std::pair<int, Vec3>>& observ
   last_model_error_ = observed.empty() ? 0 : std::sqrt(sum / double(observed.size()));
 }
 
+void ModelErrorFeedback::model_changed(const Positions& before, const Positions& after) {
+  for (auto& [node, e] : estimate_) {
+    e -= after.segment<3>(3 * node) - before.segment<3>(3 * node);
+    const double size = e.norm();
+    if (size > options_.max_correction) e *= options_.max_correction / size;
+  }
+}
+
 Vec3 ModelErrorFeedback::estimate(int node) const {
   if (estimate_.empty()) return Vec3::Zero();
   if (const auto it = estimate_.find(node); it != estimate_.end()) return it->second;

@@ -39,6 +39,11 @@ class ModelErrorFeedback {
   // One observation: node → observed position (world), and the model's equilibrium at the joints
   // the observation was taken at.
   void observe(const std::vector<std::pair<int, Vec3>>& observed, const Positions& predicted);
+  // The model changed (a new calibration): the prediction at the last observation's joints
+  // moved from `before` to `after`. The estimate follows, ê ← ê − (after − before) at the
+  // observed nodes, so that x̂ + ê, the shape the loop believes the object has, stays the same
+  // and the corrected targets move with the model instead of jumping.
+  void model_changed(const Positions& before, const Positions& after);
   // The targets the optimizer should aim the model at.
   ShapeTargets corrected(const ShapeTargets& targets) const;
   // The current estimate at `node` (zero before any observation).

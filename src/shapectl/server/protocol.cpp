@@ -1,7 +1,5 @@
 #include <shapectl/server/protocol.hpp>
 
-#include <shapectl/calib/live_observation.hpp>
-
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -92,6 +90,8 @@ const std::vector<std::pair<std::string, Command::Type>>& type_names() {
       {"disarm", Command::Type::Disarm},
       {"observe", Command::Type::Observe},
       {"set_feedback", Command::Type::SetFeedback},
+      {"calibrate", Command::Type::Calibrate},
+      {"set_auto_calibration", Command::Type::SetAutoCalibration},
   };
   return names;
 }
@@ -177,17 +177,13 @@ std::string read_scene_name(const JsonInput& scene, const ProtocolContext& conte
 }
 
 // observe: one frame of OBSERVATIONS.json (calib/observations.hpp), never a points file (a
-// client must not make the server read its files); the live loop uses its markers.
-ShapeObservation read_observation(const JsonInput& frame, const ProtocolContext& context) {
+// client must not make the server read its files). Its markers feed the model-error feedback;
+// the whole frame, points too, feeds the session's calibration.
+ObservationFrame read_observation(const JsonInput& frame, const ProtocolContext& context) {
   if (!context.robot) frame.fail_problem("the scene has no robot: nothing to close the loop with");
-  const ObservationFrame f = read_observation_frame(frame, {.node_count = context.node_count,
-                                                            .robot = context.robot,
-                                                            .allow_points_files = false});
-  if (f.markers.empty())
-    frame.fail_problem(
-        "a frame without markers: the live loop uses markers (point clouds go to shapectl "
-        "calibrate)");
-  return live_observation(f);
+  return read_observation_frame(frame, {.node_count = context.node_count,
+                                        .robot = context.robot,
+                                        .allow_points_files = false});
 }
 
 // The keys a command of this type may have, each read and checked into `c`.
@@ -197,6 +193,7 @@ void read_arguments(const JsonInput& message, const ProtocolContext& context, Co
     case T::Ping:
     case T::ClearTargets:
     case T::Reset:
+    case T::Calibrate:
     case T::Arm:
     case T::Disarm: message.expect_only({"type", "id"}); break;
     case T::SetTarget:
@@ -235,11 +232,12 @@ void read_arguments(const JsonInput& message, const ProtocolContext& context, Co
       break;
     case T::Observe:
       message.expect_only({"type", "id", "frame"});
-      c.observation = read_observation(message.at("frame"), context);
+      c.frame = read_observation(message.at("frame"), context);
       break;
     case T::SetFeedback:
+    case T::SetAutoCalibration:
       message.expect_only({"type", "id", "on"});
-      c.feedback = message.at("on").boolean();
+      c.on = message.at("on").boolean();
       break;
   }
 }

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
+#include <shapectl/calib/observations.hpp>
 #include <shapectl/control/controller.hpp>
 
 namespace shapectl::server {
@@ -54,7 +55,9 @@ struct Command {
     Arm,
     Disarm,
     Observe,
-    SetFeedback
+    SetFeedback,
+    Calibrate,
+    SetAutoCalibration
   };
   Type type = Type::Ping;
   nlohmann::json id;             // echoed in the reply; null when the client sent none
@@ -67,8 +70,8 @@ struct Command {
   double value = 0;              // SetJoint, rad (m for prismatic joints)
   Eigen::VectorXd joints;        // SetJoints
   std::string scene;             // LoadScene: one of ProtocolContext::scene_names
-  ShapeObservation observation;  // Observe: markers and the joints they were taken at
-  bool feedback = false;         // SetFeedback
+  ObservationFrame frame;        // Observe: markers and/or points, the joints they were taken at
+  bool on = false;               // SetFeedback, SetAutoCalibration
 };
 
 // The client's "id" if `text` is an object carrying a valid one (integer or string of at most

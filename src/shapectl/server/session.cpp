@@ -4,7 +4,6 @@
 #include <cmath>
 #include <fstream>
 
-#include <shapectl/calib/live_observation.hpp>
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
@@ -27,6 +26,53 @@ nlohmann::json observed_markers_json(const std::vector<std::pair<int, Vec3>>& ma
   nlohmann::json out = nlohmann::json::array();
   for (const auto& [node, p] : markers) out.push_back({node, p.x(), p.y(), p.z()});
   return out;
+}
+
+// The model the controller works with now (its material and grip offsets).
+nlohmann::json model_json(const ControllerSnapshot& s, const Scene& scene) {
+  nlohmann::json offsets = nlohmann::json::array();
+  for (std::size_t k = 0; k < s.grip_offsets.size() && k < scene.grips.size(); ++k) {
+    const nlohmann::json pose = scene_pose_json(s.grip_offsets[k]);
+    offsets.push_back(
+        {{"end_effector", scene.robot->end_effectors[scene.grips[k].end_effector].name},
+         {"position", pose.at("position")},
+         {"rpy", pose.at("rpy")}});
+  }
+  return {{"youngs_modulus", youngs_modulus_of(s.material)},
+          {"poisson_ratio", poisson_ratio_of(s.material)},
+          {"density", s.material.density},
+          {"grip_offsets", offsets},
+          {"updates", s.model_updates}};
+}
+
+// The session's calibration: whether one runs, and the newest result (docs/gui.md).
+nlohmann::json calibration_json(const OnlineCalibrationStatus& c) {
+  nlohmann::json result = nullptr;
+  if (const CalibrationResult* r = c.result.get()) {
+    nlohmann::json parameters = nlohmann::json::array();
+    for (const FittedParameter& p : r->parameters)
+      parameters.push_back({{"name", p.name},
+                            {"unit", p.unit},
+                            {"initial", finite_or_null(p.initial)},
+                            {"fitted", finite_or_null(p.fitted)},
+                            {"standard_deviation", finite_or_null(p.standard_deviation)},
+                            {"held", p.held}});
+    nlohmann::json unidentified = nlohmann::json::array();
+    for (const UnidentifiedDirection& d : r->unidentified)
+      unidentified.push_back(
+          {{"held", d.held}, {"standard_deviation", finite_or_null(d.standard_deviation)}});
+    result = {{"parameters", parameters},
+              {"unidentified", unidentified},
+              {"rms_before", finite_or_null(r->rms_before)},
+              {"rms_after", finite_or_null(r->rms_after)},
+              {"iterations", r->iterations},
+              {"seconds", r->seconds},
+              {"converged", r->converged},
+              {"reason", r->reason},
+              {"applied", c.applied}};
+  }
+  return {{"automatic", c.automatic}, {"running", c.running}, {"frames", c.frames},
+          {"runs", c.runs},           {"error", c.error},     {"result", result}};
 }
 
 const char* kind_name(Shape::Kind kind) {
@@ -100,8 +146,11 @@ std::vector<SceneEntry> find_bundled_scenes(const std::filesystem::path& directo
 }
 
 Session::Session(const std::filesystem::path& scene, std::vector<SceneEntry> scenes,
-                 RobotLink* link, ControllerOptions options)
-    : scenes_(std::move(scenes)), link_(link), options_(options) {
+                 RobotLink* link, ControllerOptions options, OnlineCalibrationOptions calibration)
+    : scenes_(std::move(scenes)),
+      link_(link),
+      options_(options),
+      calibration_options_(std::move(calibration)) {
   const std::string name = scene.filename().string();
   auto same = [&](const SceneEntry& e) { return e.name == name; };
   auto it = std::find_if(scenes_.begin(), scenes_.end(), same);
@@ -130,8 +179,10 @@ void Session::load(const SceneEntry& entry) {
                        "a scene with the robot link's robot; " + entry.name + " has other joints");
   }
   auto controller = std::make_unique<Controller>(scene, options_);
+  calibration_.reset();  // it refers to the old controller
   if (controller_) controller_->stop();
   controller_ = std::move(controller);
+  calibration_ = std::make_unique<OnlineCalibration>(*controller_, scene, calibration_options_);
   controller_->start();
   scene_name_ = entry.name;
   targets_ = {};
@@ -260,8 +311,14 @@ void Session::apply(const Command& c) {
       if (!link_) throw InputError("message", "type", "no robot link in this session");
       link_->disarm("disarmed from the GUI");
       break;
-    case T::Observe: controller_->observe(c.observation); break;
-    case T::SetFeedback: controller_->set_feedback(c.feedback); break;
+    case T::Observe: calibration_->observe(c.frame); break;
+    case T::SetFeedback: controller_->set_feedback(c.on); break;
+    case T::Calibrate: {
+      std::string why_not;
+      if (!calibration_->start(&why_not)) throw InputError("message", "calibrate", why_not);
+      break;
+    }
+    case T::SetAutoCalibration: calibration_->set_automatic(c.on); break;
   }
 }
 
@@ -301,6 +358,7 @@ void Session::tick() {
   while (history_.size() > history_capacity) history_.pop_front();
   if (link_) link_->set_target(snapshot_->joints, snapshot_->safe);
   if (world_ && link_) observe_world(t);
+  calibration_->poll(t);
 }
 
 void Session::set_world(std::unique_ptr<SimulatedWorld> world) {
@@ -319,8 +377,7 @@ void Session::observe_world(double time) {
   world_->camera().marker_nodes = snapshot_->targets.nodes;
   const std::optional<ObservationFrame> frame = world_->step(time, st.measured);
   true_error_ = world_->true_error(snapshot_->targets);
-  if (!frame || frame->markers.empty()) return;
-  controller_->observe(live_observation(*frame));
+  if (frame && !(frame->markers.empty() && frame->points.empty())) calibration_->observe(*frame);
 }
 
 bool Session::busy() const { return snapshot_->status == ControllerStatus::Optimizing; }
@@ -370,6 +427,7 @@ std::string Session::scene_message() const {
 
 std::string Session::state_message(int clients) const {
   const ControllerSnapshot& s = *snapshot_;
+  const OnlineCalibrationStatus calibration = calibration_->status();
   nlohmann::json links = nlohmann::json::array();
   for (const auto& T : s.T_world_link) links.push_back(message_pose_json(T));
   const double t = now();
@@ -396,10 +454,15 @@ std::string Session::state_message(int clients) const {
       {"last_error", s.last_error},
       {"feedback", s.feedback},
       {"observations", s.observations},
+      {"observations_ignored", s.observations_ignored},
+      {"observation_problem", s.observation_problem},
       {"model_error", finite_or_null(s.model_error)},
       {"observed_error", finite_or_null(s.observed_error)},
       {"observed_markers", observed_markers_json(s.observed_markers)},
       {"true_error", world_ ? finite_or_null(true_error_) : nlohmann::json()},
+      {"model", model_json(s, controller_->scene())},
+      {"calibration", calibration_json(calibration)},
+      {"observed_points", points_json(calibration.points)},
       {"clients", clients},
       {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)}};
   return m.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);

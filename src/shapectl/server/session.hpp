@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include <shapectl/calib/online_calibration.hpp>
 #include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/control/controller.hpp>
 #include <shapectl/server/protocol.hpp>
@@ -42,8 +43,11 @@ class Session {
  public:
   // Loads `scene` (an InputError if it is bad) and starts its controller. `scenes` are what
   // load_scene may switch to; `scene` is added to them if absent. `link` may be null.
+  // Observed frames (`observe`, the simulated world) go through an OnlineCalibration made
+  // with `calibration`.
   Session(const std::filesystem::path& scene, std::vector<SceneEntry> scenes,
-          RobotLink* link = nullptr, ControllerOptions options = {});
+          RobotLink* link = nullptr, ControllerOptions options = {},
+          OnlineCalibrationOptions calibration = {});
   ~Session();
 
   struct Reply {
@@ -55,9 +59,10 @@ class Session {
   // Validates and applies one client message; never throws for bad input.
   Reply handle(std::string_view text);
 
-  // Called at the streaming rate: samples the history, forwards θ to the link, and with a
+  // Called at the streaming rate: samples the history, forwards θ to the link, with a
   // simulated world settles it at the link's measured joints and sends its camera's
-  // observations (markers on the current target nodes) to the controller.
+  // observations (markers on the current target nodes) to the closed loop, and hands a
+  // finished calibration to the controller.
   void tick();
   // `serve --world`: the simulated real object; needs a link (its measured joints) and holds
   // only for the scene it was made for (the session then offers no other).
@@ -72,6 +77,7 @@ class Session {
   bool busy() const;
 
   Controller& controller() { return *controller_; }
+  const OnlineCalibration& calibration() const { return *calibration_; }
   const std::string& scene_name() const { return scene_name_; }
 
   static constexpr double editing_window = 0.3;  // s
@@ -89,7 +95,9 @@ class Session {
   std::string scene_name_;
   RobotLink* link_;
   ControllerOptions options_;
+  OnlineCalibrationOptions calibration_options_;
   std::unique_ptr<Controller> controller_;
+  std::unique_ptr<OnlineCalibration> calibration_;  // of controller_: destroyed before it
   std::shared_ptr<const ControllerSnapshot> snapshot_;
   nlohmann::json scene_description_;  // the static part of scene_message()
   bool paused_ = false;  // as the clients set it (the controller ignores jogs unless paused)

@@ -1,0 +1,31 @@
+#pragma once
+// The closed loop's options, the same for `run` and `serve`: the simulated world and its
+// camera, model-error feedback, and the online calibration (docs/calibration.md).
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include <shapectl/calib/online_calibration.hpp>
+#include <shapectl/calib/simulated_camera.hpp>
+
+namespace shapectl::cli {
+
+struct ClosedLoopArgs {
+  std::string world;             // WORLD.json: the simulated real object
+  double camera_rate = 10;       // observations per second
+  double camera_sigma = 0.0003;  // m
+  int camera_points = 0;         // surface points per frame (a depth camera)
+  double camera_outliers = 0;    // fraction of them that are outliers
+  bool feedback = true;
+  bool online_calibration = true;
+  std::string fit = "youngs_modulus,grip_offsets";
+};
+
+void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args);
+// The world's camera (markers on the target nodes, set by the caller); InputError naming the
+// option of `command` that is out of range.
+SimulatedCamera simulated_camera(const ClosedLoopArgs& args, const std::string& command);
+OnlineCalibrationOptions online_calibration_options(const ClosedLoopArgs& args,
+                                                    const std::string& command);
+
+}  // namespace shapectl::cli

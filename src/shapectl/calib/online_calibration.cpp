@@ -1,0 +1,130 @@
+#include <shapectl/calib/online_calibration.hpp>
+
+#include <chrono>
+
+#include <shapectl/calib/live_observation.hpp>
+
+namespace shapectl {
+
+namespace {
+// At most `count` points of `cloud`, evenly strided.
+std::vector<Vec3> thinned(const std::vector<Vec3>& cloud, std::size_t count) {
+  if (cloud.size() <= count) return cloud;
+  std::vector<Vec3> out;
+  out.reserve(count);
+  for (std::size_t k = 0; k < count; ++k) out.push_back(cloud[k * cloud.size() / count]);
+  return out;
+}
+
+bool same_pose(const ObservationFrame& a, const ObservationFrame& b, double tolerance) {
+  return a.joints.size() == b.joints.size() &&
+         (a.joints.size() == 0 || (a.joints - b.joints).cwiseAbs().maxCoeff() <= tolerance);
+}
+}  // namespace
+
+OnlineCalibration::OnlineCalibration(Controller& controller, const Scene& model,
+                                     OnlineCalibrationOptions options)
+    : controller_(controller), model_(model), options_(options) {
+  status_.automatic = options_.automatic;
+}
+
+OnlineCalibration::~OnlineCalibration() {
+  if (worker_.joinable()) worker_.join();
+}
+
+void OnlineCalibration::observe(const ObservationFrame& frame) {
+  if (!frame.markers.empty()) controller_.observe(live_observation(frame));
+  if (!window_.empty() && same_pose(window_.back(), frame, options_.same_pose))
+    window_.back() = frame;
+  else window_.push_back(frame);
+  while (static_cast<int>(window_.size()) > options_.window) window_.pop_front();
+  ++frames_since_start_;
+  std::lock_guard lock(mutex_);
+  status_.frames = static_cast<int>(window_.size());
+  if (!frame.points.empty()) status_.points = thinned(frame.points, options_.max_drawn_points);
+}
+
+bool OnlineCalibration::start(std::string* why) {
+  const auto refuse = [&](const char* reason) {
+    if (why) *why = reason;
+    return false;
+  };
+  if (worker_.joinable()) return refuse("a calibration is running");
+  if (window_.empty()) return refuse("no observed frames yet");
+  Observations observations{{window_.begin(), window_.end()}};
+  frames_since_start_ = 0;
+  done_ = false;
+  {
+    std::lock_guard lock(mutex_);
+    status_.running = true;
+  }
+  worker_ = std::thread([this, observations = std::move(observations), model = model_] {
+    std::optional<CalibrationResult> result;
+    std::string error;
+    try {
+      result = calibrate(model, observations, options_.fit, options_.calibration);
+    } catch (const std::exception& e) {
+      error = e.what();
+    }
+    std::lock_guard lock(mutex_);
+    outcome_ = std::move(result);
+    outcome_error_ = std::move(error);
+    done_ = true;
+  });
+  return true;
+}
+
+void OnlineCalibration::wait() {
+  while (worker_.joinable() && !done_) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+}
+
+void OnlineCalibration::set_automatic(bool on) {
+  options_.automatic = on;
+  std::lock_guard lock(mutex_);
+  status_.automatic = on;
+}
+
+void OnlineCalibration::poll(double time) {
+  if (worker_.joinable() && done_) finish();
+  const bool due = options_.automatic && !worker_.joinable() &&
+                   frames_since_start_ >= options_.new_frames &&
+                   time - last_start_ >= options_.period;
+  if (due && start()) last_start_ = time;
+}
+
+bool OnlineCalibration::worth_applying(const CalibrationResult& result, std::string* why) {
+  bool fitted = false;
+  for (const FittedParameter& p : result.parameters) fitted = fitted || !p.held;
+  if (!fitted) *why = "not applied: no parameter is identifiable from the frames in the window";
+  else if (!(result.rms_after < result.rms_before))
+    *why = "not applied: the fit did not lower the residuals (" + result.reason + ")";
+  else return true;
+  return false;
+}
+
+void OnlineCalibration::finish() {
+  worker_.join();
+  std::lock_guard lock(mutex_);
+  status_.running = false;
+  ++status_.runs;
+  status_.error = outcome_error_;
+  status_.applied = false;
+  if (outcome_) {
+    status_.applied = worth_applying(*outcome_, &status_.error);
+    if (status_.applied) {
+      model_ = outcome_->fitted.applied_to(model_);
+      controller_.set_model(model_);
+      ++status_.applied_runs;
+    }
+  }
+  status_.result =
+      outcome_ ? std::make_shared<const CalibrationResult>(std::move(*outcome_)) : nullptr;
+  outcome_.reset();
+}
+
+OnlineCalibrationStatus OnlineCalibration::status() const {
+  std::lock_guard lock(mutex_);
+  return status_;
+}
+
+}  // namespace shapectl

@@ -1,0 +1,97 @@
+#pragma once
+// Calibration while the controller runs (the closed loop's slow half; model-error feedback is
+// the fast half). Observed frames go to the controller's feedback (their markers) and into a
+// sliding window; from time to time, or when asked, the window is calibrated in a background
+// thread (calib/calibration.hpp, starting from the current model) and a fit that lowers the
+// residuals is handed to the controller (Controller::set_model), which continues from the
+// same joints: the robot sees no jump, only better predictions.
+//
+// The window keeps the newest frames of distinct poses: a frame taken within `same_pose` of
+// the newest kept frame's joints replaces it (a robot standing still adds noise, not
+// information). Parameters the window cannot determine are held (the calibration's
+// identifiability test), never fitted to noise.
+#include <atomic>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <shapectl/calib/calibration.hpp>
+#include <shapectl/control/controller.hpp>
+
+namespace shapectl {
+
+struct OnlineCalibrationOptions {
+  FitSelection fit{.youngs_modulus = true,
+                   .poisson_ratio = false,
+                   .density = false,
+                   .grip_offsets = true};
+  bool automatic = true;     // calibrate every `period` while new frames arrive
+  double period = 2.0;       // s between automatic calibrations
+  int new_frames = 3;        // frames since the last calibration before an automatic one
+  int window = 6;            // frames kept
+  double same_pose = 0.005;  // rad (m for prismatic joints), largest joint difference
+  CalibrationOptions calibration{.max_iterations = 8};
+  std::size_t max_drawn_points = 1000;  // of the newest cloud, for a GUI to draw
+};
+
+struct OnlineCalibrationStatus {
+  bool automatic = false;
+  bool running = false;
+  int frames = 0;                                   // in the window
+  std::uint64_t runs = 0;                           // calibrations finished
+  std::uint64_t applied_runs = 0;                   // of them, handed to the controller
+  std::shared_ptr<const CalibrationResult> result;  // the newest finished one, or null
+  bool applied = false;                             // whether that one was handed over
+  std::string error;                                // why the newest one failed or was not applied
+  std::vector<Vec3> points;                         // the newest frame's cloud, thinned
+};
+
+class OnlineCalibration {
+ public:
+  // `controller` must outlive this; `model` is the scene it was made from.
+  OnlineCalibration(Controller& controller, const Scene& model,
+                    OnlineCalibrationOptions options = {});
+  ~OnlineCalibration();  // waits for a running calibration
+  OnlineCalibration(const OnlineCalibration&) = delete;
+  OnlineCalibration& operator=(const OnlineCalibration&) = delete;
+
+  // One checked frame (read_observation_frame) observed at `time` (s): its markers to the
+  // controller's loop, the frame to the window.
+  void observe(const ObservationFrame& frame);
+  // Calibrates the window now, in the background; false with the reason when it cannot.
+  bool start(std::string* why = nullptr);
+  void set_automatic(bool on);
+  // Blocks until a running calibration has finished (poll() then hands it over).
+  void wait();
+  // Call often (each tick): hands a finished calibration to the controller, and starts an
+  // automatic one when it is due. `time`: s, any clock that only moves forward.
+  void poll(double time);
+  OnlineCalibrationStatus status() const;
+  const OnlineCalibrationOptions& options() const { return options_; }
+
+ private:
+  void finish();  // the worker's result to the controller (worker joined)
+  // Whether `result` should replace the current model; the reason in `why` if not.
+  static bool worth_applying(const CalibrationResult& result, std::string* why);
+
+  Controller& controller_;
+  Scene model_;  // the controller's model: the scene with every applied fit
+  OnlineCalibrationOptions options_;
+  std::deque<ObservationFrame> window_;
+  int frames_since_start_ = 0;
+  double last_start_ = -1e300;
+
+  mutable std::mutex mutex_;  // guards status_ and outcome_ (the worker writes them)
+  OnlineCalibrationStatus status_;
+  std::optional<CalibrationResult> outcome_;
+  std::string outcome_error_;
+  std::atomic<bool> done_{false};
+  std::thread worker_;
+};
+
+}  // namespace shapectl

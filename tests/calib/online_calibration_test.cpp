@@ -1,0 +1,221 @@
+// The closed loop's slow half: calibration from the observed frames while the controller runs,
+// the new model handed over without a jump in the joints.
+#include <shapectl/calib/online_calibration.hpp>
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <shapectl/calib/joint_path.hpp>
+#include <shapectl/calib/observation_receiver.hpp>
+#include <shapectl/calib/simulated_camera.hpp>
+#include <shapectl/control/model_error_feedback.hpp>
+#include <shapectl/io/input_error.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
+
+#include "support/test_support.hpp"
+
+namespace shapectl {
+namespace {
+
+// The world's bar: 1.5× stiffer, 0.8× as dense, held 4 mm / 3° off at each grip.
+Scene world_of(const Scene& model) {
+  Scene world = model;
+  world.material =
+      material_from_youngs(1.5 * youngs_modulus_of(model.material),
+                           poisson_ratio_of(model.material), 0.8 * model.material.density);
+  world.grips[0].offset = Eigen::Translation3d(0.004 * Vec3(0, 1, -1).normalized()) *
+                          Eigen::AngleAxisd(3 * M_PI / 180, Vec3(0, 0, 1));
+  world.grips[1].offset = Eigen::Translation3d(0.004 * Vec3(1, 0, 1).normalized()) *
+                          Eigen::AngleAxisd(3 * M_PI / 180, Vec3(0, 1, 0));
+  return world;
+}
+
+double true_error(const ShapeTargets& targets, const Positions& world) {
+  double sum = 0;
+  for (int k = 0; k < targets.size(); ++k)
+    sum += (world.segment<3>(3 * targets.nodes[k]) - targets.positions[k]).norm();
+  return sum / targets.size();
+}
+
+class OnlineCalibrationTest : public ::testing::Test {
+ protected:
+  OnlineCalibrationTest() {
+    Eigen::VectorXd goal = model.robot->reference_joints;
+    goal[0] -= 0.03, goal[7] += 0.03;  // the shoulders turn in: the bar arches
+    const ObjectState at_goal = equilibrium_along_path(GrippedObject(model), goal);
+    for (int node = 0; node < model.object_mesh->node_count(); node += 37)
+      targets.nodes.push_back(node),
+          targets.positions.push_back(at_goal.positions().segment<3>(3 * node));
+    camera.marker_nodes = targets.nodes;
+  }
+
+  // The world at `joints` (from its last shape) and a frame of it.
+  ObservationFrame look(const Eigen::VectorXd& joints) {
+    truth = world.solve_from(joints, truth.positions());
+    EXPECT_TRUE(truth.statics().converged()) << truth.statics().reason;
+    return camera.observe(world.mesh(), truth.positions(), joints, rng);
+  }
+
+  const Scene model = load_scene(test::source_path("scenes/yumi_bar.json"));
+  const GrippedObject world{world_of(model)};
+  ObjectState truth = equilibrium_along_path(world, model.robot->reference_joints);
+  ShapeTargets targets;
+  SimulatedCamera camera;
+  std::mt19937 rng{9};
+};
+
+// The controller's loop with the calibration beside it: the optimizer iterates, the world
+// settles at its joints, the camera's frames come back; calibrations run when due.
+TEST_F(OnlineCalibrationTest, TheCalibratedModelPredictsTheWorldAndTheLoopReachesTheTargets) {
+  Controller controller(model);
+  OnlineCalibration calibration(controller, model, {.period = 0.5});
+  controller.set_targets(targets);
+  controller.set_feedback(true);
+  double first_model_error = 0;
+  std::shared_ptr<const ControllerSnapshot> s;
+  for (int frame = 0; frame < 30; ++frame) {
+    for (int k = 0; k < 3; ++k) controller.step_once();
+    s = controller.snapshot();
+    ASSERT_TRUE(s->safe);
+    calibration.observe(look(s->joints));
+    calibration.poll(0.1 * frame);
+    calibration.wait();  // deterministic: the result is handed over at the next poll
+    if (frame == 2) {
+      controller.step_once();
+      first_model_error = controller.snapshot()->model_error;
+    }
+  }
+  calibration.poll(3.0);
+  controller.step_once();
+  s = controller.snapshot();
+  const OnlineCalibrationStatus c = calibration.status();
+  ASSERT_GE(c.applied_runs, 1u) << c.error;
+  EXPECT_EQ(s->model_updates, c.applied_runs);
+  ASSERT_TRUE(c.result);
+  EXPECT_LT(c.result->rms_after, c.result->rms_before);
+  EXPECT_GT(first_model_error, 2e-3);  // the scene's model misses the world by millimetres...
+  EXPECT_LT(s->model_error, 1e-3);     // ...the calibrated one predicts it at the noise level
+  EXPECT_LT(true_error(targets, truth.positions()), 1e-3);
+  EXPECT_EQ(s->observations, 30u);
+  EXPECT_EQ(s->observations_ignored, 0u);
+}
+
+TEST_F(OnlineCalibrationTest, ANewModelKeepsTheJointsAndChangesTheShape) {
+  Controller controller(model);
+  controller.set_paused(true);
+  controller.step_once();
+  const auto before = controller.snapshot();
+  controller.set_model(world.scene());
+  controller.step_once();
+  const auto after = controller.snapshot();
+  EXPECT_EQ(after->model_updates, 1u);
+  EXPECT_EQ(after->joints, before->joints);  // bit for bit: no jump
+  EXPECT_GT((after->positions - before->positions).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_DOUBLE_EQ(youngs_modulus_of(after->material), youngs_modulus_of(world.scene().material));
+  EXPECT_TRUE(after->grip_offsets[0].isApprox(world.scene().grips[0].offset));
+  // The new model's equilibrium at those joints is the world's.
+  const ObjectState world_there = world.solve_from(after->joints, after->positions);
+  EXPECT_LT((after->positions - world_there.positions()).cwiseAbs().maxCoeff(), 1e-6);
+
+  Scene other = model;
+  other.grips.pop_back();
+  EXPECT_THROW(controller.set_model(other), InputError);
+}
+
+TEST(ModelErrorFeedback, AModelChangeMovesTheEstimateSoThatTheBelievedShapeStays) {
+  const Scene scene = load_scene(test::source_path("scenes/yumi_bar.json"));
+  ModelErrorFeedback feedback(scene.object_mesh, {.gain = 1});
+  const Positions before = scene.world_rest_positions();
+  Positions observed = before, after = before;
+  observed.segment<3>(0) += Vec3(0.003, 0, 0);
+  after.segment<3>(0) += Vec3(0.002, 0.001, 0);
+  feedback.observe({{0, observed.segment<3>(0)}}, before);
+  feedback.model_changed(before, after);
+  // x̂ + ê is what the loop believes the object's shape is: unchanged by the new model.
+  EXPECT_LT((after.segment<3>(0) + feedback.estimate(0) - observed.segment<3>(0)).norm(), 1e-15);
+}
+
+TEST_F(OnlineCalibrationTest, TheWindowKeepsDistinctPosesAndNothingStartsWithoutFrames) {
+  Controller controller(model);
+  OnlineCalibration calibration(controller, model, {.automatic = false, .window = 3});
+  std::string why;
+  EXPECT_FALSE(calibration.start(&why));
+  EXPECT_EQ(why, "no observed frames yet");
+  Eigen::VectorXd joints = model.robot->reference_joints;
+  calibration.observe(look(joints));
+  calibration.observe(look(joints));  // the robot stands still: the newest frame replaces
+  EXPECT_EQ(calibration.status().frames, 1);
+  for (int k = 1; k <= 4; ++k) {
+    joints[0] -= 0.01;
+    calibration.observe(look(joints));
+  }
+  EXPECT_EQ(calibration.status().frames, 3);  // the window's size
+  calibration.poll(100);                      // not automatic: nothing starts
+  EXPECT_FALSE(calibration.status().running);
+  EXPECT_EQ(calibration.status().runs, 0u);
+}
+
+// Markers on gripped nodes only see where the grippers hold the bar, not how it bends: the
+// stiffness cannot be told from them, and such a fit is never handed to the controller.
+TEST_F(OnlineCalibrationTest, AFitOfNothingIdentifiableIsNotApplied) {
+  Controller controller(model);
+  OnlineCalibration calibration(controller, model,
+                                {.fit = {.youngs_modulus = true,
+                                         .poisson_ratio = false,
+                                         .density = false,
+                                         .grip_offsets = false},
+                                 .automatic = false});
+  camera.marker_nodes = {model.grips[0].nodes[0], model.grips[1].nodes[0]};
+  calibration.observe(look(model.robot->reference_joints));
+  ASSERT_TRUE(calibration.start());
+  calibration.wait();
+  calibration.poll(0);
+  const OnlineCalibrationStatus c = calibration.status();
+  EXPECT_EQ(c.runs, 1u);
+  EXPECT_FALSE(c.applied);
+  EXPECT_NE(c.error.find("no parameter is identifiable"), std::string::npos) << c.error;
+  controller.step_once();
+  EXPECT_EQ(controller.snapshot()->model_updates, 0u);
+}
+
+TEST(ObservationReceiver, GoodDatagramsBecomeFramesAndBadOnesAreCountedWithTheirReason) {
+  const Scene scene = load_scene(test::source_path("scenes/yumi_bar.json"));
+  ObservationReceiver receiver("127.0.0.1", 0,
+                               {.node_count = scene.object_mesh->node_count(),
+                                .robot = scene.robot->model.get(),
+                                .allow_points_files = true});  // refused all the same
+  nlohmann::json joints = nlohmann::json::object();
+  const auto& names = scene.robot->model->active_joint_names();
+  for (std::size_t j = 0; j < names.size(); ++j)
+    joints[names[j]] = scene.robot->reference_joints[static_cast<Eigen::Index>(j)];
+  const nlohmann::json good = {{"joints", joints},
+                               {"markers", {{{"node", 3}, {"position", {0.4, 0.0, 0.3}}}}},
+                               {"time", 1.5}};
+  nlohmann::json unknown_node = good, points_file = good;
+  unknown_node["markers"][0]["node"] = 1 << 20;
+  points_file["points_file"] = "/etc/passwd";
+  UdpSocket sender("127.0.0.1", 0, "test sender");
+  const sockaddr_in to = ipv4_address("127.0.0.1", receiver.port(), "test");
+  for (const std::string& datagram :
+       {good.dump(), std::string("{not json"), unknown_node.dump(), points_file.dump(),
+        std::string(10, '[') + std::string(10, ']'), good.dump()})
+    ASSERT_TRUE(sender.send_to(datagram, to));
+  std::vector<ObservationFrame> frames;
+  for (int k = 0; k < 200 && receiver.received() < 6; ++k) {  // loopback: at once, in order
+    for (ObservationFrame& f : receiver.receive()) frames.push_back(std::move(f));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_EQ(receiver.received(), 6u);
+  ASSERT_EQ(frames.size(), 2u);
+  EXPECT_EQ(frames[0].markers.at(0).node, 3);
+  EXPECT_EQ(frames[0].time, 1.5);
+  EXPECT_EQ(receiver.rejected(), 4u);
+  // The last rejection names the sender and what was wrong.
+  EXPECT_NE(receiver.last_rejection().find("udp 127.0.0.1:"), std::string::npos);
+  EXPECT_NE(receiver.last_rejection().find("nested deeper"), std::string::npos)
+      << receiver.last_rejection();
+}
+
+}  // namespace
+}  // namespace shapectl
