@@ -108,8 +108,9 @@ export class CalibrationPanel {
       row.append(cell(parameterLabel(p.name)), cell(formatValue(p.initial, p.unit, decimals), 'number'));
       if (p.held) {
         const held = cell('held (not identifiable)', 'muted');
+        // That deviation is in units of the parameter's typical size (docs/calibration.md).
         if (unidentified.has(p.name))
-          held.title = `the observations leave it ± ${formatValue(unidentified.get(p.name), p.unit)} ${symbol}`;
+          held.title = `the observations leave it undetermined: ± ${unidentified.get(p.name).toPrecision(2)} × its typical size (identifiable below 0.1)`;
         row.append(held);
       } else {
         row.append(cell(formatWithDeviation(p.fitted, p.standard_deviation, p.unit), 'number'));

@@ -8,6 +8,8 @@ import { Command, ControllerStatus } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
+// Metres as mm for the panel; '–' for none.
+const mm = (v) => (v === null || v === undefined ? '–' : (1000 * v).toFixed(2));
 // Mean error below which the targets count as reached (the paper's 1 mm).
 const REACHED = 1e-3;
 // Badge style per controller status; the others are plain.
@@ -122,7 +124,6 @@ function onState(state) {
   // "converged" means stationary; away from the targets that is no success to show in green.
   const missed = state.status === ControllerStatus.Converged && state.targets.length > 0 &&
     state.error.mean !== null && state.error.mean > REACHED;
-  const mm = (v) => (v === null || v === undefined ? '–' : (1000 * v).toFixed(2));
   // With observations of the real object, "reached" is about the real object, not the model.
   const realMiss = state.status === ControllerStatus.Converged && state.observations > 0 &&
     state.observed_error !== null && state.observed_error > REACHED;
@@ -152,10 +153,7 @@ function onState(state) {
   });
 
   $('feedback').checked = !!state.feedback;
-  $('observed').textContent = state.observations
-    ? `${state.observations} observations · model error ${mm(state.model_error)} mm · observed error ${mm(state.observed_error)} mm` +
-      (state.true_error === null || state.true_error === undefined ? '' : ` · true error (simulated world) ${mm(state.true_error)} mm`)
-    : 'no observations yet';
+  $('observed').textContent = observedLine(state);
 
   calibration.update(state);
 
@@ -164,6 +162,15 @@ function onState(state) {
     $('link-status').textContent = `${l.kind}: ${l.connected ? 'connected' : 'no feedback'}, ${l.armed ? 'ARMED' : 'disarmed'}` +
       (l.reason ? ` — ${l.reason}` : '');
   }
+}
+
+// The Real object panel's line: observations, the errors, and why the newest was ignored.
+function observedLine(state) {
+  const ignored = state.observation_problem ? `${state.observations_ignored} ignored: ${state.observation_problem}` : '';
+  if (!state.observations) return ignored || 'no observations yet';
+  const truth = state.true_error === null || state.true_error === undefined ? '' : ` · true error (simulated world) ${mm(state.true_error)} mm`;
+  return `${state.observations} observations · model error ${mm(state.model_error)} mm · observed error ${mm(state.observed_error)} mm` +
+    truth + (ignored ? ` · ${ignored}` : '');
 }
 
 // The plot's values, in the order of plot.js's SERIES; the real object's errors only once it
