@@ -67,7 +67,13 @@ export async function openPage(browser, url) {
       page.problems.push(`${m.type()}: ${m.text()}`);
   });
   await page.goto(url);
-  await waitFor(() => page.evaluate(() => window.shapectl?.ready), 'the page to show the scene');
+  try {
+    await waitFor(() => page.evaluate(() => window.shapectl?.ready), 'the page to show the scene');
+  } catch (e) {
+    const parts = await page.evaluate(() => ({ scene: !!window.shapectl?.scene, state: !!window.shapectl?.state,
+      positions: window.shapectl?.positions().length, frames: window.shapectl?.frames, connection: document.getElementById('connection')?.textContent }));
+    throw new Error(`${e.message}: ${JSON.stringify(parts)}; problems: ${JSON.stringify(page.problems)}`);
+  }
   return page;
 }
 
