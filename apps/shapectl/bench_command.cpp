@@ -18,6 +18,7 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 
+#include "bench_closed_loop.hpp"
 #include "commands.hpp"
 #include "result_json.hpp"
 
@@ -276,6 +277,7 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
     bench_target_changes(objective, reference, kind, name, args);
   bench_buckling(scene, objective, reference);
   bench_calibration(scene, args);
+  bench_closed_loop(scene, std::min(args.trials, 3), args.seed);
 }
 
 }  // namespace

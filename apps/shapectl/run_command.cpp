@@ -78,7 +78,8 @@ nlohmann::json link_json(const LinkStatus& s) {
 
 // Why running on cannot settle, or empty.
 std::string cannot_settle(const ControllerSnapshot& s, const LinkStatus& link, bool armed_once) {
-  if (s.status == ControllerStatus::Stuck)
+  // With the loop closed, a stuck optimizer is judged by what is observed (settle_decided).
+  if (s.status == ControllerStatus::Stuck && !s.feedback)
     return "optimizer stuck: no acceptable step (error " + std::to_string(s.error.mean) + " m)";
   if (!s.last_error.empty()) return "optimizer: " + s.last_error;
   if (armed_once && !link.armed) return "robot link disarmed: " + link.reason;
@@ -216,7 +217,9 @@ bool settle_decided(const ControllerSnapshot& s, const LinkStatus& st, bool arme
                     RunOutcome& outcome) {
   outcome.failure = cannot_settle(s, st, armed);
   if (!outcome.failure.empty()) return true;
-  if (s.status != ControllerStatus::Converged) return false;
+  const bool stationary = s.status == ControllerStatus::Converged ||
+                          (s.feedback && s.status == ControllerStatus::Stuck);
+  if (!stationary) return false;
   // Not armed, the robot is never asked to move: it cannot arrive, so say so.
   if (!armed) {
     outcome.failure =

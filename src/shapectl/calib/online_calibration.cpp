@@ -1,6 +1,8 @@
 #include <shapectl/calib/online_calibration.hpp>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include <shapectl/calib/live_observation.hpp>
 
@@ -16,6 +18,13 @@ std::vector<Vec3> thinned(const std::vector<Vec3>& cloud, std::size_t count) {
   return out;
 }
 
+// Whether some fitted parameter moved by more than its standard deviation.
+bool changed_significantly(const CalibrationResult& r) {
+  for (const FittedParameter& p : r.parameters)
+    if (!p.held && std::abs(p.fitted - p.initial) > p.standard_deviation) return true;
+  return false;
+}
+
 bool same_pose(const ObservationFrame& a, const ObservationFrame& b, double tolerance) {
   return a.joints.size() == b.joints.size() &&
          (a.joints.size() == 0 || (a.joints - b.joints).cwiseAbs().maxCoeff() <= tolerance);
@@ -24,7 +33,7 @@ bool same_pose(const ObservationFrame& a, const ObservationFrame& b, double tole
 
 OnlineCalibration::OnlineCalibration(Controller& controller, const Scene& model,
                                      OnlineCalibrationOptions options)
-    : controller_(controller), model_(model), options_(options) {
+    : controller_(controller), model_(model), options_(options), period_(options.period) {
   status_.automatic = options_.automatic;
 }
 
@@ -87,8 +96,7 @@ void OnlineCalibration::set_automatic(bool on) {
 void OnlineCalibration::poll(double time) {
   if (worker_.joinable() && done_) finish();
   const bool due = options_.automatic && !worker_.joinable() &&
-                   frames_since_start_ >= options_.new_frames &&
-                   time - last_start_ >= options_.period;
+                   frames_since_start_ >= options_.new_frames && time - last_start_ >= period_;
   if (due && start()) last_start_ = time;
 }
 
@@ -109,6 +117,8 @@ void OnlineCalibration::finish() {
   ++status_.runs;
   status_.error = outcome_error_;
   status_.applied = false;
+  const bool settled = !outcome_ || !changed_significantly(*outcome_);
+  period_ = settled ? std::min(2 * period_, options_.max_period) : options_.period;
   if (outcome_) {
     status_.applied = worth_applying(*outcome_, &status_.error);
     if (status_.applied) {

@@ -30,8 +30,12 @@ struct OnlineCalibrationOptions {
                    .poisson_ratio = false,
                    .density = false,
                    .grip_offsets = true};
-  bool automatic = true;     // calibrate every `period` while new frames arrive
-  double period = 2.0;       // s between automatic calibrations
+  bool automatic = true;  // calibrate every `period` while new frames arrive
+  // s between automatic calibrations. A fit that changes no parameter by more than its
+  // standard deviation (the model has settled) doubles the wait, up to max_period: a settled
+  // model must not keep a core busy that the optimizer needs.
+  double period = 2.0;
+  double max_period = 30.0;
   int new_frames = 3;        // frames since the last calibration before an automatic one
   int window = 6;            // frames kept
   double same_pose = 0.005;  // rad (m for prismatic joints), largest joint difference
@@ -85,6 +89,7 @@ class OnlineCalibration {
   std::deque<ObservationFrame> window_;
   int frames_since_start_ = 0;
   double last_start_ = -1e300;
+  double period_;  // the wait now: options_.period, doubled while fits change nothing
 
   mutable std::mutex mutex_;  // guards status_ and outcome_ (the worker writes them)
   OnlineCalibrationStatus status_;

@@ -1,0 +1,13 @@
+#pragma once
+// The closed loop's benchmark row of `shapectl bench`.
+#include <shapectl/sim/scene.hpp>
+
+namespace shapectl::cli {
+
+// The loop of `run --robot sim --world`, on the wall clock, against a world 1.5× stiffer,
+// 0.8× as dense and held 4 mm / 3° off at each grip; targets the model's own arch (both first
+// joints turned 0.03 rad in). Prints the time until the world's true error is below 1 mm,
+// with feedback only and with feedback and online calibration, median over `trials`.
+void bench_closed_loop(const Scene& scene, int trials, unsigned seed);
+
+}  // namespace shapectl::cli
