@@ -3,40 +3,10 @@
 // report state and project world points to the screen; every action goes through the UI.
 import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { startServer, launchChromium, waitFor } from './support.mjs';
+import { startServer, launchChromium, waitFor, differingFraction, openPage } from './support.mjs';
 
 const hooks = (page, f, arg) => page.evaluate(f, arg);
 const state = (page) => hooks(page, () => window.shapectl.state);
-
-async function openPage(browser, url) {
-  const page = await browser.context.newPage();
-  page.errors = [];
-  page.on('pageerror', (e) => page.errors.push(e.message));
-  await page.goto(url);
-  await waitFor(() => hooks(page, () => window.shapectl?.ready), 'the page to show the scene');
-  return page;
-}
-
-// Fraction of pixels that differ between two PNG screenshots, decoded by the page itself.
-async function differingFraction(page, pngA, pngB) {
-  return hooks(page, async ([a, b]) => {
-    const decode = async (base64) => {
-      const image = new Image();
-      image.src = `data:image/png;base64,${base64}`;
-      await image.decode();
-      const c = document.createElement('canvas');
-      c.width = image.width; c.height = image.height;
-      const g = c.getContext('2d');
-      g.drawImage(image, 0, 0);
-      return g.getImageData(0, 0, c.width, c.height).data;
-    };
-    const [p, q] = [await decode(a), await decode(b)];
-    let differing = 0;
-    for (let i = 0; i < p.length; i += 4)
-      if (Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]) > 30) differing++;
-    return differing / (p.length / 4);
-  }, [pngA.toString('base64'), pngB.toString('base64')]);
-}
 
 async function canvasShot(page, layers) {
   await hooks(page, (l) => window.shapectl.setLayers(l), layers);
@@ -80,7 +50,7 @@ describe('browser GUI', () => {
     const objectPixels = await differingFraction(page, blank, objectOnly);
     assert.ok(robotPixels > 0.05, `robot covers ${robotPixels} of the canvas`);
     assert.ok(objectPixels > 0.005, `object covers ${objectPixels} of the canvas`);
-    assert.deepEqual(page.errors, []);
+    assert.deepEqual(page.problems, []);
   });
 
   // Liveness, not a rate: a rate asserted on a shared 2-core machine fails for reasons other than
@@ -212,7 +182,7 @@ describe('browser GUI', () => {
     await waitFor(async () => (await state(page)).clients === 1, 'one client left');
     const n = await hooks(page, () => window.shapectl.stats.states);
     await waitFor(async () => (await hooks(page, () => window.shapectl.stats.states)) > n + 10, 'streaming to go on');
-    assert.deepEqual(page.errors, []);
-    assert.deepEqual(second.errors, []);
+    assert.deepEqual(page.problems, []);
+    assert.deepEqual(second.problems, []);
   });
 });

@@ -52,6 +52,52 @@ export async function launchChromium() {
   return { context, close: async () => { await context.close(); rmSync(userDataDir, { recursive: true, force: true }); } };
 }
 
+// Headless Chromium's software compositor reads every WebGL canvas back and says so as a
+// console warning; a bare canvas that only clears gets it too. The browser's, not the page's.
+const COMPOSITOR_READBACK = /^\[\.WebGL-0x[0-9a-f]+\]GL Driver Message \(OpenGL, Performance, [A-Z_]+, High\): GPU stall due to ReadPixels/;
+
+// A new page of `browser` at `url`, once it shows the scene. `page.problems` collects what the
+// page must never raise: uncaught exceptions and console errors and warnings.
+export async function openPage(browser, url) {
+  const page = await browser.context.newPage();
+  page.problems = [];
+  page.on('pageerror', (e) => page.problems.push(`exception: ${e.message}`));
+  page.on('console', (m) => {
+    if ((m.type() === 'error' || m.type() === 'warning') && !COMPOSITOR_READBACK.test(m.text()))
+      page.problems.push(`${m.type()}: ${m.text()}`);
+  });
+  await page.goto(url);
+  try {
+    await waitFor(() => page.evaluate(() => window.shapectl?.ready), 'the page to show the scene');
+  } catch (e) {
+    const parts = await page.evaluate(() => ({ scene: !!window.shapectl?.scene, state: !!window.shapectl?.state,
+      positions: window.shapectl?.positions().length, frames: window.shapectl?.frames, connection: document.getElementById('connection')?.textContent }));
+    throw new Error(`${e.message}: ${JSON.stringify(parts)}; problems: ${JSON.stringify(page.problems)}`);
+  }
+  return page;
+}
+
+// Fraction of pixels that differ between two PNG screenshots, decoded by `page` itself.
+export async function differingFraction(page, pngA, pngB) {
+  return page.evaluate(async ([a, b]) => {
+    const decode = async (base64) => {
+      const image = new Image();
+      image.src = `data:image/png;base64,${base64}`;
+      await image.decode();
+      const c = document.createElement('canvas');
+      c.width = image.width; c.height = image.height;
+      const g = c.getContext('2d');
+      g.drawImage(image, 0, 0);
+      return g.getImageData(0, 0, c.width, c.height).data;
+    };
+    const [p, q] = [await decode(a), await decode(b)];
+    let differing = 0;
+    for (let i = 0; i < p.length; i += 4)
+      if (Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]) > 30) differing++;
+    return differing / (p.length / 4);
+  }, [pngA.toString('base64'), pngB.toString('base64')]);
+}
+
 // Polls `probe` (sync or async) until it returns a truthy value; fails after `timeoutMs`.
 export async function waitFor(probe, what, timeoutMs = 30000) {
   const end = Date.now() + timeoutMs;

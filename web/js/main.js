@@ -3,10 +3,13 @@
 import { Connection } from './connection.js';
 import { View3D } from './view3d.js';
 import { ConvergencePlot } from './plot.js';
+import { CalibrationPanel } from './calibration_panel.js';
 import { Command, ControllerStatus } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
+// Metres as mm for the panel; '–' for none.
+const mm = (v) => (v === null || v === undefined ? '–' : (1000 * v).toFixed(2));
 // Mean error below which the targets count as reached (the paper's 1 mm).
 const REACHED = 1e-3;
 // Badge style per controller status; the others are plain.
@@ -27,7 +30,14 @@ const view = new View3D($('view'), {
   sketch: (points) => command(Command.SetCenterline, { points }).then(() => setSketchMode(false)),
   select: (node) => { $('delete').disabled = node === null; },
 });
-const plot = new ConvergencePlot($('plot'));
+const plot = new ConvergencePlot($('plot'), $('plot-legend'));
+const calibration = new CalibrationPanel({
+  button: $('calibrate'), auto: $('auto-calibration'), status: $('calibration-status'), model: $('model'),
+  table: $('calibration-result'), summary: $('calibration-summary'), error: $('calibration-error'),
+}, {
+  calibrate: () => command(Command.Calibrate),
+  setAutomatic: (on) => command(Command.SetAutoCalibration, { on }),
+});
 
 const connection = new Connection(`ws://${location.host}/ws`, {
   open: () => setBadge('connection', 'connected', 'ok'),
@@ -108,13 +118,12 @@ function onState(state) {
   page.stats.stateTimes.push(performance.now());
   if (page.stats.stateTimes.length > 200) page.stats.stateTimes.shift();
   view.setState(state);
-  plot.add(state.time, state.error.mean, state.editing);
+  plot.add(state.time, plotValues(state), state.editing);
   drawPlot();
 
   // "converged" means stationary; away from the targets that is no success to show in green.
   const missed = state.status === ControllerStatus.Converged && state.targets.length > 0 &&
     state.error.mean !== null && state.error.mean > REACHED;
-  const mm = (v) => (v === null || v === undefined ? '–' : (1000 * v).toFixed(2));
   // With observations of the real object, "reached" is about the real object, not the model.
   const realMiss = state.status === ControllerStatus.Converged && state.observations > 0 &&
     state.observed_error !== null && state.observed_error > REACHED;
@@ -144,16 +153,31 @@ function onState(state) {
   });
 
   $('feedback').checked = !!state.feedback;
-  $('observed').textContent = state.observations
-    ? `${state.observations} observations · model error ${mm(state.model_error)} mm · observed error ${mm(state.observed_error)} mm` +
-      (state.true_error === null || state.true_error === undefined ? '' : ` · true error (simulated world) ${mm(state.true_error)} mm`)
-    : 'no observations yet';
+  $('observed').textContent = observedLine(state);
+
+  calibration.update(state);
 
   if (state.link) {
     const l = state.link;
     $('link-status').textContent = `${l.kind}: ${l.connected ? 'connected' : 'no feedback'}, ${l.armed ? 'ARMED' : 'disarmed'}` +
       (l.reason ? ` — ${l.reason}` : '');
   }
+}
+
+// The Real object panel's line: observations, the errors, and why the newest was ignored.
+function observedLine(state) {
+  const ignored = state.observation_problem ? `${state.observations_ignored} ignored: ${state.observation_problem}` : '';
+  if (!state.observations) return ignored || 'no observations yet';
+  const truth = state.true_error === null || state.true_error === undefined ? '' : ` · true error (simulated world) ${mm(state.true_error)} mm`;
+  return `${state.observations} observations · model error ${mm(state.model_error)} mm · observed error ${mm(state.observed_error)} mm` +
+    truth + (ignored ? ` · ${ignored}` : '');
+}
+
+// The plot's values, in the order of plot.js's SERIES; the real object's errors only once it
+// was observed (before, the server sends 0).
+function plotValues(state) {
+  const observed = state.observations > 0;
+  return [state.error.mean, state.true_error ?? null, observed ? state.model_error : null, observed ? state.observed_error : null];
 }
 
 let plotPending = false;
@@ -184,6 +208,7 @@ $('face-bar').onclick = () => { if (page.scene?.bar) view.faceBar(page.scene.bar
 $('show-wireframe').onchange = (e) => view.setWireframe(e.target.checked);
 $('show-spheres').onchange = (e) => view.setSpheresVisible(e.target.checked);
 $('show-robot').onchange = (e) => view.setRobotVisible(e.target.checked);
+$('show-points').onchange = (e) => view.setObservedPointsVisible(e.target.checked);
 $('scene-select').onchange = (e) => command(Command.LoadScene, { scene: e.target.value });
 $('feedback').onchange = (e) => command(Command.SetFeedback, { on: e.target.checked });
 $('arm').onclick = () => command(Command.Arm);
@@ -203,6 +228,8 @@ window.shapectl = {
   get stats() { return page.stats; },
   get ready() { return !!(page.scene && page.state && view.positions && view.frames > 2); },
   get arrowCount() { return view.arrowCount; },
+  get frames() { return view.frames; },
+  get observedPointsDrawn() { return view.observedPointsDrawn; },
   get selected() { return view.selected; },
   nodePosition: (node) => view.nodePosition(node).toArray(),
   positions: () => Array.from(view.positions ?? []),
@@ -211,4 +238,5 @@ window.shapectl = {
   setLayers: ({ robot = true, object = true } = {}) => { view.setRobotVisible(robot); view.setObjectVisible(object); view.render(); },
   objectCentroid: () => view.objectCentroid().toArray(),
   cameraDirection: () => view.cameraDirection(),
+  observedPoints: () => view.observedPoints(),
 };

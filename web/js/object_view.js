@@ -1,8 +1,9 @@
 // The gripped object in the 3D view: its surface (optional wireframe) at the streamed node
 // positions, the gripped nodes in red, each target as an orange arrow from its node with a
 // handle to drag, the centre-line the server follows and the one being sketched, and the markers
-// a tracker observed on the real object (cyan points: where the real object is). World frame,
-// metres. Targets being dragged are shown where the hand is, ahead of the server.
+// a tracker observed on the real object (cyan points: where the real object is) with the last
+// observed point cloud (small magenta points). World frame, metres. Targets being dragged are
+// shown where the hand is, ahead of the server.
 import * as THREE from 'three';
 
 const ORANGE = 0xff8c1a;
@@ -66,6 +67,16 @@ export class ObjectView {
     this.observed.renderOrder = 2;
     this.observed.frustumCulled = false;
     this.group.add(this.observed);
+    // The last observed point cloud: small magenta points, over the surface they lie on.
+    this.cloudGeometry = new THREE.BufferGeometry();
+    this.cloud = new THREE.Points(this.cloudGeometry,
+      new THREE.PointsMaterial({ color: 0xff4fd8, size: 3, sizeAttenuation: false, depthTest: false }));
+    this.cloud.renderOrder = 1;
+    this.cloud.frustumCulled = false;
+    this.cloud.visible = false;
+    this.cloudCount = 0;       // points in the last cloud
+    this.cloudEnabled = true;  // the page's checkbox
+    this.group.add(this.cloud);
     this.sketchLine = makeLine(0xffe08a);
 
     this.targets = [];             // the last state's [{node, position}]
@@ -176,6 +187,27 @@ export class ObjectView {
     for (let k = 0; k < n; ++k) attribute.setXYZ(k, markers[k][1], markers[k][2], markers[k][3]);
     attribute.needsUpdate = true;
     this.observedGeometry.setDrawRange(0, n);
+  }
+
+  // [[x, y, z], ...] from the state's "observed_points"; hidden when empty.
+  setObservedPoints(points) {
+    const n = points?.length ?? 0;
+    let attribute = this.cloudGeometry.getAttribute('position');
+    if (!attribute || attribute.count < n) {
+      attribute = new THREE.BufferAttribute(new Float32Array(3 * Math.max(n, 256)), 3);
+      attribute.setUsage(THREE.DynamicDrawUsage);
+      this.cloudGeometry.setAttribute('position', attribute);
+    }
+    for (let k = 0; k < n; ++k) attribute.setXYZ(k, points[k][0], points[k][1], points[k][2]);
+    attribute.needsUpdate = true;
+    this.cloudGeometry.setDrawRange(0, n);
+    this.cloudCount = n;
+    this.cloud.visible = this.cloudEnabled && n > 0;
+  }
+
+  setObservedPointsVisible(on) {
+    this.cloudEnabled = on;
+    this.cloud.visible = on && this.cloudCount > 0;
   }
 
   setWireframe(on) {

@@ -19,6 +19,8 @@ export const Command = Object.freeze({
   Disarm: 'disarm',
   Observe: 'observe',
   SetFeedback: 'set_feedback',
+  Calibrate: 'calibrate',
+  SetAutoCalibration: 'set_auto_calibration',
 });
 
 // Text messages, server → client: a reply to a command (to its sender) or a broadcast.
@@ -51,6 +53,25 @@ export const ShapeKind = Object.freeze({
   Sphere: 'sphere',
   Box: 'box',
   Cylinder: 'cylinder',
+});
+
+// A calibration parameter's "name" in a state's "calibration.result.parameters" (and
+// "unidentified[].held"); a grip offset's name goes on with its end effector and coordinate,
+// "grip_offsets.left.x".
+export const Parameter = Object.freeze({
+  YoungsModulus: 'youngs_modulus',
+  PoissonRatio: 'poisson_ratio',
+  Density: 'density',
+  GripOffsets: 'grip_offsets',
+});
+
+// A calibration parameter's "unit" (SI).
+export const Unit = Object.freeze({
+  Pascal: 'Pa',
+  None: '',
+  KilogramPerCubicMetre: 'kg/m^3',
+  Metre: 'm',
+  Radian: 'rad',
 });
 
 // The first four bytes of a binary positions frame.

@@ -138,6 +138,7 @@ export class View3D {
     this.objectView.setCenterline(state.centerline);
     this.objectView.setTargets(state.targets, state.centerline.length === 0);  // the curve is the handle there
     this.objectView.setObservedMarkers(state.observed_markers);
+    this.objectView.setObservedPoints(state.observed_points);
     this.requestRender();
   }
 
@@ -163,6 +164,11 @@ export class View3D {
   get sketchMode() { return this.targetControls.sketchMode; }
   get positions() { return this.objectView.positions; }
   get arrowCount() { return this.objectView.arrowCount; }
+  // Observed cloud points drawn now (0 when hidden).
+  get observedPointsDrawn() {
+    const cloud = this.objectView.cloud;
+    return cloud.visible && cloud.parent.visible ? cloud.geometry.drawRange.count : 0;
+  }
 
   select(node) {
     this.objectView.setSelected(node);
@@ -179,11 +185,16 @@ export class View3D {
   setSpheresVisible(on) { this.robotView.setSpheresVisible(on); this.requestRender(); }
   setRobotVisible(on) { this.robotView.setVisible(on); this.requestRender(); }
   setObjectVisible(on) { this.objectView.setVisible(on); this.requestRender(); }
+  setObservedPointsVisible(on) { this.objectView.setObservedPointsVisible(on); this.requestRender(); }
 
   // ---- for tests and tools (new arrays and vectors: callers keep them) ----
   nodePosition(node) { return this.objectView.nodePosition(node, new THREE.Vector3()); }
   objectCentroid() { return this.objectView.centroid(new THREE.Vector3()); }
   cameraDirection() { return this.camera.getWorldDirection(new THREE.Vector3()).toArray(); }
+  observedPoints() {
+    const geometry = this.objectView.cloud.geometry, attribute = geometry.getAttribute('position');
+    return Array.from({ length: attribute ? geometry.drawRange.count : 0 }, (_, k) => [attribute.getX(k), attribute.getY(k), attribute.getZ(k)]);
+  }
 
   // Page coordinates of a world point.
   worldToPage(point) {

@@ -1,0 +1,26 @@
+// The calibration table's numbers: SI values in the units a person reads, with as many digits as
+// the standard deviation allows (web/js/units.js).
+import { describe, it } from 'node:test';
+import assert from 'node:assert/strict';
+import { formatValue, formatWithDeviation, shownUnit } from '../../web/js/units.js';
+import { Unit } from '../../web/js/protocol.js';
+
+describe('readable units', () => {
+  it('shows each SI unit of a calibration parameter in its readable unit', () => {
+    assert.deepEqual([Unit.Pascal, Unit.None, Unit.KilogramPerCubicMetre, Unit.Metre, Unit.Radian].map((u) => shownUnit(u).symbol),
+      ['kPa', '', 'kg/m³', 'mm', '°']);
+    assert.equal(formatWithDeviation(301234, 4120, Unit.Pascal), '301.2 ± 4.1');
+    assert.equal(formatWithDeviation(0.00391, 0.00012, Unit.Metre), '3.91 ± 0.12');
+    assert.equal(formatWithDeviation(0.052, 0.0031, Unit.Radian), '2.98 ± 0.18');
+    assert.equal(formatWithDeviation(0.3012, 0.0004, Unit.None), '0.30120 ± 0.00040');
+    assert.equal(formatWithDeviation(41.7, 2.3, Unit.KilogramPerCubicMetre), '41.7 ± 2.3');
+  });
+
+  it('keeps three significant digits without a deviation, and a dash for no number', () => {
+    assert.equal(formatValue(200000, Unit.Pascal), '200');
+    assert.equal(formatValue(0.3, Unit.None), '0.300');
+    assert.equal(formatValue(null, Unit.Metre), '–');
+    assert.equal(formatValue(Number.NaN, Unit.Metre), '–');
+    assert.equal(formatWithDeviation(0.004, null, Unit.Metre), '4.00 ± –');
+  });
+});
