@@ -23,11 +23,6 @@ struct CalibrateArgs {
   int max_iterations = 30;
 };
 
-// A robot's grips are where the real object is held off; a clamp is where the scene puts it.
-const char* default_fit(const Scene& scene) {
-  return scene.robot ? "youngs_modulus,grip_offsets" : "youngs_modulus,object_pose";
-}
-
 // The parameters to fit; --fit names one the scene does not have → InputError naming --fit.
 FitSelection fit_selection(const CalibrateArgs& args, const Scene& scene) {
   const std::string list = args.fit.empty() ? default_fit(scene) : args.fit;
@@ -35,9 +30,7 @@ FitSelection fit_selection(const CalibrateArgs& args, const Scene& scene) {
   try {
     fit = parse_fit_selection(list);
   } catch (const std::invalid_argument&) {
-    throw InputError("--fit", "",
-                     "a comma-separated list of youngs_modulus, poisson_ratio, density, "
-                     "grip_offsets, object_pose",
+    throw InputError("--fit", "", std::string("a comma-separated list of ") + fit_parameter_names(),
                      list);
   }
   try {

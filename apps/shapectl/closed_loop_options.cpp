@@ -4,7 +4,7 @@
 
 namespace shapectl::cli {
 
-void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args) {
+void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args, bool feedback_flag) {
   cmd.add_option("--world", args.world,
                  "WORLD.json: simulate the real object (true material, grip offsets; same mesh) "
                  "with --robot sim; a camera observes markers on the target nodes")
@@ -19,8 +19,9 @@ void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args) {
   cmd.add_option("--camera-outliers", args.camera_outliers,
                  "--world: fraction of those points that are outliers")
       ->capture_default_str();
-  cmd.add_flag("--feedback,!--no-feedback", args.feedback,
-               "with observations: model-error feedback on their markers (default) or not");
+  if (feedback_flag)
+    cmd.add_flag("--feedback,!--no-feedback", args.feedback,
+                 "with observations: model-error feedback on their markers (default) or not");
   cmd.add_flag("--online-calibration,!--no-online-calibration", args.online_calibration,
                "with observations: re-calibrate --fit in the background (default) or not");
   cmd.add_option("--fit", args.fit, "parameters the online calibration fits")

@@ -21,7 +21,9 @@ struct ClosedLoopArgs {
   std::string fit = "youngs_modulus,grip_offsets";
 };
 
-void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args);
+// `feedback_flag`: whether --feedback/--no-feedback is offered (`serve` leaves the switch to
+// the page).
+void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args, bool feedback_flag);
 // The world's camera (markers on the target nodes, set by the caller); InputError naming the
 // option of `command` that is out of range.
 SimulatedCamera simulated_camera(const ClosedLoopArgs& args, const std::string& command);

@@ -432,7 +432,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--egm-right-port", args->link.egm_right_port,
                   "UDP port of the right arm (ROB_R)")
       ->capture_default_str();
-  add_closed_loop_options(*cmd, args->loop);
+  add_closed_loop_options(*cmd, args->loop, /*feedback_flag=*/true);
   cmd->add_option("--observations-udp", args->observations_udp,
                   "PORT: observed frames from a camera program, one JSON frame per datagram "
                   "(docs/calibration.md)");

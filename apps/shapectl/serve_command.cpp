@@ -103,7 +103,7 @@ void add_serve_command(CLI::App& app) {
                   "Directory with index.html (default: the repository's web/)");
   cmd->add_option("--scenes-dir", args->scenes_dir,
                   "Scenes offered for switching (default: scenes/)");
-  add_closed_loop_options(*cmd, args->loop);
+  add_closed_loop_options(*cmd, args->loop, /*feedback_flag=*/false);
   cmd->add_option("--rate", args->rate, "State messages per second to each page")
       ->check(CLI::Range(1.0, 120.0))
       ->capture_default_str();

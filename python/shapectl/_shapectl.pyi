@@ -229,5 +229,5 @@ class CalibrationResult:
 Observations = Union[str, os.PathLike, Mapping[str, Any]]
 
 def calibrate(scene: Scene, observations: Observations, *,
-              fit: Union[str, Sequence[str]] = "youngs_modulus,grip_offsets",
+              fit: Optional[Union[str, Sequence[str]]] = None,
               max_iterations: int = 30) -> CalibrationResult: ...

@@ -17,7 +17,7 @@ struct Calibration : CalibrationResult {
 
 Observations observations_from(const py::handle& in, const Scene& scene) {
   const ObservationContext context{.node_count = scene.object_mesh->node_count(),
-                                   .robot = scene.robot->model.get(),
+                                   .robot = scene.robot ? scene.robot->model.get() : nullptr,
                                    .allow_points_files = true};
   if (py::isinstance<py::dict>(in))
     return read_observations(JsonInput(json_from(in, "observations"), "observations"), context);
@@ -40,9 +40,8 @@ FitSelection fit_from(const py::handle& fit) {
   try {
     return parse_fit_selection(list);
   } catch (const std::invalid_argument&) {
-    throw InputError(
-        "fit", "", "a comma-separated list of youngs_modulus, poisson_ratio, density, grip_offsets",
-        list);
+    throw InputError("fit", "", std::string("a comma-separated list of ") + fit_parameter_names(),
+                     list);
   }
 }
 
@@ -57,9 +56,7 @@ bool finite(const CalibrationResult& r) {
 Calibration run_calibrate(const SceneHandle& s, const py::object& observations_in,
                           const py::object& fit_in, int max_iterations) {
   const Scene& scene = *s.scene;
-  if (!scene.robot)
-    throw InputError(scene.source.string(), "robot", "a robot holding the object (missing key)");
-  const FitSelection fit = fit_from(fit_in);
+  const FitSelection fit = fit_from(fit_in.is_none() ? py::str(default_fit(scene)) : fit_in);
   if (max_iterations < 1 || max_iterations > 1000)
     throw InputError("max_iterations", "", "a number from 1 to 1000", max_iterations);
   const Observations observations = observations_from(observations_in, scene);
@@ -147,12 +144,14 @@ void bind_calibration(py::module_& m) {
       .def_readonly("frames", &CalibrationResult::frames, "One FrameFit per observed frame.");
 
   m.def("calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
-        py::arg("fit") = "youngs_modulus,grip_offsets", py::arg("max_iterations") = 30,
+        py::arg("fit") = py::none(), py::arg("max_iterations") = 30,
         "Fits the scene's physical parameters to observations of the real object, as `shapectl "
         "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
         "of its schema (numpy arrays allowed; a points_file relative to the current "
         "directory). fit: a comma-separated string or a list of youngs_modulus, poisson_ratio, "
-        "density, grip_offsets. Raises ValueError for bad input (the CLI's message; a dict is "
+        "density, grip_offsets, object_pose (default: youngs_modulus and grip_offsets with a "
+        "robot, youngs_modulus and object_pose without). Raises ValueError for bad input (the "
+        "CLI's message; a dict is "
         "named 'observations'), SolverError when a frame's equilibrium cannot be found. Releases "
         "the GIL while it runs.");
 }

@@ -120,13 +120,14 @@ def test_bad_options_and_a_scene_without_robot_are_named(cli, write_json, model)
         shapectl.calibrate(model, observations["frames"])
     with pytest.raises(ValueError, match="max_iterations: expected a number from 1 to 1000, got 0"):
         shapectl.calibrate(model, observations, max_iterations=0)
+    # Frames with joints for a scene without a robot (a clamped bar).
     clamped = SOURCE_DIR / "scenes" / "foam_bar_clamped.json"
     run = cli("calibrate", clamped, "--observations", path)
     assert run.exit_code == 1
     with pytest.raises(ValueError) as error:
-        shapectl.calibrate(shapectl.Scene.load(clamped), observations)
+        shapectl.calibrate(shapectl.Scene.load(clamped), path)
     assert str(error.value) == run.error_message()
-    assert str(error.value).endswith("robot: a robot holding the object (missing key)")
+    assert "frames[0].joints: the scene has no robot" in str(error.value)
 
 
 def test_a_calibration_in_a_thread_does_not_block_other_python_threads(model):

@@ -67,6 +67,14 @@ std::string object_pose_refusal(const Scene& scene) {
 
 }  // namespace
 
+const char* fit_parameter_names() {
+  return "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose";
+}
+
+const char* default_fit(const Scene& scene) {
+  return scene.robot ? "youngs_modulus,grip_offsets" : "youngs_modulus,object_pose";
+}
+
 FitSelection parse_fit_selection(const std::string& list) {
   FitSelection s;
   std::stringstream in(list);

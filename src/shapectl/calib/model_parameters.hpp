@@ -33,6 +33,11 @@ struct FitSelection {
 // Parsed from "youngs_modulus,poisson_ratio,density,grip_offsets,object_pose".
 // Throws std::invalid_argument naming the unknown entry and the known ones.
 FitSelection parse_fit_selection(const std::string& list);
+// "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose": for messages.
+const char* fit_parameter_names();
+// What to fit when nobody says: a robot's grips are where the real object is held off; a
+// clamp is where the scene puts it.
+const char* default_fit(const Scene& scene);
 
 struct PhysicalParameters {
   double youngs_modulus = 0;  // Pa

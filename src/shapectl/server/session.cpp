@@ -456,8 +456,9 @@ std::string Session::state_message(int clients) const {
       {"observations", s.observations},
       {"observations_ignored", s.observations_ignored},
       {"observation_problem", s.observation_problem},
-      {"model_error", finite_or_null(s.model_error)},
-      {"observed_error", finite_or_null(s.observed_error)},
+      // null until something was observed: 0 would claim a perfect model and object.
+      {"model_error", s.observations ? finite_or_null(s.model_error) : nlohmann::json()},
+      {"observed_error", s.observations ? finite_or_null(s.observed_error) : nlohmann::json()},
       {"observed_markers", observed_markers_json(s.observed_markers)},
       {"true_error", world_ ? finite_or_null(true_error_) : nlohmann::json()},
       {"model", model_json(s, controller_->scene())},
