@@ -14,35 +14,17 @@
 
 #include <shapectl/io/input_error.hpp>
 
+#include "calib/different_world.hpp"
 #include "support/test_support.hpp"
 
 namespace shapectl {
 namespace {
 
-// The model is the bundled YuMi bar; the world's bar is 1.5× stiffer, 0.8× as dense and held
-// 4 mm / 3° off at each grip.
-Scene world_of(const Scene& model) {
-  Scene world = model;
-  world.material =
-      material_from_youngs(1.5 * youngs_modulus_of(model.material),
-                           poisson_ratio_of(model.material), 0.8 * model.material.density);
-  world.grips[0].offset = Eigen::Translation3d(0.004 * Vec3(0, 1, -1).normalized()) *
-                          Eigen::AngleAxisd(3 * M_PI / 180, Vec3(0, 0, 1));
-  world.grips[1].offset = Eigen::Translation3d(0.004 * Vec3(1, 0, 1).normalized()) *
-                          Eigen::AngleAxisd(3 * M_PI / 180, Vec3(0, 1, 0));
-  return world;
-}
-
-double true_error(const ShapeTargets& targets, const Positions& world) {
-  double sum = 0;
-  for (int k = 0; k < targets.size(); ++k)
-    sum += (world.segment<3>(3 * targets.nodes[k]) - targets.positions[k]).norm();
-  return sum / targets.size();
-}
+using test::true_error;
 
 TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMisses) {
   const Scene model_scene = load_scene(test::source_path("scenes/yumi_bar.json"));
-  const GrippedObject model(model_scene), world(world_of(model_scene));
+  const GrippedObject model(model_scene), world(test::different_world(model_scene));
   ReducedObjective objective(model);
   const Evaluation reference =
       objective.evaluate(model.reference_joints(), model.reference_positions());
@@ -100,7 +82,7 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
 // markers come back as observations.
 TEST(ClosedLoop, TheControllerWithFeedbackOnReachesTheTargetsOnTheObservedBar) {
   const Scene model_scene = load_scene(test::source_path("scenes/yumi_bar.json"));
-  const GrippedObject world(world_of(model_scene));
+  const GrippedObject world(test::different_world(model_scene));
   Controller controller(model_scene);
   const std::shared_ptr<const ControllerSnapshot> first = controller.snapshot();
   Eigen::VectorXd goal = first->joints;
