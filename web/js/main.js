@@ -226,7 +226,9 @@ window.shapectl = {
   get scene() { return page.scene; },
   get state() { return page.state; },
   get stats() { return page.stats; },
-  get ready() { return !!(page.scene && page.state && view.positions && view.frames > 2); },
+  // Scene, state and positions here and drawn: no render still pending (the view renders on
+  // demand, so an idle scene may never draw a third frame).
+  get ready() { return !!(page.scene && page.state && view.positions && view.frames > 0 && !view.renderPending); },
   get arrowCount() { return view.arrowCount; },
   get frames() { return view.frames; },
   get observedPointsDrawn() { return view.observedPointsDrawn; },
