@@ -4,6 +4,7 @@ import { describe, it } from 'node:test';
 import assert from 'node:assert/strict';
 import { formatValue, formatWithDeviation, shownUnit } from '../../web/js/units.js';
 import { Unit } from '../../web/js/protocol.js';
+import { heldExplanation } from '../../web/js/calibration_panel.js';
 
 describe('readable units', () => {
   it('shows each SI unit of a calibration parameter in its readable unit', () => {
@@ -22,5 +23,12 @@ describe('readable units', () => {
     assert.equal(formatValue(null, Unit.Metre), '–');
     assert.equal(formatValue(Number.NaN, Unit.Metre), '–');
     assert.equal(formatWithDeviation(0.004, null, Unit.Metre), '4.00 ± –');
+  });
+
+  it('explains a held parameter, also one whose direction the observations do not see at all', () => {
+    assert.equal(heldExplanation(0.62),
+      'the observations leave it undetermined: ± 0.62 × its typical size (identifiable below 0.1)');
+    // The server sends an infinite deviation as null: no exception, a sentence.
+    assert.equal(heldExplanation(null), 'the observations do not constrain it at all');
   });
 });

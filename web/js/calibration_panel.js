@@ -18,6 +18,13 @@ function parameterLabel(name) {
   return group === Parameter.GripOffsets && coordinate ? `${endEffector} grip ${coordinate}` : name;
 }
 
+// Why a held parameter was held: its direction's deviation in units of its typical size
+// (docs/calibration.md); null when the observations do not see that direction at all.
+export function heldExplanation(deviation) {
+  if (deviation === null || !Number.isFinite(deviation)) return 'the observations do not constrain it at all';
+  return `the observations leave it undetermined: ± ${deviation.toPrecision(2)} × its typical size (identifiable below 0.1)`;
+}
+
 const mm = (m) => (Number.isFinite(m) ? (1000 * m).toFixed(2) : '–');
 
 // Writes only changes: states arrive 30 times a second.
@@ -109,8 +116,7 @@ export class CalibrationPanel {
       if (p.held) {
         const held = cell('held (not identifiable)', 'muted');
         // That deviation is in units of the parameter's typical size (docs/calibration.md).
-        if (unidentified.has(p.name))
-          held.title = `the observations leave it undetermined: ± ${unidentified.get(p.name).toPrecision(2)} × its typical size (identifiable below 0.1)`;
+        if (unidentified.has(p.name)) held.title = heldExplanation(unidentified.get(p.name));
         row.append(held);
       } else {
         row.append(cell(formatWithDeviation(p.fitted, p.standard_deviation, p.unit), 'number'));
