@@ -97,4 +97,27 @@ done < <(find "$web" -name '*.js')
 for asset in js/main.js css/style.css; do
   grep -q "$asset" "$web/index.html" && [ -f "$web/$asset" ] || fail "$asset not installed"
 done
-echo "install_test: installed tree builds, links and runs a consumer; Python and web complete"
+
+# The installed `serve` finds its page and scenes in the prefix, with no --web-root: it answers
+# GET / with the installed index.html (marked, so that the source tree's copy cannot pass).
+echo "<!-- the installed copy -->" >>"$web/index.html"
+"$prefix/bin/shapectl" serve --port 0 >"$work/serve.out" 2>"$work/serve.err" &
+serve_pid=$!
+url=""
+for _ in $(seq 200); do
+  url="$(grep -oE 'http://[^ ]+/' "$work/serve.out" || true)"
+  [ -n "$url" ] && break
+  sleep 0.05
+done
+[ -n "$url" ] || { kill "$serve_pid"; cat "$work/serve.err" >&2; fail "installed serve printed no URL"; }
+if ! python3 - "$url" "$web/index.html" <<'EOF'
+import sys, urllib.request
+page = urllib.request.urlopen(sys.argv[1], timeout=10).read()
+assert page == open(sys.argv[2], "rb").read()
+EOF
+then
+  kill "$serve_pid"; fail "installed serve does not serve the installed page"
+fi
+kill "$serve_pid"
+wait "$serve_pid" 2>/dev/null || true
+echo "install_test: installed tree builds, links and runs a consumer; Python, web and serve complete"

@@ -9,8 +9,11 @@ std::filesystem::path default_web_root() {
   std::error_code ec;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (!ec) {
-    for (const auto& candidate : {exe.parent_path().parent_path() / "web",
-                                  exe.parent_path().parent_path().parent_path() / "web"})
+    const std::filesystem::path bin = exe.parent_path();
+    // Installed (P/bin/shapectl → P/share/shapectl/web), the build tree, a nested build tree.
+    for (const auto& candidate :
+         {bin.parent_path() / "share" / "shapectl" / "web", bin.parent_path() / "web",
+          bin.parent_path().parent_path() / "web"})
       if (std::filesystem::is_regular_file(candidate / "index.html", ec)) return candidate;
   }
   return source_web;
