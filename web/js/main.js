@@ -241,4 +241,7 @@ window.shapectl = {
   objectCentroid: () => view.objectCentroid().toArray(),
   cameraDirection: () => view.cameraDirection(),
   observedPoints: () => view.observedPoints(),
+  robotColors: () => view.robotView.visualColors(),
+  ghost: () => ({ visible: view.ghostView.visible, links: view.ghostView.robotView.linkPoses(),
+    colors: view.ghostView.robotView.visualColors(), meshes: view.ghostView.group.children.reduce((n, g) => n + g.children.length, 0) }),
 };

@@ -1,5 +1,6 @@
-// The robot in the 3D view: one group per link (its visuals, one colour per link) posed from
-// each state's link poses, and the collision spheres, shown on request. World frame, metres.
+// The robot in the 3D view: one group per link (its visuals, in the URDF's colours or else one
+// colour per link) posed from each state's link poses, and the collision spheres, shown on
+// request. World frame, metres. With `opacity` < 1 and no spheres it draws the ghost robot.
 import * as THREE from 'three';
 import { ShapeKind } from './protocol.js';
 
@@ -8,6 +9,17 @@ const SPHERE_MATERIAL = new THREE.MeshBasicMaterial({ color: 0x66ccff, wireframe
 function linkColor(index) {
   // Golden-angle hues: neighbouring links get clearly different colours.
   return new THREE.Color().setHSL((index * 0.618034) % 1, 0.45, 0.55);
+}
+
+// A visual's material: the URDF's sRGB colour and alpha, else the link's colour; `opacity`
+// scales the alpha (the ghost).
+function shapeMaterial(shape, index, opacity) {
+  const [r, g, b, a] = shape.color ?? [0, 0, 0, 1];
+  const color = shape.color ? new THREE.Color().setRGB(r, g, b, THREE.SRGBColorSpace) : linkColor(index);
+  const alpha = a * opacity;
+  return new THREE.MeshStandardMaterial({
+    color, roughness: 0.6, metalness: 0.1, transparent: alpha < 1, opacity: alpha, depthWrite: alpha >= 1,
+  });
 }
 
 function shapeGeometry(shape) {
@@ -20,7 +32,10 @@ function shapeGeometry(shape) {
 }
 
 export class RobotView {
-  constructor() {
+  // `opacity` scales every visual's alpha; `spheres`: whether to draw the collision spheres.
+  constructor({ opacity = 1, spheres = true } = {}) {
+    this.opacity = opacity;
+    this.drawSpheres = spheres;
     this.group = new THREE.Group();
     this.linkGroups = [];     // per link, posed by T_world_link
     this.visualMeshes = [];   // the link shapes (hidden by the robot toggle)
@@ -44,9 +59,8 @@ export class RobotView {
       const group = new THREE.Group();
       group.matrixAutoUpdate = false;
       group.name = link.name;
-      const material = new THREE.MeshStandardMaterial({ color: linkColor(index), roughness: 0.6, metalness: 0.1 });
       for (const shape of link.visuals) {
-        const mesh = new THREE.Mesh(shapeGeometry(shape), material);
+        const mesh = new THREE.Mesh(shapeGeometry(shape), shapeMaterial(shape, index, this.opacity));
         mesh.matrixAutoUpdate = false;
         mesh.matrix.fromArray(shape.pose);
         mesh.visible = this.robotVisible;
@@ -56,6 +70,7 @@ export class RobotView {
       this.group.add(group);
       this.linkGroups.push(group);
     });
+    if (!this.drawSpheres) return;
     for (const s of robot.collision_spheres) {
       const mesh = new THREE.Mesh(new THREE.SphereGeometry(s.radius, 12, 8), SPHERE_MATERIAL);
       mesh.position.set(...s.center);
@@ -71,6 +86,23 @@ export class RobotView {
       const group = this.linkGroups[k];
       if (group) { group.matrix.fromArray(pose); group.matrixWorldNeedsUpdate = true; }
     });
+  }
+
+  // For tests: per link in scene order, its name and each drawn visual's sRGB colour and opacity.
+  visualColors() {
+    const srgb = new THREE.Color();
+    return this.linkGroups.map((group) => ({
+      name: group.name,
+      visuals: group.children.filter((o) => this.visualMeshes.includes(o)).map((m) => {
+        m.material.color.getRGB(srgb, THREE.SRGBColorSpace);
+        return { rgb: [srgb.r, srgb.g, srgb.b], opacity: m.material.opacity };
+      }),
+    }));
+  }
+
+  // For tests: each link's pose as drawn, 16 numbers (column-major T_world_link).
+  linkPoses() {
+    return this.linkGroups.map((group) => group.matrix.toArray());
   }
 
   setVisible(on) {

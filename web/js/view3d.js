@@ -5,6 +5,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { ObjectView } from './object_view.js';
 import { RobotView } from './robot_view.js';
+import { GhostView } from './ghost_view.js';
 import { TargetControls } from './target_controls.js';
 
 const MOVE_INTERVAL_MS = 33;       // ~30 target edits per second while dragging
@@ -38,8 +39,9 @@ export class View3D {
     this.scene.add(grid);
 
     this.robotView = new RobotView();
+    this.ghostView = new GhostView();
     this.objectView = new ObjectView();
-    this.scene.add(this.robotView.group, this.objectView.group);
+    this.scene.add(this.robotView.group, this.ghostView.group, this.objectView.group);
     this.targetControls = new TargetControls(this.camera, this.objectView, this.renderer.domElement);
 
     this.state = null;             // the last state message shown
@@ -118,6 +120,7 @@ export class View3D {
     this.targetControls.cancel();
     this.orbit.enabled = true;
     this.robotView.setRobot(description.robot);
+    this.ghostView.setRobot(description.robot);
     this.objectView.setScene(description);
     this.state = null;
     this.requestRender();
@@ -133,6 +136,8 @@ export class View3D {
   setState(state) {
     const unchanged = this.state && this.state.seq === state.seq && this.state.scene === state.scene;
     this.state = state;
+    // The measured robot moves between snapshots.
+    if (this.ghostView.setState(state)) this.requestRender();
     if (unchanged) return;  // same snapshot: nothing to redraw (saves software-GL time)
     this.robotView.setLinkPoses(state.links);
     this.objectView.setCenterline(state.centerline);

@@ -23,6 +23,9 @@ struct Shape {
   Vec3 box_size = Vec3::Zero();  // full edge lengths along x, y, z (box), metres
   double radius = 0;             // sphere, cylinder; metres
   double length = 0;             // cylinder; metres
+  // The URDF material's colour (visuals only): red, green, blue, alpha in [0, 1]; none when the
+  // URDF gives no colour (the GUI then picks one per link).
+  std::optional<Eigen::Vector4d> rgba;
 };
 
 struct Link {

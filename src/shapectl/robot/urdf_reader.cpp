@@ -237,8 +237,9 @@ class UrdfReader {
     out.name = link.name;
     out.parent_joint = parent_joint;
     for (const auto& visual : link.visual_array)
-      if (visual)
-        add_shape(link.name, "visual", visual->geometry, visual->origin, out.visual_shapes);
+      if (visual &&
+          add_shape(link.name, "visual", visual->geometry, visual->origin, out.visual_shapes))
+        out.visual_shapes.back().rgba = material_color(visual->material);
     for (const auto& collision : link.collision_array)
       if (collision)
         add_shape(link.name, "collision", collision->geometry, collision->origin,
@@ -338,10 +339,23 @@ class UrdfReader {
     }
   }
 
-  void add_shape(const std::string& link, const std::string& kind,
+  // urdfdom resolves a named material to its robot-level definition. A texture-only material
+  // keeps urdfdom's default colour, opaque black: that is no colour, not a black robot.
+  static std::optional<Eigen::Vector4d> material_color(const urdf::MaterialSharedPtr& material) {
+    if (!material) return std::nullopt;
+    const urdf::Color& c = material->color;
+    const Eigen::Vector4d rgba(c.r, c.g, c.b, c.a);
+    const bool default_color = rgba == Eigen::Vector4d(0, 0, 0, 1);
+    if (!rgba.allFinite() || (default_color && !material->texture_filename.empty()))
+      return std::nullopt;
+    return rgba.cwiseMax(0.0).cwiseMin(1.0);
+  }
+
+  // Returns whether a shape was added (meshes are skipped).
+  bool add_shape(const std::string& link, const std::string& kind,
                  const urdf::GeometrySharedPtr& geometry, const urdf::Pose& origin,
                  std::vector<Shape>& shapes) {
-    if (!geometry) return;
+    if (!geometry) return false;
     const std::string where = where_link(link);
     const std::string element = named("link", link) + ": " + kind;
     Shape shape;
@@ -377,10 +391,11 @@ class UrdfReader {
           first_skipped_ = element + " mesh '" +
                            bounded_preview(static_cast<const urdf::Mesh&>(*geometry).filename) +
                            "'";
-        return;
+        return false;
       }
     }
     shapes.push_back(shape);
+    return true;
   }
 
   Eigen::Isometry3d pose(const urdf::Pose& p, const std::string& where,

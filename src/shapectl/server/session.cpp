@@ -9,6 +9,7 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/link/robot_link.hpp>
+#include <shapectl/robot/kinematics.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 
 namespace shapectl::server {
@@ -89,7 +90,9 @@ nlohmann::json shape_json(const Shape& s) {
           {"pose", message_pose_json(s.T_link_shape)},
           {"size", vec3_json(s.box_size)},
           {"radius", s.radius},
-          {"length", s.length}};
+          {"length", s.length},
+          {"color", s.rgba ? nlohmann::json(std::vector<double>(s.rgba->data(), s.rgba->data() + 4))
+                           : nlohmann::json(nullptr)}};
 }
 
 nlohmann::json robot_json(const RobotSetup& setup) {
@@ -126,6 +129,16 @@ nlohmann::json link_status_json(const LinkStatus& s) {
           {"reason", s.reason},
           {"measured", vector_json(s.measured)},
           {"commanded", vector_json(s.commanded)}};
+}
+
+// The link poses at the measured joints (the ghost robot), encoded as a state's "links"; null
+// without a robot or before the first feedback.
+nlohmann::json measured_links_json(const Scene& scene, const LinkStatus& status) {
+  if (!scene.robot || status.measured.size() != scene.robot->model->active_count()) return nullptr;
+  nlohmann::json links = nlohmann::json::array();
+  for (const auto& T : forward_kinematics(*scene.robot->model, status.measured).T_world_link)
+    links.push_back(message_pose_json(T));
+  return links;
 }
 
 }  // namespace
@@ -465,7 +478,9 @@ std::string Session::state_message(int clients) const {
       {"calibration", calibration_json(calibration)},
       {"observed_points", points_json(calibration.points)},
       {"clients", clients},
-      {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)}};
+      {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)},
+      {"measured_links",
+       link_ ? measured_links_json(controller_->scene(), link_->status()) : nlohmann::json()}};
   return m.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
