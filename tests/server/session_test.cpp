@@ -291,11 +291,28 @@ TEST(SessionLog, EachNewSnapshotIsLoggedAsAnOptimizerEvent) {
   ASSERT_FALSE(events.empty());
   std::vector<std::uint64_t> sequences;
   for (const auto& e : events) {
-    EXPECT_EQ(e.event, "optimizer");
+    ASSERT_EQ(e.event, "optimizer");
     EXPECT_EQ(e.fields["joints"].size(), 14u);
     sequences.push_back(e.fields["sequence"].get<std::uint64_t>());
   }
   EXPECT_TRUE(std::adjacent_find(sequences.begin(), sequences.end()) == sequences.end());
+}
+
+TEST(SessionLog, ASceneSwitchIsLogged) {
+  test::TempDir dir;
+  const auto file = dir.path() / "session.jsonl";
+  {
+    SessionLog log(file);
+    Session session(test::source_path("scenes/yumi_bar.json"),
+                    find_bundled_scenes(test::source_path("scenes")));
+    session.set_log(&log);
+    ASSERT_TRUE(session.handle(R"({"type":"load_scene","scene":"yumi_frame.json"})").ok);
+    EXPECT_FALSE(session.handle(R"({"type":"load_scene","scene":"nowhere.json"})").ok);
+  }
+  const auto events = read_session_log(file);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].event, "scene");
+  EXPECT_EQ(events[0].fields["scene"], test::source_path("scenes/yumi_frame.json").string());
 }
 
 }  // namespace

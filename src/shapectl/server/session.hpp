@@ -73,7 +73,8 @@ class Session {
   // only for the scene it was made for (the session then offers no other).
   void set_world(std::unique_ptr<SimulatedWorld> world);
   // `serve --log`: each new snapshot tick() sends to the link also goes to `log` as an
-  // "optimizer" event. `log` must outlive the session; null stops logging.
+  // "optimizer" event, each scene switch as a "scene" event. `log` must outlive the session;
+  // null stops logging.
   void set_log(SessionLog* log) { log_ = log; }
   // JSON "scene" message: static description (robot geometry, mesh triangles, grips, scene
   // list, limits, history). Sent on connect and after a scene switch.
