@@ -3,6 +3,7 @@
 #include <sys/wait.h>
 
 #include <chrono>
+#include <sstream>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -90,9 +91,19 @@ TEST(ServeCli, EveryLinkOptionOfRunIsTakenAndTheLogReplays) {
   const auto summary = nlohmann::json::parse(replay.out);
   EXPECT_EQ(summary["counts"]["session"], 1);
   EXPECT_EQ(summary["violations"].size(), 0u);
-  const auto first = nlohmann::json::parse(read_text(log).substr(0, read_text(log).find('\n')));
-  EXPECT_EQ(first["command"], "serve");
-  EXPECT_NE(first["scene"].get<std::string>().find("yumi_bar.json"), std::string::npos);
+  std::istringstream lines(read_text(log));
+  std::string line;
+  std::getline(lines, line);
+  const auto session = nlohmann::json::parse(line);
+  EXPECT_EQ(session["command"], "serve");
+  EXPECT_NE(session["scene"].get<std::string>().find("yumi_bar.json"), std::string::npos);
+  // The link got the options: its logged limits are theirs.
+  std::getline(lines, line);
+  const auto link = nlohmann::json::parse(line);
+  ASSERT_EQ(link["event"], "link");
+  for (const auto& a : link["acceleration"]) EXPECT_DOUBLE_EQ(a.get<double>(), 0.8);
+  for (const auto& v : link["velocity"]) EXPECT_LE(v.get<double>(), 0.3);
+  EXPECT_NEAR(link["lower"][0].get<double>(), -2.94087978961 + 0.03, 1e-12) << "--limit-margin";
 }
 
 }  // namespace
