@@ -29,9 +29,11 @@
 #include <shapectl/link/make_robot_link.hpp>
 #include <shapectl/link/stop_signal.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
+#include <shapectl/server/session.hpp>
 
 #include "closed_loop_options.hpp"
 #include "commands.hpp"
+#include "link_options.hpp"
 #include "result_json.hpp"
 
 namespace shapectl::cli {
@@ -48,8 +50,8 @@ struct RunArgs {
   bool until_settled = false;
   double timeout = 0;         // s; 0: none
   std::string robot = "sim";  // a LinkKind name
-  LinkConfig link;
-  double watchdog_ms = 100;
+  LinkArgs link_options;
+  LinkConfig link;      // from link_options and the scene (load_run_inputs)
   ClosedLoopArgs loop;  // the simulated world, feedback, online calibration
   // A real camera's frames: one JSON frame per UDP datagram (calib/observation_receiver.hpp).
   int observations_udp = -1;  // port; -1: none
@@ -84,17 +86,6 @@ std::string cannot_settle(const ControllerSnapshot& s, const LinkStatus& link, b
   if (!s.last_error.empty()) return "optimizer: " + s.last_error;
   if (armed_once && !link.armed) return "robot link disarmed: " + link.reason;
   return {};
-}
-
-void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
-  log.write("optimizer", {{"sequence", s.sequence},
-                          {"status", to_string(s.status)},
-                          {"joints", vector_json(s.joints)},
-                          {"safe", s.safe},
-                          {"error_mean", s.error.mean},
-                          {"error_max", s.error.max},
-                          {"objective", s.objective},
-                          {"iterations", s.iterations}});
 }
 
 struct RunInputs {
@@ -140,9 +131,9 @@ RunInputs load_run_inputs(RunArgs& args) {
   print_scene_notes(scene);
   if (!scene.robot) throw InputError(args.scene, "robot", "run needs a scene with a robot");
   TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
-  parse(args.robot, &args.link.kind);  // checked by the option
-  args.link.watchdog_timeout = args.watchdog_ms / 1000;
-  args.link.sim_initial_joints = scene.robot->reference_joints;
+  LinkKind kind = LinkKind::Sim;
+  parse(args.robot, &kind);  // checked by the option
+  args.link = link_config(args.link_options, kind, scene.robot->reference_joints);
   if (args.timeout < 0) throw InputError("run", "--timeout", "a number >= 0", args.timeout);
   std::unique_ptr<SimulatedWorld> world = make_world(args, scene, targets.targets);
   OnlineCalibrationOptions calibration = online_calibration_options(args.loop, "run");
@@ -302,7 +293,7 @@ RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLi
     if (snap.sequence > seen) {
       seen = snap.sequence;
       link.set_target(snap.joints, snap.safe);
-      if (log) log_snapshot(*log, snap);
+      if (log) server::log_snapshot(*log, snap);
     }
     const LinkStatus st = link.status();
     observe(observers, snap, st, clock.elapsed(), log);
@@ -416,22 +407,7 @@ void add_run_command(CLI::App& app) {
                 "exit 0 once converged and arrived; exit 2 with the reason if that cannot happen");
   cmd->add_option("--timeout", args->timeout, "seconds before giving up (0: none)")
       ->capture_default_str();
-  cmd->add_option("--max-velocity", args->link.max_velocity,
-                  "rad/s per joint (capped by the robot's own)")
-      ->capture_default_str();
-  cmd->add_option("--max-acceleration", args->link.max_acceleration, "rad/s² per joint")
-      ->capture_default_str();
-  cmd->add_option("--limit-margin", args->link.limit_margin, "rad kept from each joint limit")
-      ->capture_default_str();
-  cmd->add_option("--watchdog-ms", args->watchdog_ms, "feedback gap that holds and disarms, ms")
-      ->capture_default_str();
-  cmd->add_option("--egm-address", args->link.egm_address, "local address for the EGM ports")
-      ->capture_default_str();
-  cmd->add_option("--egm-left-port", args->link.egm_left_port, "UDP port of the left arm (ROB_L)")
-      ->capture_default_str();
-  cmd->add_option("--egm-right-port", args->link.egm_right_port,
-                  "UDP port of the right arm (ROB_R)")
-      ->capture_default_str();
+  add_link_options(*cmd, args->link_options);
   add_closed_loop_options(*cmd, args->loop, /*feedback_flag=*/true);
   cmd->add_option("--observations-udp", args->observations_udp,
                   "PORT: observed frames from a camera program, one JSON frame per datagram "

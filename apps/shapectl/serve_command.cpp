@@ -1,10 +1,12 @@
-// shapectl serve [SCENE.json] [--host 127.0.0.1] [--port 8080] [--robot none|sim|egm] [--web-root
-// DIR] The browser GUI: serves web/ over HTTP and the session over a WebSocket at /ws
+// shapectl serve [SCENE.json] [--host 127.0.0.1] [--port 8080] [--robot none|sim|egm]
+//                [link options] [--log LOG.jsonl] [--web-root DIR]
+// The browser GUI: serves web/ over HTTP and the session over a WebSocket at /ws
 // (docs/gui.md).
 #include <iostream>
 
 #include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/session_log.hpp>
 #include <shapectl/link/make_robot_link.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/server/server.hpp>
@@ -12,6 +14,7 @@
 
 #include "closed_loop_options.hpp"
 #include "commands.hpp"
+#include "link_options.hpp"
 
 namespace shapectl::cli {
 
@@ -22,11 +25,26 @@ struct ServeArgs {
   std::string host = "127.0.0.1";
   int port = 8080;
   std::string robot = "none";
+  LinkArgs link;
+  std::string log;
   std::string web_root;
   std::string scenes_dir;
   double rate = 30;
   ClosedLoopArgs loop;  // the simulated real object, the online calibration
 };
+
+// The session log if --log names one, opened with a "session" event; else null.
+std::shared_ptr<SessionLog> open_serve_log(const ServeArgs& args,
+                                           const std::filesystem::path& scene,
+                                           const Scene& description) {
+  if (args.log.empty()) return nullptr;
+  auto log = std::make_shared<SessionLog>(args.log);
+  log->write("session", {{"command", "serve"},
+                         {"scene", std::filesystem::absolute(scene).string()},
+                         {"robot", args.robot},
+                         {"joint_names", description.robot->model->active_joint_names()}});
+  return log;
+}
 
 void run_serve(const ServeArgs& args) {
   server::ServerOptions options;
@@ -46,18 +64,24 @@ void run_serve(const ServeArgs& args) {
 
   // The robot link follows the optimizer's θ; it starts disarmed (arm from the page).
   std::unique_ptr<RobotLink> link;
-  if (args.robot != "none") {
+  std::shared_ptr<SessionLog> log;
+  if (args.robot != "none" || !args.log.empty()) {
     const Scene description = load_scene(scene);
     if (!description.robot)
-      throw InputError(scene.string(), "robot", "a robot for --robot " + args.robot);
-    LinkConfig config;
-    parse(args.robot, &config.kind);  // checked by the option
-    config.sim_initial_joints = description.robot->reference_joints;
-    link = make_robot_link(config, *description.robot->model, description.robot->collisions);
-    link->start();
+      throw InputError(scene.string(), "robot",
+                       "a robot for " + (args.robot == "none" ? "--log" : "--robot " + args.robot));
+    LinkKind kind = LinkKind::Sim;
+    parse(args.robot, &kind);  // checked by the option; "none" leaves it
+    const LinkConfig config = link_config(args.link, kind, description.robot->reference_joints);
+    log = open_serve_log(args, scene, description);
+    if (args.robot != "none") {
+      link = make_robot_link(config, *description.robot->model, description.robot->collisions, log);
+      link->start();
+    }
   }
   server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(), {},
                           online_calibration_options(args.loop, "serve"));
+  session.set_log(log.get());
   if (!args.loop.world.empty()) {
     if (args.robot != "sim")
       throw InputError("serve", "--world", "--robot sim (a real robot holds a real object)");
@@ -78,7 +102,9 @@ void run_serve(const ServeArgs& args) {
     std::cerr << "serve: warning: listening on " << args.host
               << ": anyone who can reach this port can move the robot (see docs/gui.md)\n";
   server.run();
+  session.set_log(nullptr);
   if (link) link->stop();
+  if (log) log->write("end", {{"reason", "serve stopped"}});
   std::cout << "shapectl serve: stopped" << std::endl;
 }
 
@@ -99,6 +125,9 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--robot", args->robot, "Robot link following the optimizer (starts disarmed)")
       ->check(CLI::IsMember({"none", "sim", "egm"}))
       ->capture_default_str();
+  add_link_options(*cmd, args->link);
+  cmd->add_option("--log", args->log,
+                  "session log to write (JSON lines, as `run --log`; `shapectl replay` reads it)");
   cmd->add_option("--web-root", args->web_root,
                   "Directory with index.html (default: the repository's web/)");
   cmd->add_option("--scenes-dir", args->scenes_dir,

@@ -1,4 +1,5 @@
 // shapectl solve SCENE.json --targets TARGETS.json --out RESULT.json [--vtu DEFORMED.vtu]
+//   [--surface SURFACE.ply|SURFACE.obj]
 //   [--optimizer lbfgs|gauss-newton] [--gradient sensitivity|adjoint|finite-difference]
 //   [--max-iterations N] [--max-seconds S]
 // Finds joint angles whose equilibrium shape best matches the targets.
@@ -17,13 +18,14 @@
 
 #include "commands.hpp"
 #include "result_json.hpp"
+#include "surface_option.hpp"
 
 namespace shapectl::cli {
 
 namespace {
 
 struct SolveArgs {
-  std::string scene, targets, out, vtu;
+  std::string scene, targets, out, vtu, surface;
   std::string optimizer = "gauss-newton";
   std::string gradient = "sensitivity";
   int max_iterations = 100;
@@ -51,6 +53,7 @@ ShapeTargets resolve_targets(const TargetsInput& in, const std::string& file,
 }
 
 void run_solve(const SolveArgs& args) {
+  check_surface_option("solve", args.surface);
   const Scene scene = load_scene(args.scene);
   print_scene_notes(scene);
   if (!scene.robot) throw InputError(args.scene, "robot", "a robot to optimize (missing key)");
@@ -104,7 +107,7 @@ void run_solve(const SolveArgs& args) {
                    {"gradient_evaluations", t.gradient_evaluations},
                    {"gradient_seconds", t.gradient_seconds}};
   require_finite(out, "solve", result.reason);
-  // With --vtu both files or neither.
+  // With --vtu or --surface all files or none.
   std::vector<FileContent> files = {{args.out, to_pretty_json(out)}};
   if (!args.vtu.empty()) {
     std::vector<std::array<int, 4>> tets;
@@ -113,6 +116,8 @@ void run_solve(const SolveArgs& args) {
     files.push_back(
         {args.vtu, vtu_text(best.positions, tets, {{"displacement", best.positions - rest}})});
   }
+  if (!args.surface.empty())
+    files.push_back(surface_file(args.surface, object.mesh(), best.positions));
   write_files_atomically(files);
   std::cerr << "solve: " << result.reason << "; mean error " << best.error.mean * 1e3 << " mm, max "
             << best.error.max * 1e3 << " mm, min clearance " << best.min_clearance * 1e3 << " mm\n";
@@ -129,6 +134,7 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
   cmd->add_option("--vtu", args->vtu,
                   "also write the deformed mesh at the best joints as VTU (ParaView)");
+  add_surface_option(*cmd, args->surface);
   cmd->add_option("--optimizer", args->optimizer, "gauss-newton (default) or lbfgs")
       ->check(CLI::IsMember(optimizer_names()));
   cmd->add_option("--gradient", args->gradient,

@@ -1,4 +1,5 @@
 // shapectl statics SCENE.json [--joints JOINTS.json] --out RESULT.json [--vtu DEFORMED.vtu]
+//   [--surface SURFACE.ply|SURFACE.obj]
 // Solves the object's static equilibrium (held by fixed nodes, or by the robot at the given
 // joints) and writes the deformed positions.
 #include <iostream>
@@ -14,6 +15,7 @@
 
 #include "commands.hpp"
 #include "result_json.hpp"
+#include "surface_option.hpp"
 
 namespace shapectl::cli {
 
@@ -24,10 +26,11 @@ struct StaticsArgs {
   std::string joints;
   std::string out;
   std::string vtu;
+  std::string surface;
 };
 
 // Writes RESULT.json (and the VTU) even when Newton failed, so the failure can be inspected,
-// but never with a non-finite number, and with --vtu both files or neither.
+// but never with a non-finite number, and with --vtu or --surface all files or none.
 void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMesh& mesh,
                    const Positions& rest, const Positions& x, nlohmann::json result) {
   result["converged"] = r.converged();
@@ -44,6 +47,7 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMes
     for (const auto& t : mesh.tets()) tets.push_back(t.nodes);
     files.push_back({args.vtu, vtu_text(x, tets, {{"displacement", x - rest}})});
   }
+  if (!args.surface.empty()) files.push_back(surface_file(args.surface, mesh, x));
   write_files_atomically(files);
   std::cerr << "statics: " << r.reason << " (" << mesh.tet_count() << " tets, " << mesh.node_count()
             << " nodes)\n";
@@ -51,6 +55,7 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMes
 }
 
 void run_statics(const StaticsArgs& args) {
+  check_surface_option("statics", args.surface);
   const Scene scene = load_scene(args.scene);
   print_scene_notes(scene);
   const Positions rest = scene.world_rest_positions();
@@ -81,6 +86,7 @@ void add_statics_command(CLI::App& app) {
                   "JOINTS.json {\"joints\": {name: rad}} (default: the reference joints)");
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
   cmd->add_option("--vtu", args->vtu, "also write the deformed mesh as VTU (ParaView)");
+  add_surface_option(*cmd, args->surface);
   cmd->callback([args] { run_statics(*args); });
 }
 

@@ -5,6 +5,10 @@
 #include <chrono>
 #include <thread>
 
+#include <shapectl/io/session_log.hpp>
+#include <shapectl/link/make_robot_link.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
+
 #include "support/controller_wait.hpp"
 #include "support/test_support.hpp"
 
@@ -236,6 +240,79 @@ TEST(SessionScenes, BundledScenesAreTheOnesWithARobot) {
   ASSERT_EQ(scenes.size(), 2u);
   EXPECT_EQ(scenes[0].name, "a.json");
   EXPECT_EQ(scenes[1].name, "b.json");
+}
+
+// yumi_bar.json in `dir` as `name` (bundled_scene_text makes its file names absolute);
+// `drop_joint` (if not empty) held fixed at its reference value instead of active.
+std::filesystem::path yumi_scene_copy(const test::TempDir& dir, const std::string& name,
+                                      const std::string& drop_joint = "") {
+  auto scene = nlohmann::json::parse(test::bundled_scene_text("yumi_bar.json"));
+  auto& robot = scene["robot"];
+  if (!drop_joint.empty()) {
+    auto& active = robot["active_joints"];
+    active.erase(std::find(active.begin(), active.end(), drop_joint));
+    robot["fixed_joints"][drop_joint] = robot["reference_joints"][drop_joint];
+    robot["reference_joints"].erase(drop_joint);
+  }
+  return dir.write(name, scene.dump());
+}
+
+TEST(SessionScenes, WithARobotLinkOnlyScenesWithItsJointsAreOffered) {
+  test::TempDir dir;
+  const auto first = yumi_scene_copy(dir, "a_yumi.json");
+  yumi_scene_copy(dir, "b_same_yumi.json");
+  yumi_scene_copy(dir, "c_one_joint_fixed.json", "yumi_joint_6_r");
+  const Scene scene = load_scene(first);
+  const auto link = make_robot_link(LinkConfig{}, *scene.robot->model, scene.robot->collisions);
+  Session session(first, find_bundled_scenes(dir.path()), link.get());
+  const auto scenes = nlohmann::json::parse(session.scene_message())["scenes"];
+  EXPECT_EQ(scenes, nlohmann::json({"a_yumi.json", "b_same_yumi.json"}));
+  // Without a link every scene with a robot is offered.
+  Session free(first, find_bundled_scenes(dir.path()));
+  EXPECT_EQ(nlohmann::json::parse(free.scene_message())["scenes"].size(), 3u);
+}
+
+TEST(SessionLog, EachNewSnapshotIsLoggedAsAnOptimizerEvent) {
+  test::TempDir dir;
+  const auto file = dir.path() / "session.jsonl";
+  {
+    SessionLog log(file);
+    Session session(test::source_path("scenes/yumi_bar.json"), {});
+    session.set_log(&log);
+    ASSERT_TRUE(
+        session.handle(R"({"type":"set_target","id":1,"node":5,"position":[0.4,0.0,0.3]})").ok);
+    const auto s =
+        wait_until(session, [](const ControllerSnapshot& s) { return !s.targets.empty(); });
+    ASSERT_FALSE(s->targets.empty());
+    session.tick();
+    session.tick();  // nothing new, or a newer snapshot: never the same one twice
+  }
+  const auto events = read_session_log(file);
+  ASSERT_FALSE(events.empty());
+  std::vector<std::uint64_t> sequences;
+  for (const auto& e : events) {
+    ASSERT_EQ(e.event, "optimizer");
+    EXPECT_EQ(e.fields["joints"].size(), 14u);
+    sequences.push_back(e.fields["sequence"].get<std::uint64_t>());
+  }
+  EXPECT_TRUE(std::adjacent_find(sequences.begin(), sequences.end()) == sequences.end());
+}
+
+TEST(SessionLog, ASceneSwitchIsLogged) {
+  test::TempDir dir;
+  const auto file = dir.path() / "session.jsonl";
+  {
+    SessionLog log(file);
+    Session session(test::source_path("scenes/yumi_bar.json"),
+                    find_bundled_scenes(test::source_path("scenes")));
+    session.set_log(&log);
+    ASSERT_TRUE(session.handle(R"({"type":"load_scene","scene":"yumi_frame.json"})").ok);
+    EXPECT_FALSE(session.handle(R"({"type":"load_scene","scene":"nowhere.json"})").ok);
+  }
+  const auto events = read_session_log(file);
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].event, "scene");
+  EXPECT_EQ(events[0].fields["scene"], test::source_path("scenes/yumi_frame.json").string());
 }
 
 }  // namespace

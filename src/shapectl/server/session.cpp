@@ -8,6 +8,7 @@
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
+#include <shapectl/io/session_log.hpp>
 #include <shapectl/link/robot_link.hpp>
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
@@ -141,7 +142,28 @@ nlohmann::json measured_links_json(const Scene& scene, const LinkStatus& status)
   return links;
 }
 
+// Whether `entry` loads with a robot whose active joints are `joints`.
+bool has_joints(const SceneEntry& entry, const std::vector<std::string>& joints) {
+  try {
+    const Scene scene = load_scene(entry.path);
+    return scene.robot && scene.robot->model->active_joint_names() == joints;
+  } catch (const InputError&) {
+    return false;  // it could not be switched to either
+  }
+}
+
 }  // namespace
+
+void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
+  log.write("optimizer", {{"sequence", s.sequence},
+                          {"status", to_string(s.status)},
+                          {"joints", vector_json(s.joints)},
+                          {"safe", s.safe},
+                          {"error_mean", s.error.mean},
+                          {"error_max", s.error.max},
+                          {"objective", s.objective},
+                          {"iterations", s.iterations}});
+}
 
 std::vector<SceneEntry> find_bundled_scenes(const std::filesystem::path& directory) {
   std::vector<SceneEntry> scenes;
@@ -174,6 +196,14 @@ Session::Session(const std::filesystem::path& scene, std::vector<SceneEntry> sce
     it->path = scene;  // the file asked for wins over a bundled one of the same name
   }
   load(*it);
+  // A robot link drives one robot: offering a scene that load() would refuse only confuses.
+  if (link_) {
+    const std::vector<std::string> joints = controller_->robot().active_joint_names();
+    std::erase_if(scenes_, [&](const SceneEntry& e) {
+      return e.name != scene_name_ && !has_joints(e, joints);
+    });
+    scene_description_ = describe_scene();  // its list of scenes
+  }
 }
 
 Session::~Session() = default;
@@ -205,6 +235,7 @@ void Session::load(const SceneEntry& entry) {
   started_ = std::chrono::steady_clock::now();
   last_edit_time_ = -1e9;
   snapshot_ = controller_->snapshot();
+  logged_sequence_ = 0;
   if (link_) link_->disarm("scene changed to " + entry.name);
   scene_description_ = describe_scene();
 }
@@ -312,6 +343,8 @@ void Session::apply(const Command& c) {
       const auto it = std::find_if(scenes_.begin(), scenes_.end(),
                                    [&](const SceneEntry& e) { return e.name == c.scene; });
       load(*it);  // parse_command admitted only known names
+      // The optimizer events that follow belong to this scene.
+      if (log_) log_->write("scene", {{"scene", std::filesystem::absolute(it->path).string()}});
       break;
     }
     case T::Arm: {
@@ -370,6 +403,10 @@ void Session::tick() {
   history_.push_back({t, snapshot_->error.mean, t - last_edit_time_ < editing_window});
   while (history_.size() > history_capacity) history_.pop_front();
   if (link_) link_->set_target(snapshot_->joints, snapshot_->safe);
+  if (log_ && snapshot_->sequence != logged_sequence_) {
+    logged_sequence_ = snapshot_->sequence;
+    log_snapshot(*log_, *snapshot_);
+  }
   if (world_ && link_) observe_world(t);
   calibration_->poll(t);
 }

@@ -21,9 +21,13 @@
 
 namespace shapectl {
 class RobotLink;
-}
+class SessionLog;
+}  // namespace shapectl
 
 namespace shapectl::server {
+
+// Appends `s` as an "optimizer" event: what the robot link was sent (`run`, `serve --log`).
+void log_snapshot(SessionLog& log, const ControllerSnapshot& s);
 
 struct SceneEntry {
   std::string name;  // what clients ask for, e.g. "yumi_bar.json"
@@ -42,7 +46,8 @@ struct HistorySample {
 class Session {
  public:
   // Loads `scene` (an InputError if it is bad) and starts its controller. `scenes` are what
-  // load_scene may switch to; `scene` is added to them if absent. `link` may be null.
+  // load_scene may switch to; `scene` is added to them if absent. `link` may be null; with a
+  // link, only the scenes with its robot's active joints are offered.
   // Observed frames (`observe`, the simulated world) go through an OnlineCalibration made
   // with `calibration`.
   Session(const std::filesystem::path& scene, std::vector<SceneEntry> scenes,
@@ -67,6 +72,10 @@ class Session {
   // `serve --world`: the simulated real object; needs a link (its measured joints) and holds
   // only for the scene it was made for (the session then offers no other).
   void set_world(std::unique_ptr<SimulatedWorld> world);
+  // `serve --log`: each new snapshot tick() sends to the link also goes to `log` as an
+  // "optimizer" event, each scene switch as a "scene" event. `log` must outlive the session;
+  // null stops logging.
+  void set_log(SessionLog* log) { log_ = log; }
   // JSON "scene" message: static description (robot geometry, mesh triangles, grips, scene
   // list, limits, history). Sent on connect and after a scene switch.
   std::string scene_message() const;
@@ -111,6 +120,8 @@ class Session {
   std::deque<HistorySample> history_;
   std::unique_ptr<SimulatedWorld> world_;
   double true_error_ = NAN;  // the world's, at the last tick (NaN without a world or targets)
+  SessionLog* log_ = nullptr;
+  std::uint64_t logged_sequence_ = 0;  // of the last snapshot written to log_
 };
 
 }  // namespace shapectl::server
