@@ -140,6 +140,24 @@ TEST_F(OnlineCalibrationTest, TheWindowKeepsDistinctPosesAndNothingStartsWithout
   EXPECT_EQ(calibration.status().runs, 0u);
 }
 
+// One marker from one pose is 3 numbers: no fit of 13 parameters starts from it (it would
+// "explain" the noise exactly and make the model worse elsewhere).
+TEST_F(OnlineCalibrationTest, TooFewObservedNumbersForTheParametersStartNothing) {
+  Controller controller(model);
+  OnlineCalibration calibration(controller, model, {.period = 0});
+  camera.marker_nodes = {targets.nodes[0]};
+  calibration.observe(look(model.robot->reference_joints));
+  std::string why;
+  EXPECT_FALSE(calibration.start(&why));
+  EXPECT_EQ(why,
+            "too few observations: 3 measured numbers for 13 parameters (at least 39: more "
+            "markers, or frames at other poses)");
+  for (int k = 0; k < 3; ++k) calibration.observe(look(model.robot->reference_joints));
+  calibration.poll(1);  // due, but refused: the status says why
+  EXPECT_FALSE(calibration.status().running);
+  EXPECT_EQ(calibration.status().error, why);
+}
+
 // Markers on gripped nodes only see where the grippers hold the bar, not how it bends: the
 // stiffness cannot be told from them, and such a fit is never handed to the controller.
 TEST_F(OnlineCalibrationTest, AFitOfNothingIdentifiableIsNotApplied) {

@@ -54,12 +54,26 @@ void OnlineCalibration::observe(const ObservationFrame& frame) {
 }
 
 bool OnlineCalibration::start(std::string* why) {
-  const auto refuse = [&](const char* reason) {
+  const auto refuse = [&](const std::string& reason) {
     if (why) *why = reason;
     return false;
   };
   if (worker_.joinable()) return refuse("a calibration is running");
   if (window_.empty()) return refuse("no observed frames yet");
+  // A fit needs more numbers than it has unknowns, by a margin: one marker seen from one pose
+  // (3 numbers) "fits" two grip offsets exactly, noise included, and the model gets worse.
+  std::size_t measured = 0;
+  for (const ObservationFrame& f : window_) measured += 3 * f.markers.size() + f.points.size();
+  std::size_t needed = 0;
+  try {
+    needed = 3 * static_cast<std::size_t>(ParameterSpace(model_, options_.fit).size());
+  } catch (const std::invalid_argument& e) {  // a parameter this scene does not have
+    return refuse(e.what());
+  }
+  if (measured < needed)
+    return refuse("too few observations: " + std::to_string(measured) + " measured numbers for " +
+                  std::to_string(needed / 3) + " parameters (at least " + std::to_string(needed) +
+                  ": more markers, or frames at other poses)");
   Observations observations{{window_.begin(), window_.end()}};
   frames_since_start_ = 0;
   done_ = false;
@@ -97,7 +111,15 @@ void OnlineCalibration::poll(double time) {
   if (worker_.joinable() && done_) finish();
   const bool due = options_.automatic && !worker_.joinable() &&
                    frames_since_start_ >= options_.new_frames && time - last_start_ >= period_;
-  if (due && start()) last_start_ = time;
+  if (!due) return;
+  std::string why;
+  if (start(&why)) {
+    last_start_ = time;
+  } else {  // say why nothing happens; try again once more frames have come
+    frames_since_start_ = 0;
+    std::lock_guard lock(mutex_);
+    status_.error = why;
+  }
 }
 
 bool OnlineCalibration::worth_applying(const CalibrationResult& result, std::string* why) {

@@ -67,7 +67,9 @@ class OnlineCalibration {
   // One checked frame (read_observation_frame) observed at `time` (s): its markers to the
   // controller's loop, the frame to the window.
   void observe(const ObservationFrame& frame);
-  // Calibrates the window now, in the background; false with the reason when it cannot.
+  // Calibrates the window now, in the background; false with the reason when it cannot: one
+  // is running, no frames, or fewer than 3 measured numbers (marker coordinates, points) per
+  // parameter to fit.
   bool start(std::string* why = nullptr);
   void set_automatic(bool on);
   // Blocks until a running calibration has finished (poll() then hands it over).
