@@ -14,14 +14,7 @@ namespace {
 using test::run_cli;
 using test::TempDir;
 
-const char* kBarScene = R"({
-  "object": {
-    "mesh": {"box": {"size": [0.32, 0.03, 0.03], "cells": [8, 2, 2]}},
-    "material": {"youngs_modulus": 2e5, "poisson_ratio": 0.3, "density": 40}
-  },
-  "gravity": [0, 0, -9.81],
-  "fixed": {"box": {"min": [-0.17, -1, -1], "max": [-0.15, 1, 1]}}
-})";
+const char* const kBarScene = test::kClampedBarScene;
 
 // A single tet (nodes 1..4) in MSH 2.2; `element` is the $Elements body line.
 std::string msh22(const std::string& element, const std::string& count = "1") {

@@ -13,15 +13,8 @@ namespace {
 using test::run_cli;
 using test::TempDir;
 
-// A clamped bar of 9 × 3 × 3 nodes; its surface is 2 × (8·2 + 8·2 + 2·2) quads, 2 triangles each.
-const char* kBarScene = R"({
-  "object": {
-    "mesh": {"box": {"size": [0.32, 0.03, 0.03], "cells": [8, 2, 2]}},
-    "material": {"youngs_modulus": 2e5, "poisson_ratio": 0.3, "density": 40}
-  },
-  "gravity": [0, 0, -9.81],
-  "fixed": {"box": {"min": [-0.17, -1, -1], "max": [-0.15, 1, 1]}}
-})";
+const char* const kBarScene =
+    test::kClampedBarScene;  // its surface: 2 × (8·2 + 8·2 + 2·2) quads, 2 triangles each
 constexpr std::size_t kBarNodes = 81, kBarTriangles = 144;
 
 struct Surface {

@@ -48,6 +48,17 @@ pid_t start_process(const std::vector<std::string>& command, const std::filesyst
 // Waits for the child `pid` to end: its exit code, or 128 + the signal that ended it.
 int wait_for_exit(pid_t pid);
 
+// A foam bar clamped at one end, 9 × 3 × 3 nodes (81; its surface 144 triangles): scene JSON
+// for tests that need a small robot-less scene file.
+inline constexpr const char* kClampedBarScene = R"({
+  "object": {
+    "mesh": {"box": {"size": [0.32, 0.03, 0.03], "cells": [8, 2, 2]}},
+    "material": {"youngs_modulus": 2e5, "poisson_ratio": 0.3, "density": 40}
+  },
+  "gravity": [0, 0, -9.81],
+  "fixed": {"box": {"min": [-0.17, -1, -1], "max": [-0.15, 1, 1]}}
+})";
+
 // Path of a file in the source tree, e.g. source_path("scenes/yumi_bar.json").
 std::filesystem::path source_path(const std::string& relative);
 
