@@ -34,8 +34,11 @@ describe('browser GUI', () => {
   });
 
   after(async () => {
-    await browser?.close();
-    await server?.stop();
+    try {
+      await browser?.close();  // fails on any console problem of the run
+    } finally {
+      await server?.stop();
+    }
   });
 
   it('loads with robot and object visible', async () => {

@@ -80,9 +80,12 @@ describe('the real object: plot and calibration (serve --world)', () => {
 
   after(async () => {
     ws?.close();
-    await browser?.close();
-    await server?.stop();
-    if (dir) rmSync(dir, { recursive: true, force: true });
+    try {
+      await browser?.close();  // fails on any console problem of the run
+    } finally {
+      await server?.stop();
+      if (dir) rmSync(dir, { recursive: true, force: true });
+    }
   });
 
   const reply = (id) => ws.next((m) => m.text?.includes(`"id":"${id}"`)).then((m) => JSON.parse(m.text));
@@ -175,8 +178,11 @@ describe('the real object: an observed point cloud (serve)', () => {
 
   after(async () => {
     ws?.close();
-    await browser?.close();
-    await server?.stop();
+    try {
+      await browser?.close();  // fails on any console problem of the run
+    } finally {
+      await server?.stop();
+    }
   });
 
   it('draws the points of the last observed frame over the model, and hides them with the checkbox', async () => {

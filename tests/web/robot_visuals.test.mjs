@@ -41,8 +41,11 @@ describe('robot visuals in the 3D view', () => {
     page = await openPage(browser, server.url);
   });
   after(async () => {
-    await browser?.close();
-    await server?.stop();
+    try {
+      await browser?.close();  // fails on any console problem of the run
+    } finally {
+      await server?.stop();
+    }
   });
 
   it('draws each visual in its URDF material colour', async () => {

@@ -49,7 +49,19 @@ export async function launchChromium() {
     executablePath: '/usr/bin/chromium', headless: true, args: chromiumFlags,
     viewport: { width: 1280, height: 800 },
   });
-  return { context, close: async () => { await context.close(); rmSync(userDataDir, { recursive: true, force: true }); } };
+  const browser = {
+    context,
+    pages: [],  // every page openPage opened: their problems are checked at close
+    // Closes the browser; fails when any page raised a console error or warning, or an
+    // exception, at any time during the run (not only where a test looked).
+    close: async () => {
+      await context.close();
+      rmSync(userDataDir, { recursive: true, force: true });
+      const problems = browser.pages.flatMap((p) => p.problems);
+      if (problems.length) throw new Error(`the page raised ${problems.length} console problem(s): ${JSON.stringify(problems.slice(0, 10))}`);
+    },
+  };
+  return browser;
 }
 
 // Headless Chromium's software compositor reads every WebGL canvas back and says so as a
@@ -61,6 +73,7 @@ const COMPOSITOR_READBACK = /^\[\.WebGL-0x[0-9a-f]+\]GL Driver Message \(OpenGL,
 export async function openPage(browser, url) {
   const page = await browser.context.newPage();
   page.problems = [];
+  browser.pages.push(page);
   page.on('pageerror', (e) => page.problems.push(`exception: ${e.message}`));
   page.on('console', (m) => {
     if ((m.type() === 'error' || m.type() === 'warning') && !COMPOSITOR_READBACK.test(m.text()))
@@ -96,6 +109,50 @@ export async function differingFraction(page, pngA, pngB) {
       if (Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]) > 30) differing++;
     return differing / (p.length / 4);
   }, [pngA.toString('base64'), pngB.toString('base64')]);
+}
+
+// Which of `points` (page coordinates) have a pixel of `rgb` ([r, g, b], within `tolerance` per
+// channel summed) within `radius` pixels in the PNG screenshot `png` of the whole page: an array
+// of booleans, one per point. Decoded by `page` itself.
+export async function colourNear(page, png, points, rgb, { radius = 3, tolerance = 60 } = {}) {
+  return page.evaluate(async ([base64, points, rgb, radius, tolerance]) => {
+    const image = new Image();
+    image.src = `data:image/png;base64,${base64}`;
+    await image.decode();
+    const c = document.createElement('canvas');
+    c.width = image.width; c.height = image.height;
+    const g = c.getContext('2d');
+    g.drawImage(image, 0, 0);
+    const data = g.getImageData(0, 0, c.width, c.height).data;
+    const scale = image.width / window.innerWidth;  // device pixels per page pixel
+    return points.map(({ x, y }) => {
+      for (let dy = -radius; dy <= radius; dy++) {
+        for (let dx = -radius; dx <= radius; dx++) {
+          const px = Math.round(x * scale) + dx, py = Math.round(y * scale) + dy;
+          if (px < 0 || py < 0 || px >= c.width || py >= c.height) continue;
+          const i = 4 * (py * c.width + px);
+          if (Math.abs(data[i] - rgb[0]) + Math.abs(data[i + 1] - rgb[1]) + Math.abs(data[i + 2] - rgb[2]) <= tolerance) return true;
+        }
+      }
+      return false;
+    });
+  }, [png.toString('base64'), points, rgb, radius, tolerance]);
+}
+
+// The [r, g, b] of the PNG screenshot `png` of the whole page at each of `points` (page
+// coordinates).
+export async function pixelsAt(page, png, points) {
+  return page.evaluate(async ([base64, points]) => {
+    const image = new Image();
+    image.src = `data:image/png;base64,${base64}`;
+    await image.decode();
+    const c = document.createElement('canvas');
+    c.width = image.width; c.height = image.height;
+    const g = c.getContext('2d');
+    g.drawImage(image, 0, 0);
+    const scale = image.width / window.innerWidth;
+    return points.map(({ x, y }) => Array.from(g.getImageData(Math.round(x * scale), Math.round(y * scale), 1, 1).data.slice(0, 3)));
+  }, [png.toString('base64'), points]);
 }
 
 // Polls `probe` (sync or async) until it returns a truthy value; fails after `timeoutMs`.

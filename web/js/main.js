@@ -4,6 +4,7 @@ import { Connection } from './connection.js';
 import { View3D } from './view3d.js';
 import { ConvergencePlot } from './plot.js';
 import { CalibrationPanel } from './calibration_panel.js';
+import { TargetEditor } from './target_editing.js';
 import { Command, ControllerStatus } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
@@ -28,8 +29,13 @@ const view = new View3D($('view'), {
   addTarget: (node, position) => command(Command.SetTarget, { node, position }),
   moveTarget: (node, position) => command(Command.SetTarget, { node, position }),
   sketch: (points) => command(Command.SetCenterline, { points }).then(() => setSketchMode(false)),
-  select: (node) => { $('delete').disabled = node === null; },
+  select: (node) => { $('delete').disabled = node === null; if (page.state) editor.update(page.state); },
+  beginEdit: () => editor.beginEdit(),
 });
+const editor = new TargetEditor({
+  x: $('target-x'), y: $('target-y'), z: $('target-z'), node: $('target-node'), undo: $('undo'), redo: $('redo'),
+  saveTargets: $('save-targets'), saveJoints: $('save-joints'), load: $('load-file'),
+}, { command, state: () => page.state, scene: () => page.scene, view, notify: (text) => toast(text) });
 const plot = new ConvergencePlot($('plot'), $('plot-legend'));
 const calibration = new CalibrationPanel({
   button: $('calibrate'), auto: $('auto-calibration'), status: $('calibration-status'), model: $('model'),
@@ -75,6 +81,7 @@ function onScene(scene) {
   page.scene = scene;
   page.state = null;
   view.setScene(scene);
+  editor.reset();
   plot.reset(scene.history);
   const select = $('scene-select');
   select.replaceChildren(...scene.scenes.map((name) => new Option(name, name, false, name === scene.scene)));
@@ -118,6 +125,7 @@ function onState(state) {
   page.stats.stateTimes.push(performance.now());
   if (page.stats.stateTimes.length > 200) page.stats.stateTimes.shift();
   view.setState(state);
+  editor.update(state);
   plot.add(state.time, plotValues(state), state.editing);
   drawPlot();
 
@@ -195,13 +203,14 @@ function setSketchMode(on) {
 
 function deleteSelected() {
   if (view.selected === null) return;
+  editor.beginEdit();
   command(Command.RemoveTarget, { node: view.selected });
   view.select(null);
 }
 
 $('pause').onclick = () => command(Command.SetPaused, { paused: !page.state?.paused });
 $('reset').onclick = () => command(Command.Reset);
-$('clear').onclick = () => { command(Command.ClearTargets); view.select(null); };
+$('clear').onclick = () => { editor.beginEdit(); command(Command.ClearTargets); view.select(null); };
 $('delete').onclick = deleteSelected;
 $('sketch').onclick = () => setSketchMode(!view.sketchMode);
 $('face-bar').onclick = () => { if (page.scene?.bar) view.faceBar(page.scene.bar.direction); };
@@ -215,9 +224,12 @@ $('arm').onclick = () => command(Command.Arm);
 $('disarm').onclick = () => command(Command.Disarm);
 window.addEventListener('keydown', (e) => {
   if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
+  if (e.ctrlKey || e.metaKey || e.altKey) return;  // Ctrl+Z and the like: target_editing.js
   if (e.key === 'Delete' || e.key === 'Backspace') deleteSelected();
   else if (e.key === 'c') setSketchMode(!view.sketchMode);
   else if (e.key === 'Escape') setSketchMode(false);
+  else if (e.key === 'f') view.fitView();
+  else if (e.key === 't') view.setRobotSeeThrough(!view.robotSeeThrough);
   else if (e.key === ' ') { e.preventDefault(); $('pause').click(); }
 });
 
@@ -230,6 +242,11 @@ window.shapectl = {
   // demand, so an idle scene may never draw a third frame).
   get ready() { return !!(page.scene && page.state && view.positions && view.frames > 0 && !view.renderPending); },
   get arrowCount() { return view.arrowCount; },
+  get handleCount() { return view.objectView.handleCount; },
+  // Page coordinates of the gizmo's centre and of its x, y, z arrows' tips; null without a gizmo.
+  gizmo: () => view.gizmoOnPage(),
+  // The object's node positions on the page and the view's box: is it all in view?
+  objectOnPage: () => view.objectOnPage(),
   get frames() { return view.frames; },
   get observedPointsDrawn() { return view.observedPointsDrawn; },
   get selected() { return view.selected; },
@@ -237,9 +254,13 @@ window.shapectl = {
   positions: () => Array.from(view.positions ?? []),
   worldToPage: (point) => view.worldToPage(point),
   nodeToPage: (node) => view.worldToPage(view.nodePosition(node).toArray()),
-  setLayers: ({ robot = true, object = true } = {}) => { view.setRobotVisible(robot); view.setObjectVisible(object); view.render(); },
+  setLayers: ({ robot = true, object = true, targets = true } = {}) => {
+    view.setRobotVisible(robot); view.setObjectVisible(object); view.setTargetsVisible(targets); view.render();
+  },
   objectCentroid: () => view.objectCentroid().toArray(),
   cameraDirection: () => view.cameraDirection(),
+  cameraPosition: () => view.camera.position.toArray(),
+  get renderPending() { return view.renderPending; },
   observedPoints: () => view.observedPoints(),
   robotColors: () => view.robotView.visualColors(),
   ghost: () => ({ visible: view.ghostView.visible, links: view.ghostView.robotView.linkPoses(),

@@ -5,50 +5,24 @@
 // observed point cloud (small magenta points). World frame, metres. Targets being dragged are
 // shown where the hand is, ahead of the server.
 import * as THREE from 'three';
+import { ScreenLine } from './screen_line.js';
+import { TargetGlyphs, TARGET_ORANGE } from './target_glyphs.js';
 
-const ORANGE = 0xff8c1a;
-const HANDLE_GEOMETRY = new THREE.SphereGeometry(0.006, 16, 12);  // radius in m
-const HANDLE_MATERIAL = new THREE.MeshBasicMaterial({ color: ORANGE });
-const SELECTED_MATERIAL = new THREE.MeshBasicMaterial({ color: 0xffffff });
 const MIN_ARROW_LENGTH = 1e-4;  // m; a target this close to its node shows only its handle
+const LINE_PIXELS = 4;          // centre-line width on screen
+const GRIP_PIXELS = 7;          // gripped-node marker size on screen
 
 // Scratch vectors, reused by every target drawing and pick.
 const _from = new THREE.Vector3();
-const _delta = new THREE.Vector3();
 const _target = new THREE.Vector3();
 const _vertex = new THREE.Vector3();
-
-// Centre-lines lie inside the bar: drawn over it, or the user would not see them.
-function makeLine(color) {
-  const material = new THREE.LineBasicMaterial({ color, depthTest: false });
-  const line = new THREE.Line(new THREE.BufferGeometry(), material);
-  line.frustumCulled = false;
-  line.renderOrder = 10;
-  return line;
-}
-
-// The position attribute of `line` with room for `count` points and only those drawn. A new
-// geometry only when it grows: three.js cannot resize an attribute in place.
-function linePositions(line, count) {
-  let attribute = line.geometry.getAttribute('position');
-  if (!attribute || attribute.count < count) {
-    line.geometry.dispose();
-    line.geometry = new THREE.BufferGeometry();
-    attribute = new THREE.BufferAttribute(new Float32Array(3 * Math.max(64, 2 * count)), 3);
-    attribute.setUsage(THREE.DynamicDrawUsage);
-    line.geometry.setAttribute('position', attribute);
-  }
-  line.geometry.setDrawRange(0, count);
-  attribute.needsUpdate = true;
-  return attribute;
-}
 
 export class ObjectView {
   constructor() {
     this.group = new THREE.Group();
     this.surfaceGroup = new THREE.Group();  // rebuilt for every scene
-    this.targetsGroup = new THREE.Group();  // arrows and handles, reused across states and scenes
-    this.group.add(this.surfaceGroup, this.targetsGroup);
+    this.glyphs = new TargetGlyphs();       // arrows and handles, reused across states and scenes
+    this.group.add(this.surfaceGroup, this.glyphs.group);
 
     this.positions = null;  // node positions (Float32Array, 3 per node) once a frame arrived
     this.positionAttribute = null;
@@ -59,7 +33,10 @@ export class ObjectView {
     this.gripNodes = [];
     this.gripAttribute = null;
     this.gripPoints = null;
-    this.centerline = makeLine(ORANGE);
+    // Centre-lines lie inside the bar: drawn over it, or the user would not see them.
+    this.centerline = new ScreenLine(TARGET_ORANGE, LINE_PIXELS, 10);
+    this.sketchLine = new ScreenLine(0xffe08a, LINE_PIXELS, 11);
+    this.group.add(this.centerline.object, this.sketchLine.object);
     // Observed markers: one Points object, its buffer regrown only when more markers arrive.
     this.observedGeometry = new THREE.BufferGeometry();
     this.observed = new THREE.Points(this.observedGeometry,
@@ -77,16 +54,11 @@ export class ObjectView {
     this.cloudCount = 0;       // points in the last cloud
     this.cloudEnabled = true;  // the page's checkbox
     this.group.add(this.cloud);
-    this.sketchLine = makeLine(0xffe08a);
 
     this.targets = [];             // the last state's [{node, position}]
     this.showHandles = true;       // no handles while a centre-line is the handle
     this.localTargets = new Map(); // node → Vector3 of targets being dragged
     this.selected = null;          // node whose handle is highlighted
-    this.arrows = [];              // pool of ArrowHelpers; the first arrowCount are shown
-    this.handles = [];             // pool of handle meshes; the first handleCount are shown
-    this.arrowCount = 0;
-    this.handleCount = 0;
   }
 
   // Rebuilds the surface from a scene message; targets and positions start empty.
@@ -115,9 +87,10 @@ export class ObjectView {
     const gripGeometry = new THREE.BufferGeometry();
     this.gripAttribute = new THREE.BufferAttribute(new Float32Array(3 * this.gripNodes.length), 3);
     gripGeometry.setAttribute('position', this.gripAttribute);
-    this.gripPoints = new THREE.Points(gripGeometry, new THREE.PointsMaterial({ color: 0xff2222, size: 6, sizeAttenuation: false }));
+    this.gripPoints = new THREE.Points(gripGeometry, new THREE.PointsMaterial({ color: 0xff2222, size: GRIP_PIXELS, sizeAttenuation: false, depthTest: false }));
     this.gripPoints.frustumCulled = false;
-    this.surfaceGroup.add(this.surfaceMesh, this.wireframe, this.gripPoints, this.centerline, this.sketchLine);
+    this.gripPoints.renderOrder = 3;  // over the grippers that hold them
+    this.surfaceGroup.add(this.surfaceMesh, this.wireframe, this.gripPoints);
 
     this.setCenterline([]);
     this.setSketch([]);
@@ -141,16 +114,23 @@ export class ObjectView {
 
   // `points`: a state's "centerline", [x, y, z] each.
   setCenterline(points) {
-    const attribute = linePositions(this.centerline, points.length);
-    points.forEach((p, k) => attribute.setXYZ(k, p[0], p[1], p[2]));
-    this.centerline.visible = points.length > 1;
+    this.centerline.setPoints(points);
   }
 
   // `points`: the Vector3s of the stroke being sketched (none: hidden).
   setSketch(points) {
-    const attribute = linePositions(this.sketchLine, points.length);
-    points.forEach((p, k) => attribute.setXYZ(k, p.x, p.y, p.z));
+    this.sketchLine.setPoints(points);
   }
+
+  // Sizes what is drawn in screen pixels for `camera` in a `width` × `height` pixel view.
+  fitToScreen(camera, width, height) {
+    this.glyphs.fitToScreen(camera, height);
+    this.centerline.setResolution(width, height);
+    this.sketchLine.setResolution(width, height);
+  }
+
+  get arrowCount() { return this.glyphs.arrowCount; }
+  get handleCount() { return this.glyphs.handleCount; }
 
   // `targets`: a state's "targets"; `showHandles` false when a centre-line stands for them.
   setTargets(targets, showHandles) {
@@ -238,8 +218,7 @@ export class ObjectView {
 
   // The shown handle nearest along `raycaster`: {node, target, point} or null.
   pickHandle(raycaster) {
-    const hit = raycaster.intersectObjects(this.handles.slice(0, this.handleCount), false)[0];
-    return hit ? { node: hit.object.userData.node, target: hit.object.position.clone(), point: hit.point } : null;
+    return this.glyphs.pick(raycaster);
   }
 
   // The surface node under `raycaster` (the nearest vertex of the hit triangle): {node, point} or null.
@@ -256,51 +235,18 @@ export class ObjectView {
 
   // Poses the pooled arrows and handles for the current targets and hides the rest.
   drawTargets() {
-    this.arrowCount = 0;
-    this.handleCount = 0;
+    this.glyphs.begin();
     if (this.positions) {
       for (const t of this.targets)
         if (!this.localTargets.has(t.node)) this.drawTarget(t.node, _target.fromArray(t.position));
       for (const [node, position] of this.localTargets) this.drawTarget(node, position);
     }
-    for (let k = this.arrowCount; k < this.arrows.length; k++) this.arrows[k].visible = false;
-    for (let k = this.handleCount; k < this.handles.length; k++) this.handles[k].visible = false;
+    this.glyphs.end();
   }
 
   drawTarget(node, target) {
     this.nodePosition(node, _from);
-    const length = _delta.subVectors(target, _from).length();
-    if (length > MIN_ARROW_LENGTH) {
-      const arrow = this.nextArrow();
-      const head = Math.min(0.02, 0.4 * length);
-      arrow.position.copy(_from);
-      arrow.setDirection(_delta.divideScalar(length));
-      arrow.setLength(length, head, 0.5 * head);
-    }
-    if (!this.showHandles) return;
-    const handle = this.nextHandle();
-    handle.position.copy(target);
-    handle.material = node === this.selected ? SELECTED_MATERIAL : HANDLE_MATERIAL;
-    handle.userData.node = node;
-  }
-
-  // The next pooled arrow (handle), created the first time that many are needed.
-  nextArrow() {
-    if (this.arrowCount === this.arrows.length) this.addToPool(this.arrows, new THREE.ArrowHelper(undefined, undefined, 1, ORANGE));
-    const arrow = this.arrows[this.arrowCount++];
-    arrow.visible = true;
-    return arrow;
-  }
-
-  nextHandle() {
-    if (this.handleCount === this.handles.length) this.addToPool(this.handles, new THREE.Mesh(HANDLE_GEOMETRY, HANDLE_MATERIAL));
-    const handle = this.handles[this.handleCount++];
-    handle.visible = true;
-    return handle;
-  }
-
-  addToPool(pool, object) {
-    pool.push(object);
-    this.targetsGroup.add(object);
+    if (_from.distanceTo(target) > MIN_ARROW_LENGTH) this.glyphs.addArrow(_from, target);
+    if (this.showHandles) this.glyphs.addHandle(node, target, node === this.selected);
   }
 }

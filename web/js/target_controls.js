@@ -1,7 +1,8 @@
 // Mouse interaction with the object, in the style of three.js' DragControls: a left press on
 // a target handle or on the surface drags that node's target in the plane facing the camera;
 // in sketch mode a left drag draws a centre-line in the plane through the object facing the
-// camera. It changes nothing itself: it dispatches events and its owner acts on them.
+// camera. Holding x, y or z while dragging moves the target along that world axis only. A press
+// off the handles that `yieldsTo(event)` claims (the gizmo's) is left alone. It changes nothing itself: it dispatches events and its owner acts on them.
 //   dragstart {node, position, added}  added: the node had no target, position is where it starts
 //   drag      {node, position}         position: scratch vector, copy it to keep it
 //   dragend   {node, position, moved}
@@ -11,6 +12,8 @@ import { Controls, Plane, Raycaster, Vector2, Vector3 } from 'three';
 
 const SKETCH_SPACING = 0.002;  // m; closer pointer samples are dropped
 const SKETCH_POINTS = 64;      // points in a finished sketch
+const AXES = { x: new Vector3(1, 0, 0), y: new Vector3(0, 1, 0), z: new Vector3(0, 0, 1) };
+const AXIS_REACH = 10;         // m; the axis line is a segment this far each way
 
 export class TargetControls extends Controls {
   constructor(camera, objectView, domElement = null) {
@@ -20,6 +23,8 @@ export class TargetControls extends Controls {
     this.dragNode = null;      // node whose target is being dragged
     this.moved = false;        // the dragged target moved since the press
     this.sketchPoints = null;  // Vector3s of the stroke while sketching
+    this.axis = null;          // 'x', 'y' or 'z' while that key is held: drags follow that axis
+    this.yieldsTo = () => false;  // (pointerdown event) → true when another control takes it
     this.raycaster = new Raycaster();
     // Scratch objects, reused by every pointer event.
     this._pointer = new Vector2();
@@ -27,6 +32,12 @@ export class TargetControls extends Controls {
     this._offset = new Vector3();  // dragged target minus the grabbed point
     this._point = new Vector3();
     this._target = new Vector3();  // where the dragged target is
+    this._dragAxis = null;         // the axis the drag follows now (null: the view plane)
+    this._anchor = new Vector3();  // axis drags: the target when the axis was taken
+    this._anchorParameter = 0;     // axis drags: the pointer's place along the axis then
+    this._segment = [new Vector3(), new Vector3(), new Vector3()];  // axis ends, nearest point
+    this._onAxisKey = this.onAxisKey.bind(this);
+    this._onBlur = () => { this.axis = null; };
     this._onPointerDown = this.onPointerDown.bind(this);
     this._onPointerMove = this.onPointerMove.bind(this);
     this._onPointerUp = this.onPointerUp.bind(this);
@@ -40,6 +51,9 @@ export class TargetControls extends Controls {
     element.addEventListener('pointermove', this._onPointerMove);
     element.addEventListener('pointerup', this._onPointerUp);
     element.addEventListener('pointercancel', this._onPointerUp);
+    window.addEventListener('keydown', this._onAxisKey);
+    window.addEventListener('keyup', this._onAxisKey);
+    window.addEventListener('blur', this._onBlur);
   }
 
   disconnect() {
@@ -47,6 +61,18 @@ export class TargetControls extends Controls {
     this.domElement.removeEventListener('pointermove', this._onPointerMove);
     this.domElement.removeEventListener('pointerup', this._onPointerUp);
     this.domElement.removeEventListener('pointercancel', this._onPointerUp);
+    window.removeEventListener('keydown', this._onAxisKey);
+    window.removeEventListener('keyup', this._onAxisKey);
+    window.removeEventListener('blur', this._onBlur);
+  }
+
+  // x, y, z held (not while typing in a field) constrain drags to that axis.
+  onAxisKey(event) {
+    const key = event.key.toLowerCase();
+    if (!(key in AXES) || event.ctrlKey || event.metaKey || event.altKey) return;
+    if (event.type === 'keyup') { if (this.axis === key) this.axis = null; return; }
+    const typing = event.target instanceof HTMLInputElement || event.target instanceof HTMLTextAreaElement || event.target instanceof HTMLSelectElement;
+    if (!typing) this.axis = key;
   }
 
   dispose() {
@@ -77,6 +103,7 @@ export class TargetControls extends Controls {
       this.startDrag(handle.node, handle.target, handle.point, false, event);
       return;
     }
+    if (this.yieldsTo(event)) return;  // the gizmo's arrows reach over the surface, not over handles
     const picked = this.objectView.pickNode(this.raycaster);
     if (!picked) return;
     const existing = this.objectView.targetPosition(picked.node, this._target);
@@ -93,8 +120,13 @@ export class TargetControls extends Controls {
     }
     if (this.dragNode === null) return;
     this.updateRay(event);
-    if (!this.raycaster.ray.intersectPlane(this._plane, this._point)) return;
-    this._target.addVectors(this._point, this._offset);
+    if (this.axis !== this._dragAxis) this.rebase();
+    if (this._dragAxis) {
+      this._target.copy(this._anchor).addScaledVector(AXES[this._dragAxis], this.axisParameter() - this._anchorParameter);
+    } else {
+      if (!this.raycaster.ray.intersectPlane(this._plane, this._point)) return;
+      this._target.addVectors(this._point, this._offset);
+    }
     this.moved = true;
     this.dispatchEvent({ type: 'drag', node: this.dragNode, position: this._target });
   }
@@ -119,6 +151,8 @@ export class TargetControls extends Controls {
     this.setViewPlane(grabPoint);
     this.dragNode = node;
     this.moved = false;
+    this._dragAxis = null;
+    if (this.axis) this.rebase();
     this.beginGesture(event);
     this.dispatchEvent({ type: 'dragstart', node, position: this._target, added });
   }
@@ -127,6 +161,30 @@ export class TargetControls extends Controls {
     this.domElement.setPointerCapture(event.pointerId);
     event.stopPropagation();
     event.preventDefault();
+  }
+
+  // The drag switches between the view plane and an axis: it goes on from where the target is.
+  rebase() {
+    this._dragAxis = this.axis;
+    if (this._dragAxis) {
+      this._anchor.copy(this._target);
+      this._anchorParameter = this.axisParameter();
+      return;
+    }
+    this.setViewPlane(this._target);
+    if (this.raycaster.ray.intersectPlane(this._plane, this._point)) this._offset.subVectors(this._target, this._point);
+    else this._offset.set(0, 0, 0);
+  }
+
+  // Where the pointer's ray passes nearest the drag axis through the anchor, as a coordinate
+  // along that axis (m from the anchor).
+  axisParameter() {
+    const axis = AXES[this._dragAxis];
+    const [a, b, onAxis] = this._segment;
+    a.copy(this._anchor).addScaledVector(axis, -AXIS_REACH);
+    b.copy(this._anchor).addScaledVector(axis, AXIS_REACH);
+    this.raycaster.ray.distanceSqToSegment(a, b, null, onAxis);
+    return onAxis.sub(this._anchor).dot(axis);
   }
 
   updateRay(event) {

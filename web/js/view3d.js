@@ -7,16 +7,36 @@ import { ObjectView } from './object_view.js';
 import { RobotView } from './robot_view.js';
 import { GhostView } from './ghost_view.js';
 import { TargetControls } from './target_controls.js';
+import { TargetGizmo } from './target_gizmo.js';
+import { fitCamera } from './fit_view.js';
 
 const MOVE_INTERVAL_MS = 33;       // ~30 target edits per second while dragging
 const LOCAL_TARGET_HOLD_MS = 300;  // a dropped target shows where it was left until the server has it
-const FRONT_VIEW = new THREE.Vector3(0.95, -0.5, 0.45);  // camera offset from the object, m
+const FRONT_VIEW = new THREE.Vector3(0.95, -0.5, 0.45);  // fit-view: from the scene towards the camera
 const UP = new THREE.Vector3(0, 0, 1);
+
+const SEE_THROUGH_OPACITY = 0.3;
+
+// Fades a robot material to SEE_THROUGH_OPACITY (on) or back to what it was.
+function seeThrough(material, on) {
+  if (!material || !!material.userData.solid === on) return;
+  if (on) {
+    const { opacity, transparent, depthWrite } = material;
+    material.userData.solid = { opacity, transparent, depthWrite };
+    Object.assign(material, { opacity: Math.min(opacity, SEE_THROUGH_OPACITY), transparent: true, depthWrite: false });
+  } else {
+    Object.assign(material, material.userData.solid);
+    delete material.userData.solid;
+  }
+  material.needsUpdate = true;
+}
 
 export class View3D {
   constructor(container, callbacks) {
     this.container = container;
-    this.callbacks = callbacks;  // addTarget(node, position), moveTarget(node, position), sketch(points), select(node)
+    // addTarget(node, position), moveTarget(node, position), sketch(points), select(node), and
+    // beginEdit() before a gesture changes the targets (for undo)
+    this.callbacks = callbacks;
     this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
     this.renderer.setPixelRatio(window.devicePixelRatio);
     container.appendChild(this.renderer.domElement);
@@ -43,12 +63,16 @@ export class View3D {
     this.objectView = new ObjectView();
     this.scene.add(this.robotView.group, this.ghostView.group, this.objectView.group);
     this.targetControls = new TargetControls(this.camera, this.objectView, this.renderer.domElement);
+    this.gizmo = new TargetGizmo(this.camera, this.renderer.domElement, this.scene);
+    this.targetControls.yieldsTo = (event) => this.gizmo.hits(event);
 
+    this.robotSeeThrough = false;  // the t key
     this.state = null;             // the last state message shown
     this.frames = 0;               // frames rendered (tests wait for a few)
     this.renderPending = false;
     this.moveSentAt = -Infinity;   // performance.now() of the last moveTarget while dragging
     this.scratch = new THREE.Vector3();
+    this.viewSize = new THREE.Vector2();
 
     this.wireTargetControls();
     // Render on demand only: software WebGL (headless, remote desktops) can't afford 60 fps.
@@ -59,30 +83,13 @@ export class View3D {
 
   wireTargetControls() {
     const controls = this.targetControls;
-    controls.addEventListener('dragstart', ({ node, position, added }) => {
-      this.orbit.enabled = false;
-      if (added) this.callbacks.addTarget(node, position.toArray());
-      this.moveSentAt = -Infinity;
-      this.objectView.setLocalTarget(node, position);
-      this.select(node);
-    });
-    controls.addEventListener('drag', ({ node, position }) => {
-      this.objectView.setLocalTarget(node, position);
-      this.requestRender();
-      const now = performance.now();
-      if (now - this.moveSentAt < MOVE_INTERVAL_MS) return;
-      this.moveSentAt = now;
-      this.callbacks.moveTarget(node, position.toArray());
-    });
-    controls.addEventListener('dragend', ({ node, position, moved }) => {
-      this.orbit.enabled = true;
-      if (moved) this.callbacks.moveTarget(node, position.toArray());
-      setTimeout(() => {
-        if (controls.dragging) return;
-        this.objectView.dropLocalTarget(node);
-        this.requestRender();
-      }, LOCAL_TARGET_HOLD_MS);
-    });
+    controls.addEventListener('dragstart', ({ node, position, added }) => this.startTargetDrag(node, position, added));
+    controls.addEventListener('drag', ({ node, position }) => this.dragTarget(node, position));
+    controls.addEventListener('dragend', ({ node, position, moved }) => this.endTargetDrag(node, position, moved));
+    this.gizmo.addEventListener('dragstart', ({ node, position }) => this.startTargetDrag(node, position, false));
+    this.gizmo.addEventListener('drag', ({ node, position }) => this.dragTarget(node, position));
+    this.gizmo.addEventListener('dragend', ({ node, position }) => this.endTargetDrag(node, position, true));
+    this.gizmo.addChangeListener(() => this.requestRender());
     controls.addEventListener('sketchstart', () => { this.orbit.enabled = false; });
     controls.addEventListener('sketch', ({ points }) => {
       this.objectView.setSketch(points);
@@ -92,8 +99,40 @@ export class View3D {
       this.orbit.enabled = true;
       this.objectView.setSketch([]);
       this.requestRender();
-      if (points.length >= 2) this.callbacks.sketch(points.map((p) => p.toArray()));
+      if (points.length < 2) return;
+      this.callbacks.beginEdit();
+      this.callbacks.sketch(points.map((p) => p.toArray()));
     });
+  }
+
+  // A target drag (by handle, surface or gizmo): shown locally at once, sent ~30 times a second.
+  startTargetDrag(node, position, added) {
+    this.orbit.enabled = false;
+    this.callbacks.beginEdit();
+    if (added) this.callbacks.addTarget(node, position.toArray());
+    this.moveSentAt = -Infinity;
+    this.objectView.setLocalTarget(node, position);
+    this.select(node);
+  }
+
+  dragTarget(node, position) {
+    this.objectView.setLocalTarget(node, position);
+    if (!this.gizmo.dragging) this.gizmo.attach(node, position);
+    this.requestRender();
+    const now = performance.now();
+    if (now - this.moveSentAt < MOVE_INTERVAL_MS) return;
+    this.moveSentAt = now;
+    this.callbacks.moveTarget(node, position.toArray());
+  }
+
+  endTargetDrag(node, position, moved) {
+    this.orbit.enabled = true;
+    if (moved) this.callbacks.moveTarget(node, position.toArray());
+    setTimeout(() => {
+      if (this.targetControls.dragging || this.gizmo.dragging) return;
+      this.objectView.dropLocalTarget(node);
+      this.requestRender();
+    }, LOCAL_TARGET_HOLD_MS);
   }
 
   requestRender() {
@@ -111,6 +150,8 @@ export class View3D {
   }
 
   render() {
+    const size = this.renderer.getSize(this.viewSize);
+    this.objectView.fitToScreen(this.camera, size.x, size.y);
     this.renderer.render(this.scene, this.camera);
     this.frames++;
   }
@@ -118,8 +159,10 @@ export class View3D {
   // ---- scene description and streamed state ----
   setScene(description) {
     this.targetControls.cancel();
+    this.gizmo.attach(null);
     this.orbit.enabled = true;
     this.robotView.setRobot(description.robot);
+    if (this.robotSeeThrough) this.setRobotSeeThrough(true);
     this.ghostView.setRobot(description.robot);
     this.objectView.setScene(description);
     this.state = null;
@@ -129,7 +172,7 @@ export class View3D {
   setPositions(positions) {
     const first = !this.objectView.positions;
     this.objectView.setPositions(positions);
-    if (first) this.frameObject();
+    if (first) this.fitView();
     this.requestRender();
   }
 
@@ -144,14 +187,25 @@ export class View3D {
     this.objectView.setTargets(state.targets, state.centerline.length === 0);  // the curve is the handle there
     this.objectView.setObservedMarkers(state.observed_markers);
     this.objectView.setObservedPoints(state.observed_points);
+    this.placeGizmo();
     this.requestRender();
   }
 
-  // Looks at the object from the front (+x, where the robot faces), a little from the side and above.
-  frameObject() {
-    this.objectView.centroid(this.orbit.target);
-    this.camera.position.copy(this.orbit.target).add(FRONT_VIEW);
-    this.orbit.update();
+  // The gizmo on the selected target, where it is drawn; off without one.
+  placeGizmo() {
+    const node = this.objectView.selected;
+    const at = node === null || !this.objectView.showHandles ? null : this.objectView.targetPosition(node, this.scratch);
+    this.gizmo.attach(at ? node : null, at);
+  }
+
+  // Frames the robot and the object from the front (+x, where the robot faces), a little from
+  // the side and above, all of both in view (on load, on a scene switch, and the f key).
+  fitView() {
+    if (!this.objectView.positions) return;
+    const box = new THREE.Box3().setFromBufferAttribute(this.objectView.positionAttribute);
+    box.union(new THREE.Box3().setFromObject(this.robotView.group));
+    fitCamera(this.camera, this.orbit, box, FRONT_VIEW);
+    this.requestRender();
   }
 
   // Looks at a bar square on from the robot's front, so the sketch plane contains its axis.
@@ -177,6 +231,7 @@ export class View3D {
 
   select(node) {
     this.objectView.setSelected(node);
+    this.placeGizmo();
     this.callbacks.select(node);
     this.requestRender();
   }
@@ -188,6 +243,14 @@ export class View3D {
 
   setWireframe(on) { this.objectView.setWireframe(on); this.requestRender(); }
   setSpheresVisible(on) { this.robotView.setSpheresVisible(on); this.requestRender(); }
+  // A see-through robot: targets behind the arms show through them.
+  setRobotSeeThrough(on) {
+    this.robotSeeThrough = on;
+    this.robotView.group.traverse((o) => seeThrough(o.material, on));
+    this.requestRender();
+  }
+  // Handles, arrows and the gizmo (tests compare the view with and without them).
+  setTargetsVisible(on) { this.objectView.glyphs.group.visible = on; this.gizmo.setVisible(on); this.requestRender(); }
   setRobotVisible(on) { this.robotView.setVisible(on); this.requestRender(); }
   setObjectVisible(on) { this.objectView.setVisible(on); this.requestRender(); }
   setObservedPointsVisible(on) { this.objectView.setObservedPointsVisible(on); this.requestRender(); }
@@ -199,6 +262,23 @@ export class View3D {
   observedPoints() {
     const geometry = this.objectView.cloud.geometry, attribute = geometry.getAttribute('position');
     return Array.from({ length: attribute ? geometry.drawRange.count : 0 }, (_, k) => [attribute.getX(k), attribute.getY(k), attribute.getZ(k)]);
+  }
+
+  // The selected target's gizmo on the page: its centre and its x, y, z arrows' tips.
+  gizmoOnPage() {
+    if (this.gizmo.node === null) return null;
+    const centre = this.gizmo.standIn.position.toArray();
+    const reach = this.gizmo.arrowLength();
+    const tip = (i) => this.worldToPage(centre.map((v, k) => v + (k === i ? reach : 0)));
+    return { node: this.gizmo.node, centre: this.worldToPage(centre), x: tip(0), y: tip(1), z: tip(2) };
+  }
+
+  // Every node of the object on the page, and the canvas's box: whether it is all in view.
+  objectOnPage() {
+    const x = this.objectView.positions, nodes = [];
+    for (let i = 0; i < x.length; i += 3) nodes.push(this.worldToPage([x[i], x[i + 1], x[i + 2]]));
+    const r = this.renderer.domElement.getBoundingClientRect();
+    return { nodes, view: { left: r.left, top: r.top, right: r.right, bottom: r.bottom } };
   }
 
   // Page coordinates of a world point.
