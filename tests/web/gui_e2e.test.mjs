@@ -3,7 +3,7 @@
 // report state and project world points to the screen; every action goes through the UI.
 import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { startServer, launchChromium, waitFor, differingFraction, openPage } from './support.mjs';
+import { startServer, launchChromium, waitFor, differingFraction, openPage, closeAll } from './support.mjs';
 
 const hooks = (page, f, arg) => page.evaluate(f, arg);
 const state = (page) => hooks(page, () => window.shapectl.state);
@@ -34,11 +34,7 @@ describe('browser GUI', () => {
   });
 
   after(async () => {
-    try {
-      await browser?.close();  // fails on any console problem of the run
-    } finally {
-      await server?.stop();
-    }
+    await closeAll(browser, server);  // fails on any console problem of the run
   });
 
   it('loads with robot and object visible', async () => {

@@ -8,7 +8,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { startServer, launchChromium, openPage, waitFor, differingFraction, RawWebSocket, sourceDir } from './support.mjs';
+import { startServer, launchChromium, openPage, waitFor, differingFraction, RawWebSocket, sourceDir, closeAll } from './support.mjs';
 import { Command, LinkKind, Message, Parameter } from '../../web/js/protocol.js';
 import { SERIES } from '../../web/js/plot.js';
 
@@ -80,12 +80,8 @@ describe('the real object: plot and calibration (serve --world)', () => {
 
   after(async () => {
     ws?.close();
-    try {
-      await browser?.close();  // fails on any console problem of the run
-    } finally {
-      await server?.stop();
-      if (dir) rmSync(dir, { recursive: true, force: true });
-    }
+    await closeAll(browser, server);  // fails on any console problem of the run
+    if (dir) rmSync(dir, { recursive: true, force: true });
   });
 
   const reply = (id) => ws.next((m) => m.text?.includes(`"id":"${id}"`)).then((m) => JSON.parse(m.text));
@@ -178,11 +174,7 @@ describe('the real object: an observed point cloud (serve)', () => {
 
   after(async () => {
     ws?.close();
-    try {
-      await browser?.close();  // fails on any console problem of the run
-    } finally {
-      await server?.stop();
-    }
+    await closeAll(browser, server);  // fails on any console problem of the run
   });
 
   it('draws the points of the last observed frame over the model, and hides them with the checkbox', async () => {

@@ -5,7 +5,7 @@ import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
 import path from 'node:path';
-import { startServer, launchChromium, openPage, waitFor, sourceDir, RawWebSocket } from './support.mjs';
+import { startServer, launchChromium, openPage, waitFor, sourceDir, RawWebSocket, closeAll } from './support.mjs';
 import { Command, LinkKind, Message } from '../../web/js/protocol.js';
 
 const hooks = (page, f, arg) => page.evaluate(f, arg);
@@ -41,11 +41,7 @@ describe('robot visuals in the 3D view', () => {
     page = await openPage(browser, server.url);
   });
   after(async () => {
-    try {
-      await browser?.close();  // fails on any console problem of the run
-    } finally {
-      await server?.stop();
-    }
+    await closeAll(browser, server);  // fails on any console problem of the run
   });
 
   it('draws each visual in its URDF material colour', async () => {

@@ -79,6 +79,7 @@ export async function openPage(browser, url) {
     if ((m.type() === 'error' || m.type() === 'warning') && !COMPOSITOR_READBACK.test(m.text()))
       page.problems.push(`${m.type()}: ${m.text()}`);
   });
+  await page.addInitScript(installScreenshotDecoder);
   await page.goto(url);
   try {
     await waitFor(() => page.evaluate(() => window.shapectl?.ready), 'the page to show the scene');
@@ -90,32 +91,10 @@ export async function openPage(browser, url) {
   return page;
 }
 
-// Fraction of pixels that differ between two PNG screenshots, decoded by `page` itself.
-export async function differingFraction(page, pngA, pngB) {
-  return page.evaluate(async ([a, b]) => {
-    const decode = async (base64) => {
-      const image = new Image();
-      image.src = `data:image/png;base64,${base64}`;
-      await image.decode();
-      const c = document.createElement('canvas');
-      c.width = image.width; c.height = image.height;
-      const g = c.getContext('2d');
-      g.drawImage(image, 0, 0);
-      return g.getImageData(0, 0, c.width, c.height).data;
-    };
-    const [p, q] = [await decode(a), await decode(b)];
-    let differing = 0;
-    for (let i = 0; i < p.length; i += 4)
-      if (Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]) > 30) differing++;
-    return differing / (p.length / 4);
-  }, [pngA.toString('base64'), pngB.toString('base64')]);
-}
-
-// Which of `points` (page coordinates) have a pixel of `rgb` ([r, g, b], within `tolerance` per
-// channel summed) within `radius` pixels in the PNG screenshot `png` of the whole page: an array
-// of booleans, one per point. Decoded by `page` itself.
-export async function colourNear(page, png, points, rgb, { radius = 3, tolerance = 60 } = {}) {
-  return page.evaluate(async ([base64, points, rgb, radius, tolerance]) => {
+// Put into every page openPage opens, for the pixel checks below: decodes a PNG screenshot
+// (base64) into {width, height, data (RGBA bytes), scale (device pixels per page pixel)}.
+function installScreenshotDecoder() {
+  window.decodeScreenshot = async (base64) => {
     const image = new Image();
     image.src = `data:image/png;base64,${base64}`;
     await image.decode();
@@ -123,14 +102,33 @@ export async function colourNear(page, png, points, rgb, { radius = 3, tolerance
     c.width = image.width; c.height = image.height;
     const g = c.getContext('2d');
     g.drawImage(image, 0, 0);
-    const data = g.getImageData(0, 0, c.width, c.height).data;
-    const scale = image.width / window.innerWidth;  // device pixels per page pixel
+    return { width: c.width, height: c.height, data: g.getImageData(0, 0, c.width, c.height).data, scale: image.width / window.innerWidth };
+  };
+}
+
+// Fraction of pixels that differ between two PNG screenshots, decoded by `page` itself.
+export async function differingFraction(page, pngA, pngB) {
+  return page.evaluate(async ([a, b]) => {
+    const [p, q] = [(await window.decodeScreenshot(a)).data, (await window.decodeScreenshot(b)).data];
+    let differing = 0;
+    for (let i = 0; i < p.length; i += 4)
+      if (Math.abs(p[i] - q[i]) + Math.abs(p[i + 1] - q[i + 1]) + Math.abs(p[i + 2] - q[i + 2]) > 30) differing++;
+    return differing / (p.length / 4);
+  }, [pngA.toString('base64'), pngB.toString('base64')]);
+}
+
+// Which of `points` (page coordinates) have a pixel of `rgb` ([r, g, b], within `tolerance`
+// summed over the channels) within `radius` pixels in the PNG screenshot `png` of the whole
+// page: an array of booleans, one per point.
+export async function colourNear(page, png, points, rgb, { radius = 3, tolerance = 60 } = {}) {
+  return page.evaluate(async ([base64, points, rgb, radius, tolerance]) => {
+    const { width, height, data, scale } = await window.decodeScreenshot(base64);
     return points.map(({ x, y }) => {
       for (let dy = -radius; dy <= radius; dy++) {
         for (let dx = -radius; dx <= radius; dx++) {
           const px = Math.round(x * scale) + dx, py = Math.round(y * scale) + dy;
-          if (px < 0 || py < 0 || px >= c.width || py >= c.height) continue;
-          const i = 4 * (py * c.width + px);
+          if (px < 0 || py < 0 || px >= width || py >= height) continue;
+          const i = 4 * (py * width + px);
           if (Math.abs(data[i] - rgb[0]) + Math.abs(data[i + 1] - rgb[1]) + Math.abs(data[i + 2] - rgb[2]) <= tolerance) return true;
         }
       }
@@ -143,16 +141,21 @@ export async function colourNear(page, png, points, rgb, { radius = 3, tolerance
 // coordinates).
 export async function pixelsAt(page, png, points) {
   return page.evaluate(async ([base64, points]) => {
-    const image = new Image();
-    image.src = `data:image/png;base64,${base64}`;
-    await image.decode();
-    const c = document.createElement('canvas');
-    c.width = image.width; c.height = image.height;
-    const g = c.getContext('2d');
-    g.drawImage(image, 0, 0);
-    const scale = image.width / window.innerWidth;
-    return points.map(({ x, y }) => Array.from(g.getImageData(Math.round(x * scale), Math.round(y * scale), 1, 1).data.slice(0, 3)));
+    const { width, data, scale } = await window.decodeScreenshot(base64);
+    return points.map(({ x, y }) => {
+      const i = 4 * (Math.round(y * scale) * width + Math.round(x * scale));
+      return [data[i], data[i + 1], data[i + 2]];
+    });
   }, [png.toString('base64'), points]);
+}
+
+// Closes the browser, then stops the server even when closing failed (on a console problem).
+export async function closeAll(browser, server) {
+  try {
+    await browser?.close();
+  } finally {
+    await server?.stop();
+  }
 }
 
 // Polls `probe` (sync or async) until it returns a truthy value; fails after `timeoutMs`.

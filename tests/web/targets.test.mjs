@@ -7,7 +7,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { startServer, launchChromium, waitFor, openPage, colourNear, pixelsAt, RawWebSocket, sourceDir } from './support.mjs';
+import { startServer, launchChromium, waitFor, openPage, colourNear, pixelsAt, RawWebSocket, sourceDir, closeAll } from './support.mjs';
 
 const cli = process.env.SHAPECTL_CLI ?? path.join(sourceDir, 'build/shapectl');
 const ORANGE = [0xff, 0x8c, 0x1a];      // targets and the followed centre-line
@@ -53,6 +53,7 @@ async function gripsDrawn(page) {
 }
 
 async function addTargetAtCentre(page) {
+  await waitFor(() => hooks(page, () => window.shapectl.ready), 'the page to draw');
   const centre = await hooks(page, () => window.shapectl.worldToPage(window.shapectl.objectCentroid()));
   const before = (await state(page)).targets.length;
   await page.mouse.click(centre.x, centre.y);
@@ -80,9 +81,8 @@ describe('targets in the browser GUI', () => {
 
   after(async () => {
     try {
-      await browser?.close();  // fails on any console problem of the run
+      await closeAll(browser, server);  // fails on any console problem of the run
     } finally {
-      await server?.stop();
       rmSync(dir, { recursive: true, force: true });
     }
   });
@@ -172,6 +172,15 @@ describe('targets in the browser GUI', () => {
     const [robotOrange] = await colourNear(page, await shot(page, { targets: false }), [where], ORANGE, { radius: 1 });
     const [handleThere] = await colourNear(page, await shot(page), [where], ORANGE, { radius: 1 });
     assert.ok(!robotOrange && handleThere, `the handle is drawn over the robot (orange without it: ${robotOrange}, with: ${handleThere})`);
+    // t: a see-through robot shows what is behind it; t again: solid.
+    await page.keyboard.press('t');
+    const [seeThrough] = await pixelsAt(page, await shot(page, { targets: false }), [where]);
+    await page.keyboard.press('t');
+    const [solidAgain] = await pixelsAt(page, await shot(page, { targets: false }), [where]);
+    // (Other translucent links behind this one add up: the gain is partial.)
+    assert.ok(distance(seeThrough, withoutRobot) < 0.85 * distance(withRobot, withoutRobot),
+      `see-through: ${seeThrough} nearer ${withoutRobot} (no robot) than ${withRobot} (solid)`);
+    assert.ok(distance(solidAgain, withRobot) < 10, `solid again: ${solidAgain}`);
     // Grab it again where it is drawn and drag it back down.
     const back = (await targetOf(page, target.node)).position.map((v, i) => v + (from[i] - v) * 0.5);
     const again = await toPage(page, Array.from({ length: 9 }, (_, k) => behind.map((v, i) => v + (back[i] - v) * k / 8)));

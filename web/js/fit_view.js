@@ -18,4 +18,5 @@ export function fitCamera(camera, orbit, box, direction) {
   camera.far = Math.max(50, 4 * distance);
   camera.updateProjectionMatrix();
   orbit.update();
+  camera.updateMatrixWorld();  // picks and projections before the next render see the new view
 }

@@ -15,7 +15,7 @@ const LOCAL_TARGET_HOLD_MS = 300;  // a dropped target shows where it was left u
 const FRONT_VIEW = new THREE.Vector3(0.95, -0.5, 0.45);  // fit-view: from the scene towards the camera
 const UP = new THREE.Vector3(0, 0, 1);
 
-const SEE_THROUGH_OPACITY = 0.3;
+const SEE_THROUGH_OPACITY = 0.2;
 
 // Fades a robot material to SEE_THROUGH_OPACITY (on) or back to what it was.
 function seeThrough(material, on) {
@@ -216,6 +216,7 @@ export class View3D {
     this.camera.position.copy(this.orbit.target).addScaledVector(side, 0.8);
     this.camera.position.z += 0.2;
     this.orbit.update();
+    this.camera.updateMatrixWorld();
   }
 
   // ---- selection and display toggles ----
