@@ -1,19 +1,33 @@
-// Fit-view: the camera looks at a box's centre from a direction, just far enough back that the
-// box's bounding sphere fills the narrower of the view's two angles (with a margin).
-import { MathUtils, Sphere, Vector3 } from 'three';
+// Fit-view: the camera looks at a centre from a direction, just far enough back that every given
+// point is inside both of the view's angles (with a margin). Fitting the points themselves, not
+// their box or sphere: a robot's bounding box seen from the side is far wider than the robot.
+import { MathUtils, Vector3 } from 'three';
 
-const MARGIN = 1.1;  // sphere radius × this fits the view
-const _sphere = new Sphere();
+const MARGIN = 1.08;  // distance × this: a little room around what is framed
+const _forward = new Vector3();
+const _right = new Vector3();
+const _up = new Vector3();
 const _offset = new Vector3();
 
-// `camera`: a PerspectiveCamera; `orbit`: its OrbitControls; `direction`: from the centre to the camera.
-export function fitCamera(camera, orbit, box, direction) {
-  box.getBoundingSphere(_sphere);
-  const halfVertical = MathUtils.degToRad(camera.fov) / 2;
-  const halfHorizontal = Math.atan(Math.tan(halfVertical) * camera.aspect);
-  const distance = MARGIN * _sphere.radius / Math.sin(Math.min(halfVertical, halfHorizontal));
-  orbit.target.copy(_sphere.center);
-  camera.position.copy(_sphere.center).add(_offset.copy(direction).normalize().multiplyScalar(distance));
+// `camera`: a PerspectiveCamera (its `up` set); `orbit`: its OrbitControls; `direction`: from
+// `centre` towards the camera; `forEachPoint(visit)` calls visit(Vector3) for each point to frame.
+export function fitCamera(camera, orbit, centre, direction, forEachPoint) {
+  _forward.copy(direction).normalize().negate();  // where the camera looks
+  _right.crossVectors(_forward, camera.up).normalize();
+  _up.crossVectors(_right, _forward);
+  const tanVertical = Math.tan(MathUtils.degToRad(camera.fov) / 2);
+  const tanHorizontal = tanVertical * camera.aspect;
+  let distance = 0;
+  forEachPoint((point) => {
+    // At depth distance + offset·forward, its sideways offsets must be within the angles.
+    _offset.subVectors(point, centre);
+    const ahead = _offset.dot(_forward);
+    distance = Math.max(distance,
+      Math.abs(_offset.dot(_right)) / tanHorizontal - ahead, Math.abs(_offset.dot(_up)) / tanVertical - ahead);
+  });
+  distance *= MARGIN;
+  orbit.target.copy(centre);
+  camera.position.copy(centre).addScaledVector(_forward, -distance);
   camera.near = Math.max(0.001, distance / 1000);
   camera.far = Math.max(50, 4 * distance);
   camera.updateProjectionMatrix();

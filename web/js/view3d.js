@@ -67,6 +67,7 @@ export class View3D {
     this.targetControls.yieldsTo = (event) => this.gizmo.hits(event);
 
     this.robotSeeThrough = false;  // the t key
+    this.fitPending = false;       // a new scene waits for its shape and pose to be framed
     this.state = null;             // the last state message shown
     this.frames = 0;               // frames rendered (tests wait for a few)
     this.renderPending = false;
@@ -166,14 +167,21 @@ export class View3D {
     this.ghostView.setRobot(description.robot);
     this.objectView.setScene(description);
     this.state = null;
+    this.fitPending = true;
     this.requestRender();
   }
 
   setPositions(positions) {
-    const first = !this.objectView.positions;
     this.objectView.setPositions(positions);
-    if (first) this.fitView();
+    this.fitOnceShown();
     this.requestRender();
+  }
+
+  // A new scene is framed once both its shape and its robot's pose have arrived.
+  fitOnceShown() {
+    if (!this.fitPending || !this.objectView.positions || !this.state) return;
+    this.fitPending = false;
+    this.fitView();
   }
 
   setState(state) {
@@ -188,6 +196,7 @@ export class View3D {
     this.objectView.setObservedMarkers(state.observed_markers);
     this.objectView.setObservedPoints(state.observed_points);
     this.placeGizmo();
+    this.fitOnceShown();
     this.requestRender();
   }
 
@@ -202,11 +211,19 @@ export class View3D {
   // the side and above, all of both in view (on load, on a scene switch, and the f key).
   fitView() {
     if (!this.objectView.positions) return;
-    const box = new THREE.Box3().setFromBufferAttribute(this.objectView.positionAttribute);
-    box.union(new THREE.Box3().setFromObject(this.robotView.group));
-    fitCamera(this.camera, this.orbit, box, FRONT_VIEW);
+    const robot = this.robotView.group, object = this.objectView.positionAttribute, point = new THREE.Vector3();
+    robot.updateMatrixWorld(true);  // link poses set since the last render
+    const box = new THREE.Box3().setFromBufferAttribute(object).union(new THREE.Box3().setFromObject(robot));
+    fitCamera(this.camera, this.orbit, box.getCenter(new THREE.Vector3()), FRONT_VIEW, (visit) => {
+      for (let i = 0; i < object.count; i++) visit(point.fromBufferAttribute(object, i));
+      for (const mesh of this.robotView.visualMeshes) {
+        const vertices = mesh.geometry.getAttribute('position');
+        for (let i = 0; i < vertices.count; i++) visit(point.fromBufferAttribute(vertices, i).applyMatrix4(mesh.matrixWorld));
+      }
+    });
     this.requestRender();
   }
+
 
   // Looks at a bar square on from the robot's front, so the sketch plane contains its axis.
   faceBar(direction) {
