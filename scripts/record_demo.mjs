@@ -1,6 +1,5 @@
 // Records the image sequences in docs/demo/: a target dragged up and along (drag-NN.png) and a
-// centre-line sketched and followed (sketch-NN.png): the middle of the 3D view, at 1280×800, as
-// a user sees it. `node scripts/record_demo.mjs [OUT_DIR]` after a build (SHAPECTL_CLI names another binary).
+// centre-line sketched and followed (sketch-NN.png): the 3D view, at 1280×800, as a user sees it. `node scripts/record_demo.mjs [OUT_DIR]` after a build (SHAPECTL_CLI names another binary).
 // Run by hand when the page changes, never by the tests: a recording is no assertion.
 import { mkdirSync } from 'node:fs';
 import path from 'node:path';
@@ -16,8 +15,7 @@ try {
   const hooks = (f, arg) => page.evaluate(f, arg);
   const state = () => hooks(() => window.shapectl.state);
   const toPage = (points) => hooks((ps) => ps.map((p) => window.shapectl.worldToPage(p)), points);
-  const box = await page.locator('#view').boundingBox();
-  const view = { x: box.x + 0.15 * box.width, y: box.y + 0.15 * box.height, width: 0.7 * box.width, height: 0.7 * box.height };
+  const view = await page.locator('#view').boundingBox();
   const frame = async (name, k) => {
     await waitFor(() => hooks(() => !window.shapectl.renderPending), 'the frame to be drawn');
     await page.screenshot({ path: path.join(out, `${name}-${String(k + 1).padStart(2, '0')}.png`), clip: view });

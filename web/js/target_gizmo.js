@@ -75,6 +75,12 @@ export class TargetGizmo extends EventDispatcher {
     return 0.6 * factor * GIZMO_SIZE / 4;
   }
 
+  // Off while another control drags the target: no hover highlight, no grab.
+  setEnabled(on) {
+    this.controls.enabled = on;
+    if (!on) this.controls.axis = null;
+  }
+
   setVisible(on) { this.controls.getHelper().visible = on; }
 
   addChangeListener(listener) { this.controls.addEventListener('change', listener); }

@@ -84,9 +84,15 @@ export class View3D {
 
   wireTargetControls() {
     const controls = this.targetControls;
-    controls.addEventListener('dragstart', ({ node, position, added }) => this.startTargetDrag(node, position, added));
+    controls.addEventListener('dragstart', ({ node, position, added }) => {
+      this.gizmo.setEnabled(false);
+      this.startTargetDrag(node, position, added);
+    });
     controls.addEventListener('drag', ({ node, position }) => this.dragTarget(node, position));
-    controls.addEventListener('dragend', ({ node, position, moved }) => this.endTargetDrag(node, position, moved));
+    controls.addEventListener('dragend', ({ node, position, moved }) => {
+      this.gizmo.setEnabled(true);
+      this.endTargetDrag(node, position, moved);
+    });
     this.gizmo.addEventListener('dragstart', ({ node, position }) => this.startTargetDrag(node, position, false));
     this.gizmo.addEventListener('drag', ({ node, position }) => this.dragTarget(node, position));
     this.gizmo.addEventListener('dragend', ({ node, position }) => this.endTargetDrag(node, position, true));
