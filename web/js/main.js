@@ -4,6 +4,7 @@ import { Connection } from './connection.js';
 import { View3D } from './view3d.js';
 import { ConvergencePlot } from './plot.js';
 import { CalibrationPanel } from './calibration_panel.js';
+import { ViewTools } from './view_tools.js';
 import { Command, ControllerStatus } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
@@ -30,7 +31,11 @@ const view = new View3D($('view'), {
   sketch: (points) => command(Command.SetCenterline, { points }).then(() => setSketchMode(false)),
   select: (node) => { $('delete').disabled = node === null; },
 });
-const plot = new ConvergencePlot($('plot'), $('plot-legend'));
+const plot = new ConvergencePlot($('plot'), $('plot-legend'), { readout: $('plot-readout'), logScale: $('plot-log') });
+const tools = new ViewTools(view, {
+  frames: $('show-frames'), screenshot: $('screenshot'), helpButton: $('help-button'), help: $('help'), scaleBar: $('scale-bar'),
+  hover: $('hover-readout'), notice: $('notice'), deleteButton: $('delete'),
+});
 const calibration = new CalibrationPanel({
   button: $('calibrate'), auto: $('auto-calibration'), status: $('calibration-status'), model: $('model'),
   table: $('calibration-result'), summary: $('calibration-summary'), error: $('calibration-error'),
@@ -53,6 +58,7 @@ const connection = new Connection(`ws://${location.host}/ws`, {
 
 // Fire and forget: errors already show as a toast.
 function command(type, fields) {
+  tools.sent(type);
   return connection.send(type, fields).catch(() => {});
 }
 
@@ -75,6 +81,7 @@ function onScene(scene) {
   page.scene = scene;
   page.state = null;
   view.setScene(scene);
+  tools.setScene(scene);
   plot.reset(scene.history);
   const select = $('scene-select');
   select.replaceChildren(...scene.scenes.map((name) => new Option(name, name, false, name === scene.scene)));
@@ -118,6 +125,7 @@ function onState(state) {
   page.stats.stateTimes.push(performance.now());
   if (page.stats.stateTimes.length > 200) page.stats.stateTimes.shift();
   view.setState(state);
+  tools.setState(state);
   plot.add(state.time, plotValues(state), state.editing);
   drawPlot();
 
@@ -233,6 +241,8 @@ window.shapectl = {
   get frames() { return view.frames; },
   get observedPointsDrawn() { return view.observedPointsDrawn; },
   get selected() { return view.selected; },
+  get tools() { return tools.hooks; },
+  plot: () => ({ top: plot.top, clipped: plot.clipped, log: plot.log }),
   nodePosition: (node) => view.nodePosition(node).toArray(),
   positions: () => Array.from(view.positions ?? []),
   worldToPage: (point) => view.worldToPage(point),
