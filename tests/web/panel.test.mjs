@@ -23,13 +23,11 @@ async function clickCentroid(page) {
   return waitFor(async () => (await state(page)).targets[0], 'a target from the click');
 }
 
-async function mouseStroke(page, points) {
-  await page.mouse.move(points[0].x, points[0].y);
+// Drags with the left button from `from` to `to` in small steps, as a hand would.
+async function drag(page, from, to) {
+  await page.mouse.move(from.x, from.y);
   await page.mouse.down();
-  for (const p of points.slice(1)) {
-    await page.mouse.move(p.x, p.y, { steps: 3 });
-    await page.waitForTimeout(15);
-  }
+  await page.mouse.move(to.x, to.y, { steps: 25 });
   await page.mouse.up();
 }
 
@@ -88,7 +86,6 @@ describe('side panel and view tools', () => {
     // Live: add a target and drag it, so the status, errors, rate and joints all change.
     const target = await clickCentroid(page);
     const from = await hooks(page, (n) => window.shapectl.nodePosition(n), target.node);
-    const path3d = Array.from({ length: 8 }, (_, k) => [from[0], from[1], from[2] + 0.004 * k]);
     const sampling = hooks(page, (f) => new Promise((done) => {
       const probeFn = new Function(`return (${f})()`);
       const seen = [];
@@ -96,7 +93,8 @@ describe('side panel and view tools', () => {
       const tick = () => { seen.push(probeFn()); if (performance.now() < end) requestAnimationFrame(tick); else done(seen); };
       tick();
     }), probe.toString());
-    await mouseStroke(page, await hooks(page, (ps) => ps.map((p) => window.shapectl.worldToPage(p)), path3d));
+    const [start2d, end2d] = await hooks(page, (ps) => ps.map((p) => window.shapectl.worldToPage(p)), [from, [from[0], from[1], from[2] + 0.028]]);
+    await drag(page, start2d, end2d);
     const seen = await sampling;
     for (const tops of seen) assert.deepEqual(tops, start, 'nothing moved while the session changed');
     // The widest texts the page writes there.
