@@ -36,7 +36,7 @@ function quantileOf(values, quantile) {
 }
 
 // Tick label: as many decimals as the value needs, at most 3.
-const tickLabel = (mm) => (mm >= 1 ? mm.toFixed(0) : mm.toFixed(Math.min(3, Math.ceil(-Math.log10(mm) - 1e-9))));
+const tickLabel = (mm) => (mm === 0 ? '0' : mm >= 1 ? mm.toFixed(0) : mm.toFixed(Math.min(3, Math.ceil(-Math.log10(mm) - 1e-9))));
 
 export class ConvergencePlot {
   // `legend`: an element that gets one entry per series. Optional: `readout`, an element that
