@@ -98,14 +98,18 @@ describe('side panel and view tools', () => {
     const seen = await sampling;
     for (const tops of seen) assert.deepEqual(tops, start, 'nothing moved while the session changed');
     // The widest texts the page writes there.
-    const extreme = await hooks(page, (f) => {
+    const extreme = await hooks(page, async (f) => {
       const set = (id, text) => { document.getElementById(id).textContent = text; };
       set('status', 'best effort · unreachable: joint limit of yumi_joint_7_l and collision with the other arm');
       set('error-mean', '12345.67'); set('error-max', '123456.78'); set('rate', '1234');
       set('status-detail', '12 targets · 123456 iterations · 3 page(s) · clearance 123 mm · UNSAFE · jog refused: link_7_l would collide with link_6_r (clearance −3 mm)');
-      return new Function(`return (${f})()`)();
+      const tops = new Function(`return (${f})()`)();
+      // Before the next state message rewrites it: the tooltip updates in a microtask.
+      await new Promise((done) => queueMicrotask(done));
+      return { tops, title: document.getElementById('status').title };
     }, probe.toString());
-    assert.deepEqual(extreme, start, 'long texts do not re-wrap the panel');
+    assert.deepEqual(extreme.tops, start, 'long texts do not re-wrap the panel');
+    assert.match(extreme.title, /^best effort · unreachable: joint limit/, 'what is cut off is whole in the tooltip');
   });
 
   it('draws the convergence plot in mm with a robust range, merged editing spans and a log option', async () => {

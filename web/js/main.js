@@ -34,7 +34,7 @@ const view = new View3D($('view'), {
 const plot = new ConvergencePlot($('plot'), $('plot-legend'), { readout: $('plot-readout'), logScale: $('plot-log') });
 const tools = new ViewTools(view, {
   frames: $('show-frames'), screenshot: $('screenshot'), helpButton: $('help-button'), help: $('help'), scaleBar: $('scale-bar'),
-  hover: $('hover-readout'), notice: $('notice'), deleteButton: $('delete'),
+  hover: $('hover-readout'), notice: $('notice'), deleteButton: $('delete'), clipped: [$('status'), $('status-detail')],
 });
 const calibration = new CalibrationPanel({
   button: $('calibrate'), auto: $('auto-calibration'), status: $('calibration-status'), model: $('model'),

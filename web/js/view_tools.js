@@ -13,7 +13,8 @@ import { saveScreenshot } from './screenshot.js';
 const NOTICE_MS = 6000;
 
 export class ViewTools {
-  // `elements`: {frames, screenshot, helpButton, help, scaleBar, hover, notice, deleteButton}.
+  // `elements`: {frames, screenshot, helpButton, help, scaleBar, hover, notice, deleteButton, clipped}
+  // (`clipped`: panel texts cut to a fixed size so the panel does not jump).
   constructor(view, elements) {
     this.view = view;
     this.elements = elements;
@@ -28,6 +29,9 @@ export class ViewTools {
     elements.frames.addEventListener('change', () => { this.frames.setVisible(elements.frames.checked); view.requestRender(); });
     elements.screenshot.addEventListener('click', () => saveScreenshot(view, this.scene?.scene));
     window.addEventListener('keydown', (e) => this.onKey(e));
+    // A cut-off text is whole in its tooltip.
+    for (const e of elements.clipped)
+      new MutationObserver(() => { e.title = e.textContent; }).observe(e, { childList: true, characterData: true, subtree: true });
   }
 
   onKey(e) {
