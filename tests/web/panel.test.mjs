@@ -229,7 +229,9 @@ describe('side panel and view tools', () => {
       assert.ok(Math.hypot(...d.map((v, i) => v - direction[i])) < 2e-3, `key ${key}: looking along ${d}`);
     }
     // Front view: a bar of `metres` along y at the orbit centre spans `pixels` on screen.
+    const frames = await hooks(page, () => window.shapectl.frames);
     await page.keyboard.press('1');
+    await waitFor(async () => (await hooks(page, () => window.shapectl.frames)) > frames, 'the front view drawn');
     const bar = await tools(page, 'scaleBar');
     const centre = await tools(page, 'orbitTarget');
     const [a, b] = await hooks(page, ([c, m]) => [window.shapectl.worldToPage(c), window.shapectl.worldToPage([c[0], c[1] + m, c[2]])], [centre, bar.metres]);

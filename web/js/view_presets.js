@@ -17,6 +17,7 @@ export function applyPreset(view, key) {
   const distance = view.camera.position.distanceTo(view.orbit.target);
   view.camera.position.copy(view.orbit.target).addScaledVector(preset.direction, distance);
   view.orbit.update();
+  view.camera.updateMatrixWorld();  // projections before the next frame see the new view
   view.requestRender();
   return true;
 }
