@@ -5,6 +5,7 @@ import { View3D } from './view3d.js';
 import { ConvergencePlot } from './plot.js';
 import { CalibrationPanel } from './calibration_panel.js';
 import { TargetEditor } from './target_editing.js';
+import { ViewTools } from './view_tools.js';
 import { Command, ControllerStatus } from './protocol.js';
 
 const $ = (id) => document.getElementById(id);
@@ -36,7 +37,11 @@ const editor = new TargetEditor({
   x: $('target-x'), y: $('target-y'), z: $('target-z'), node: $('target-node'), undo: $('undo'), redo: $('redo'),
   saveTargets: $('save-targets'), saveJoints: $('save-joints'), load: $('load-file'),
 }, { command, state: () => page.state, scene: () => page.scene, view, notify: (text) => toast(text) });
-const plot = new ConvergencePlot($('plot'), $('plot-legend'));
+const plot = new ConvergencePlot($('plot'), $('plot-legend'), { readout: $('plot-readout'), logScale: $('plot-log') });
+const tools = new ViewTools(view, {
+  frames: $('show-frames'), screenshot: $('screenshot'), helpButton: $('help-button'), help: $('help'), scaleBar: $('scale-bar'),
+  hover: $('hover-readout'), notice: $('notice'), deleteButton: $('delete'), clipped: [$('status'), $('status-detail')],
+});
 const calibration = new CalibrationPanel({
   button: $('calibrate'), auto: $('auto-calibration'), status: $('calibration-status'), model: $('model'),
   table: $('calibration-result'), summary: $('calibration-summary'), error: $('calibration-error'),
@@ -59,6 +64,7 @@ const connection = new Connection(`ws://${location.host}/ws`, {
 
 // Fire and forget: errors already show as a toast.
 function command(type, fields) {
+  tools.sent(type);
   return connection.send(type, fields).catch(() => {});
 }
 
@@ -82,6 +88,7 @@ function onScene(scene) {
   page.state = null;
   view.setScene(scene);
   editor.reset();
+  tools.setScene(scene);
   plot.reset(scene.history);
   const select = $('scene-select');
   select.replaceChildren(...scene.scenes.map((name) => new Option(name, name, false, name === scene.scene)));
@@ -126,6 +133,7 @@ function onState(state) {
   if (page.stats.stateTimes.length > 200) page.stats.stateTimes.shift();
   view.setState(state);
   editor.update(state);
+  tools.setState(state);
   plot.add(state.time, plotValues(state), state.editing);
   drawPlot();
 
@@ -250,6 +258,8 @@ window.shapectl = {
   get frames() { return view.frames; },
   get observedPointsDrawn() { return view.observedPointsDrawn; },
   get selected() { return view.selected; },
+  get tools() { return tools.hooks; },
+  plot: () => ({ top: plot.top, clipped: plot.clipped, log: plot.log }),
   nodePosition: (node) => view.nodePosition(node).toArray(),
   positions: () => Array.from(view.positions ?? []),
   worldToPage: (point) => view.worldToPage(point),

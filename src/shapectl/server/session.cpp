@@ -236,7 +236,8 @@ void Session::load(const SceneEntry& entry) {
   last_edit_time_ = -1e9;
   snapshot_ = controller_->snapshot();
   logged_sequence_ = 0;
-  if (link_) link_->disarm("scene changed to " + entry.name);
+  // Only an armed link has something to say about it (at start-up it is disarmed already).
+  if (link_ && link_->status().armed) link_->disarm("scene changed to " + entry.name);
   scene_description_ = describe_scene();
 }
 
