@@ -17,7 +17,8 @@ export const KEYS = Object.freeze([
 
 export const MOUSE = Object.freeze([
   ['click the object', 'add a target at the nearest node'],
-  ['drag a handle', 'move that target'],
+  ['drag a handle', 'move that target in the view plane'],
+  ["drag the gizmo's arrows", 'move the selected target along that axis'],
   ['left drag', 'orbit'],
   ['right / middle drag', 'pan'],
   ['wheel', 'zoom'],
