@@ -89,7 +89,8 @@ TEST(RobotModel, AVisualMeshIsKeptWithItsFileName) {
   // Whether the file exists is for find_visual_meshes (visual_meshes_test.cpp) to say.
   const RobotModel model = test_robot();
   EXPECT_TRUE(model.warnings().empty());
-  const auto& visuals = model.links()[static_cast<std::size_t>(model.link_index("a"))].visual_shapes;
+  const auto& visuals =
+      model.links()[static_cast<std::size_t>(model.link_index("a"))].visual_shapes;
   ASSERT_EQ(visuals.size(), 1u);
   EXPECT_EQ(visuals[0].kind, Shape::Kind::Mesh);
   EXPECT_EQ(visuals[0].mesh_filename, "package://missing/a.stl");

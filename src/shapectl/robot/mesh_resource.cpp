@@ -16,7 +16,8 @@ bool is_existing_file(const std::filesystem::path& p) {
 
 // Whether `dir` is the ROS package `package`: so named, or so declared in its package.xml.
 bool is_package_dir(const std::filesystem::path& dir, const std::string& package) {
-  if (dir.filename() == package || (dir.filename().empty() && dir.parent_path().filename() == package))
+  if (dir.filename() == package ||
+      (dir.filename().empty() && dir.parent_path().filename() == package))
     return true;
   std::ifstream in(dir / "package.xml");
   if (!in) return false;

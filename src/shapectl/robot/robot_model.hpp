@@ -35,7 +35,7 @@ struct Shape {
 
 struct Link {
   std::string name;
-  int parent_joint = -1;                // index into joints(); -1 for the root
+  int parent_joint = -1;  // index into joints(); -1 for the root
   // Collision meshes are not loaded: the collision spheres are the collision model (one warning
   // says so); `shapectl author` covers them with spheres (urdf_collision.hpp).
   std::vector<Shape> collision_shapes;

@@ -20,7 +20,7 @@ const char* to_string(MeshFormat format);  // "stl", "obj", "dae": also the URL'
 std::optional<MeshFormat> mesh_format_of(const std::filesystem::path& file);
 
 struct VisualMesh {
-  int link = -1;   // model.links()[link].visual_shapes[shape]
+  int link = -1;  // model.links()[link].visual_shapes[shape]
   int shape = -1;
   std::optional<std::filesystem::path> file;  // set only when it can be drawn
   MeshFormat format = MeshFormat::Stl;
@@ -29,8 +29,8 @@ struct VisualMesh {
 
 // Every visual mesh of `model`, links in order, visuals in file order. Relative and file://
 // names resolve against the directory of model.source() (the URDF file).
-std::vector<VisualMesh> find_visual_meshes(
-    const RobotModel& model, const std::vector<std::filesystem::path>& package_paths);
+std::vector<VisualMesh> find_visual_meshes(const RobotModel& model,
+                                           const std::vector<std::filesystem::path>& package_paths);
 
 // "<urdf>: link 'l': visual mesh 'package://p/a.stl' not found (...): the link is drawn without
 // it" for a mesh with a problem.
