@@ -77,6 +77,13 @@ install(FILES ${three}/build/three.module.js ${three}/build/three.core.js
         DESTINATION ${shapectl_data_dir}/web/node_modules/three/build)
 install(FILES ${three}/examples/jsm/controls/OrbitControls.js
         DESTINATION ${shapectl_data_dir}/web/node_modules/three/examples/jsm/controls)
+# The robot's mesh visuals (web/js/mesh_loader.js), with what ColladaLoader imports.
+install(FILES ${three}/examples/jsm/loaders/STLLoader.js ${three}/examples/jsm/loaders/OBJLoader.js
+              ${three}/examples/jsm/loaders/ColladaLoader.js ${three}/examples/jsm/loaders/TGALoader.js
+        DESTINATION ${shapectl_data_dir}/web/node_modules/three/examples/jsm/loaders)
+install(FILES ${three}/examples/jsm/loaders/collada/ColladaParser.js
+              ${three}/examples/jsm/loaders/collada/ColladaComposer.js
+        DESTINATION ${shapectl_data_dir}/web/node_modules/three/examples/jsm/loaders/collada)
 
 install(FILES ${PROJECT_SOURCE_DIR}/LICENSE ${PROJECT_SOURCE_DIR}/README.md
         DESTINATION ${CMAKE_INSTALL_DOCDIR})

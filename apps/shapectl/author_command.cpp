@@ -32,6 +32,7 @@
 #include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
+#include "robot_mesh_options.hpp"
 
 namespace shapectl::cli {
 
@@ -187,11 +188,11 @@ void add_cover(std::vector<CollisionSphere>& out, int link, const std::vector<Co
 
 std::vector<CollisionSphere> cover_meshes(const AuthorOptions& o, const RobotModel& model,
                                           std::vector<std::string>& warnings) {
-  std::vector<fs::path> package_paths(o.package_paths.begin(), o.package_paths.end());
+  const std::vector<fs::path> paths = package_paths(o.package_paths);
   std::vector<CollisionSphere> spheres;
   for (const auto& m : read_mesh_collisions(model, o.urdf)) {
     const std::string& link = model.links()[static_cast<std::size_t>(m.link)].name;
-    const auto file = resolve_mesh_file(m.filename, fs::path(o.urdf).parent_path(), package_paths);
+    const auto file = resolve_mesh_file(m.filename, fs::path(o.urdf).parent_path(), paths);
     if (!file || !is_surface_file(*file)) {
       warnings.push_back(o.urdf + ": link '" + link + "': collision mesh '" +
                          bounded_preview(m.filename) +
@@ -405,10 +406,11 @@ void run(const AuthorOptions& o) {
                      o.sphere_margin);
 
   RobotModel model = RobotModel::load_urdf_file(o.urdf);
-  // The loader's note that it skips meshes does not apply here: meshes are covered below.
+  // The loader's note that collision meshes are ignored does not apply here: they are covered
+  // with spheres below.
   std::vector<std::string> warnings;
-  for (const auto& w : model.warnings())
-    if (w.find("mesh geometries skipped") == std::string::npos) warnings.push_back(w);
+  for (const auto& w : robot_notes(model, o.package_paths))
+    if (w.find("collision meshes ignored") == std::string::npos) warnings.push_back(w);
   const std::vector<EndEffector> ees = read_end_effectors(o, model);
   const ObjectMesh object = read_object_mesh(o, scene_dir);
   const Spheres spheres = generate_spheres(o, model, warnings);
@@ -614,8 +616,7 @@ void add_author_command(CLI::App& app) {
   c->add_option("--youngs-modulus", o->youngs_modulus, "Pa")->capture_default_str();
   c->add_option("--poisson-ratio", o->poisson_ratio, "")->capture_default_str();
   c->add_option("--density", o->density, "kg/m^3")->capture_default_str();
-  c->add_option("--package-path", o->package_paths,
-                "Directory holding ROS packages for package:// meshes; repeatable");
+  add_package_path_option(*c, o->package_paths);
   c->add_option("--sphere-margin", o->sphere_margin,
                 "Collision margin written to the sphere file (m)")
       ->capture_default_str();

@@ -21,6 +21,7 @@
 #include "bench_closed_loop.hpp"
 #include "commands.hpp"
 #include "result_json.hpp"
+#include "robot_mesh_options.hpp"
 
 namespace shapectl::cli {
 
@@ -38,6 +39,7 @@ double percentile(std::vector<double> v, double p) {
 }
 
 struct BenchArgs {
+  std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::vector<std::string> scenes = {"scenes/yumi_bar.json", "scenes/yumi_frame.json"};
   int trials = 20;
   unsigned seed = 1;
@@ -260,7 +262,7 @@ void bench_calibration(const Scene& scene, const BenchArgs& args) {
 
 void bench_scene(const std::string& file, const BenchArgs& args) {
   const Scene scene = load_scene(file);
-  print_scene_notes(scene);
+  print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(file, "robot", "a scene with a robot (missing key)");
   GrippedObject object(scene);
   ReducedObjective objective(object);
@@ -291,6 +293,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--trials", args->trials, "random target sets per measurement")
       ->check(CLI::Range(1, 10000));
   cmd->add_option("--seed", args->seed, "random seed");
+  add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] {
     for (const auto& s : args->scenes) bench_scene(s, *args);
   });

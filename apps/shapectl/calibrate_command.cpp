@@ -12,12 +12,14 @@
 
 #include "commands.hpp"
 #include "result_json.hpp"
+#include "robot_mesh_options.hpp"
 
 namespace shapectl::cli {
 
 namespace {
 
 struct CalibrateArgs {
+  std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::string scene, observations, out, report;
   std::string fit;  // default: default_fit(scene)
   int max_iterations = 30;
@@ -98,7 +100,7 @@ void print_summary(const CalibrationResult& r) {
 
 void run_calibrate(const CalibrateArgs& args) {
   const Scene scene = load_scene(args.scene);
-  print_scene_notes(scene);
+  print_scene_notes(scene, args.package_paths);
   const FitSelection fit = fit_selection(args, scene);
   const Observations observations =
       load_observations(args.observations,
@@ -143,6 +145,7 @@ void add_calibrate_command(CLI::App& app) {
                   "REPORT.json: values, standard deviations, residuals, identifiability");
   cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")
       ->check(CLI::Range(1, 1000));
+  add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] { run_calibrate(*args); });
 }
 

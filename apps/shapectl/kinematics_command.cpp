@@ -17,6 +17,7 @@
 
 #include "commands.hpp"
 #include "result_json.hpp"
+#include "robot_mesh_options.hpp"
 
 namespace shapectl::cli {
 
@@ -24,6 +25,7 @@ namespace {
 
 struct KinematicsOptions {
   std::string urdf;
+  std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::string joints;
   std::string spheres;
   std::string out;
@@ -70,7 +72,7 @@ nlohmann::ordered_json collision_json(const RobotModel& robot, const CollisionMo
 
 void run(const KinematicsOptions& options) {
   RobotModel robot = RobotModel::load_urdf_file(options.urdf);
-  for (const auto& warning : robot.warnings()) std::cerr << "warning: " << warning << "\n";
+  print_robot_notes(robot, options.package_paths);
   const Eigen::VectorXd active =
       options.joints.empty()
           ? Eigen::VectorXd::Zero(robot.active_count()).eval()
@@ -112,6 +114,7 @@ void add_kinematics_command(CLI::App& app) {
   command->add_option("--spheres", options->spheres, "Collision spheres JSON (see docs/robot.md)");
   command->add_option("--out", options->out, "Output JSON: link poses in the URDF root frame")
       ->required();
+  add_package_path_option(*command, options->package_paths);
   command->callback([options] { run(*options); });
 }
 

@@ -7,6 +7,8 @@
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/sim/scene_checks.hpp>
 
+#include "robot_mesh_options.hpp"
+
 namespace shapectl::cli {
 
 nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints) {
@@ -22,7 +24,8 @@ nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints) {
   return out;
 }
 
-void print_scene_notes(const Scene& scene) {
+void print_scene_notes(const Scene& scene, const std::vector<std::string>& package_paths) {
+  if (scene.robot) print_robot_notes(*scene.robot->model, package_paths);
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";
   if (scene.robot)
     for (const auto& line : describe_grips(scene)) std::cerr << line << "\n";

@@ -2,6 +2,7 @@
 // JSON pieces shared by the commands' result files.
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include <shapectl/sim/scene.hpp>
 
@@ -17,8 +18,9 @@ void require_finite(const nlohmann::json& result, const std::string& what,
                     const std::string& context);
 void require_finite(const nlohmann::ordered_json& result, const std::string& what,
                     const std::string& context);
-// The scene's warnings ("warning: <file>: <field>: ...") and the nodes each grip caught, one line
-// each, on stderr: the traps a user must see before trusting a result.
-void print_scene_notes(const Scene& scene);
+// The robot's notes (robot_mesh_options.hpp: skipped geometry, visual meshes not found through
+// `package_paths`), the scene's warnings ("warning: <file>: <field>: ...") and the nodes each
+// grip caught, one line each, on stderr: the traps a user must see before trusting a result.
+void print_scene_notes(const Scene& scene, const std::vector<std::string>& package_paths);
 
 }  // namespace shapectl::cli

@@ -35,6 +35,7 @@
 #include "commands.hpp"
 #include "link_options.hpp"
 #include "result_json.hpp"
+#include "robot_mesh_options.hpp"
 
 namespace shapectl::cli {
 
@@ -43,6 +44,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct RunArgs {
+  std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::string scene;
   std::string targets;
   std::string log;
@@ -128,7 +130,7 @@ std::unique_ptr<SimulatedWorld> make_world(const RunArgs& args, const Scene& mod
 // The scene (with a robot) and the targets, checked; the link settings completed from them.
 RunInputs load_run_inputs(RunArgs& args) {
   Scene scene = load_scene(args.scene);
-  print_scene_notes(scene);
+  print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(args.scene, "robot", "run needs a scene with a robot");
   TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
   LinkKind kind = LinkKind::Sim;
@@ -415,6 +417,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--observations-address", args->observations_address,
                   "local address for --observations-udp")
       ->capture_default_str();
+  add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] { run(*args); });
 }
 

@@ -1,5 +1,5 @@
 // shapectl serve [SCENE.json] [--host 127.0.0.1] [--port 8080] [--robot none|sim|egm]
-//                [link options] [--log LOG.jsonl] [--web-root DIR]
+//                [link options] [--log LOG.jsonl] [--web-root DIR] [--package-path DIR]...
 // The browser GUI: serves web/ over HTTP and the session over a WebSocket at /ws
 // (docs/gui.md).
 #include <iostream>
@@ -15,6 +15,7 @@
 #include "closed_loop_options.hpp"
 #include "commands.hpp"
 #include "link_options.hpp"
+#include "robot_mesh_options.hpp"
 
 namespace shapectl::cli {
 
@@ -31,6 +32,8 @@ struct ServeArgs {
   std::string scenes_dir;
   double rate = 30;
   ClosedLoopArgs loop;  // the simulated real object, the online calibration
+  // --package-path: the URDF's package:// meshes
+  std::vector<std::string> package_paths;
 };
 
 // The session log if --log names one, opened with a "session" event; else null.
@@ -80,7 +83,9 @@ void run_serve(const ServeArgs& args) {
     }
   }
   server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(), {},
-                          online_calibration_options(args.loop, "serve"));
+                          online_calibration_options(args.loop, "serve"),
+                          package_paths(args.package_paths));
+  print_robot_notes(session.controller().robot(), args.package_paths);
   session.set_log(log.get());
   if (!args.loop.world.empty()) {
     if (args.robot != "sim")
@@ -136,6 +141,7 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--rate", args->rate, "State messages per second to each page")
       ->check(CLI::Range(1.0, 120.0))
       ->capture_default_str();
+  add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] { run_serve(*args); });
 }
 

@@ -18,6 +18,7 @@
 
 #include "commands.hpp"
 #include "result_json.hpp"
+#include "robot_mesh_options.hpp"
 #include "surface_option.hpp"
 
 namespace shapectl::cli {
@@ -25,6 +26,7 @@ namespace shapectl::cli {
 namespace {
 
 struct SolveArgs {
+  std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::string scene, targets, out, vtu, surface;
   std::string optimizer = "gauss-newton";
   std::string gradient = "sensitivity";
@@ -55,7 +57,7 @@ ShapeTargets resolve_targets(const TargetsInput& in, const std::string& file,
 void run_solve(const SolveArgs& args) {
   check_surface_option("solve", args.surface);
   const Scene scene = load_scene(args.scene);
-  print_scene_notes(scene);
+  print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(args.scene, "robot", "a robot to optimize (missing key)");
   GrippedObject object(scene);
   const TargetsInput input = load_targets(args.targets, object.node_count());
@@ -143,6 +145,7 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--max-seconds", args->max_seconds, "time limit")->check(CLI::PositiveNumber);
+  add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] { run_solve(*args); });
 }
 

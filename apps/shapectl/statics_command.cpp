@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "result_json.hpp"
+#include "robot_mesh_options.hpp"
 #include "surface_option.hpp"
 
 namespace shapectl::cli {
@@ -22,6 +23,7 @@ namespace shapectl::cli {
 namespace {
 
 struct StaticsArgs {
+  std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::string scene;
   std::string joints;
   std::string out;
@@ -57,7 +59,7 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const TetMes
 void run_statics(const StaticsArgs& args) {
   check_surface_option("statics", args.surface);
   const Scene scene = load_scene(args.scene);
-  print_scene_notes(scene);
+  print_scene_notes(scene, args.package_paths);
   const Positions rest = scene.world_rest_positions();
   Positions x = rest;
   if (!scene.robot) {
@@ -87,6 +89,7 @@ void add_statics_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
   cmd->add_option("--vtu", args->vtu, "also write the deformed mesh as VTU (ParaView)");
   add_surface_option(*cmd, args->surface);
+  add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] { run_statics(*args); });
 }
 

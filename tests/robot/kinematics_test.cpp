@@ -85,11 +85,15 @@ TEST(RobotModel, ActiveJointsDefaultToMovableNonMimicJointsInTreeOrder) {
   EXPECT_DOUBLE_EQ(mimic.mimic_multiplier, 2.0);
 }
 
-TEST(RobotModel, MissingMeshIsSkippedWithAWarning) {
+TEST(RobotModel, AVisualMeshIsKeptWithItsFileName) {
+  // Whether the file exists is for find_visual_meshes (visual_meshes_test.cpp) to say.
   const RobotModel model = test_robot();
-  ASSERT_EQ(model.warnings().size(), 1u);
-  EXPECT_NE(model.warnings()[0].find("package://missing/a.stl"), std::string::npos);
-  EXPECT_TRUE(model.links()[static_cast<std::size_t>(model.link_index("a"))].visual_shapes.empty());
+  EXPECT_TRUE(model.warnings().empty());
+  const auto& visuals =
+      model.links()[static_cast<std::size_t>(model.link_index("a"))].visual_shapes;
+  ASSERT_EQ(visuals.size(), 1u);
+  EXPECT_EQ(visuals[0].kind, Shape::Kind::Mesh);
+  EXPECT_EQ(visuals[0].mesh_filename, "package://missing/a.stl");
 }
 
 TEST(RobotModel, UnknownNamesAndInvalidActiveJointsAreInputErrors) {

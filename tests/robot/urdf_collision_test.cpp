@@ -1,4 +1,4 @@
-// Mesh collision geometry read from URDF and its file names resolved the ROS way.
+// Mesh collision geometry read from URDF (its files are found as in mesh_resource_test.cpp).
 #include <gtest/gtest.h>
 
 #include <shapectl/robot/urdf_collision.hpp>
@@ -27,27 +27,6 @@ TEST(UrdfCollision, MeshesAreReadWithScaleAndOrigin) {
   EXPECT_NEAR((meshes[0].scale - Vec3(0.001, 0.001, 0.002)).norm(), 0, 1e-15);
   EXPECT_NEAR((meshes[0].T_link_mesh.translation() - Vec3(0.1, 0.2, 0.3)).norm(), 0, 1e-12);
   EXPECT_NEAR((meshes[0].T_link_mesh.linear() * Vec3::UnitX() - Vec3::UnitY()).norm(), 0, 1e-9);
-}
-
-TEST(UrdfCollision, MeshFilesResolveRelativeToTheUrdfAndThroughPackagePaths) {
-  test::TempDir dir;
-  std::filesystem::create_directories(dir.path() / "share" / "pkg" / "meshes");
-  std::filesystem::create_directories(dir.path() / "urdf");
-  const auto in_package = dir.write("share/pkg/meshes/a.stl", "solid a\nendsolid a\n");
-  const auto beside = dir.write("urdf/b.obj", "");
-  const auto urdf_dir = dir.path() / "urdf";
-  EXPECT_EQ(resolve_mesh_file("package://pkg/meshes/a.stl", urdf_dir, {dir.path() / "share"}),
-            in_package);
-  // A package path may also name the package folder itself.
-  EXPECT_EQ(resolve_mesh_file("package://pkg/meshes/a.stl", urdf_dir,
-                              {dir.path() / "share" / "pkg"}),
-            in_package);
-  EXPECT_EQ(resolve_mesh_file("b.obj", urdf_dir, {}), beside);
-  EXPECT_EQ(resolve_mesh_file("file://" + beside.string(), urdf_dir, {}), beside);
-  EXPECT_FALSE(resolve_mesh_file("package://pkg/meshes/a.stl", urdf_dir, {}));
-  EXPECT_FALSE(
-      resolve_mesh_file("package://other/meshes/a.stl", urdf_dir, {dir.path() / "nowhere"}));
-  EXPECT_FALSE(resolve_mesh_file("missing.obj", urdf_dir, {}));
 }
 
 }  // namespace

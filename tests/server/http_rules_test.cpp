@@ -34,6 +34,23 @@ TEST(HttpRules, ContentTypesForTheAssetsThePageUses) {
   EXPECT_EQ(content_type("x.css"), "text/css; charset=utf-8");
   EXPECT_EQ(content_type("gui.png"), "image/png");
   EXPECT_EQ(content_type("blob"), "application/octet-stream");
+  EXPECT_EQ(content_type("/pkg/meshes/arm.STL"), "model/stl");
+  EXPECT_EQ(content_type("hand.obj"), "model/obj");
+  EXPECT_EQ(content_type("hand.dae"), "model/vnd.collada+xml");
+}
+
+TEST(HttpRules, RobotMeshRequestsAreANumberAndAKnownExtensionOnly) {
+  const auto mesh = parse_robot_mesh_target("/robot-mesh/12.stl?v=2");
+  ASSERT_TRUE(mesh);
+  EXPECT_EQ(mesh->index, 12u);
+  EXPECT_EQ(mesh->extension, "stl");
+  EXPECT_EQ(parse_robot_mesh_target("/robot-mesh/0.dae")->index, 0u);
+  for (const char* bad : {"/robot-mesh/", "/robot-mesh/7", "/robot-mesh/7.", "/robot-mesh/7.png",
+                          "/robot-mesh/07.stl", "/robot-mesh/-1.stl", "/robot-mesh/1e3.stl",
+                          "/robot-mesh/../secret.stl", "/robot-mesh/%2e%2e/a.stl",
+                          "/robot-mesh//etc/a.stl", "/robot-mesh/1.stl/../../a",
+                          "/robot-mesh/9999999.stl", "/js/robot-mesh/1.stl", "/robot-mesh/1.STL"})
+    EXPECT_FALSE(parse_robot_mesh_target(bad)) << bad;
 }
 
 TEST(HttpRules, HostMustBeLoopbackAnAddressOrTheBoundName) {

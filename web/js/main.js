@@ -23,6 +23,7 @@ const page = {
   scene: null,       // the last "scene" message
   state: null,       // the last "state" message
   sliders: [],       // per joint: {slider, row, value, mark, lo, hi}
+  robotWarnings: [], // robot meshes not drawn, as shown in the panel
   stats: { states: 0, positions: 0, errors: [], editingStates: 0, stateTimes: [] },
 };
 
@@ -97,7 +98,21 @@ function onScene(scene) {
   $('sketch').title = scene.bar ? 'Sketch a centre-line with the mouse (C)' : 'Only for bar-like objects';
   $('link-section').hidden = !scene.link;
   buildJointSliders(scene.robot);
+  showRobotWarnings(scene.warnings ?? []);
 }
+
+// Robot meshes the server could not find (the scene's "warnings") or the page could not draw:
+// a line each in the panel, and a toast.
+function showRobotWarnings(lines) {
+  page.robotWarnings = lines;
+  const box = $('robot-warnings');
+  box.textContent = lines.join('\n');
+  box.hidden = lines.length === 0;
+  if (lines.length) toast(lines.length === 1 ? lines[0] : `${lines.length} robot meshes are not drawn: see the panel`);
+}
+view.robotView.group.addEventListener('meshloaded', () => view.requestRender());
+view.ghostView.group.addEventListener('meshloaded', () => view.requestRender());
+view.robotView.group.addEventListener('mesherror', (e) => showRobotWarnings([...page.robotWarnings, e.message]));
 
 function buildJointSliders(robot) {
   const box = $('joints');
@@ -273,6 +288,9 @@ window.shapectl = {
   get renderPending() { return view.renderPending; },
   observedPoints: () => view.observedPoints(),
   robotColors: () => view.robotView.visualColors(),
+  robotMeshes: () => view.robotView.meshVisuals(),
+  get robotWarnings() { return page.robotWarnings; },
   ghost: () => ({ visible: view.ghostView.visible, links: view.ghostView.robotView.linkPoses(),
-    colors: view.ghostView.robotView.visualColors(), meshes: view.ghostView.group.children.reduce((n, g) => n + g.children.length, 0) }),
+    colors: view.ghostView.robotView.visualColors(), meshes: view.ghostView.group.children.reduce((n, g) => n + g.children.length, 0),
+    meshVisuals: view.ghostView.robotView.meshVisuals() }),
 };

@@ -53,6 +53,14 @@ export const ShapeKind = Object.freeze({
   Sphere: 'sphere',
   Box: 'box',
   Cylinder: 'cylinder',
+  Mesh: 'mesh',  // with "url" (null when the server could not find it), "format", "scale", "file"
+});
+
+// A mesh visual's "format": also the extension of its "url".
+export const MeshFormat = Object.freeze({
+  Stl: 'stl',
+  Obj: 'obj',
+  Dae: 'dae',
 });
 
 // A calibration parameter's "name" in a state's "calibration.result.parameters" (and

@@ -1,8 +1,11 @@
 // The robot in the 3D view: one group per link (its visuals, in the URDF's colours or else one
 // colour per link) posed from each state's link poses, and the collision spheres, shown on
 // request. World frame, metres. With `opacity` < 1 and no spheres it draws the ghost robot.
+// Mesh visuals arrive later (mesh_loader.js): `group` then dispatches 'meshloaded', or
+// 'mesherror' with a `message` naming the file when one cannot be drawn.
 import * as THREE from 'three';
-import { ShapeKind } from './protocol.js';
+import { MeshFormat, ShapeKind } from './protocol.js';
+import { loadMesh, triangleVertexCount } from './mesh_loader.js';
 
 const SPHERE_MATERIAL = new THREE.MeshBasicMaterial({ color: 0x66ccff, wireframe: true, transparent: true, opacity: 0.35 });
 
@@ -31,6 +34,23 @@ function shapeGeometry(shape) {
   return new THREE.SphereGeometry(shape.radius, 24, 16);
 }
 
+// Gives the loaded mesh the URDF's colour, else (STL, OBJ) the link's; a DAE without a URDF
+// colour keeps its own materials, made translucent for the ghost.
+function colourMesh(object, shape, index, opacity) {
+  object.traverse((o) => {
+    if (!o.isMesh) return;
+    if (shape.color || shape.format !== MeshFormat.Dae) {
+      o.material = shapeMaterial(shape, index, opacity);
+      return;
+    }
+    for (const m of Array.isArray(o.material) ? o.material : [o.material]) {
+      m.opacity *= opacity;
+      m.transparent = m.opacity < 1;
+      m.depthWrite = m.opacity >= 1;
+    }
+  });
+}
+
 export class RobotView {
   // `opacity` scales every visual's alpha; `spheres`: whether to draw the collision spheres.
   constructor({ opacity = 1, spheres = true } = {}) {
@@ -42,6 +62,8 @@ export class RobotView {
     this.sphereMeshes = [];   // collision spheres (their own toggle)
     this.robotVisible = true;
     this.spheresVisible = false;
+    this.meshes = [];         // per mesh visual: {link, url, format, holder, state, vertices, problem}
+    this.generation = 0;      // loads for an older robot are dropped
   }
 
   // Rebuilds the links from a scene message's "robot" (null: no robot).
@@ -54,12 +76,18 @@ export class RobotView {
     this.linkGroups = [];
     this.visualMeshes = [];
     this.sphereMeshes = [];
+    this.meshes = [];
+    this.generation++;
     if (!robot) return;
     robot.links.forEach((link, index) => {
       const group = new THREE.Group();
       group.matrixAutoUpdate = false;
       group.name = link.name;
       for (const shape of link.visuals) {
+        if (shape.kind === ShapeKind.Mesh) {
+          this.addMeshVisual(group, shape, index);
+          continue;
+        }
         const mesh = new THREE.Mesh(shapeGeometry(shape), shapeMaterial(shape, index, this.opacity));
         mesh.matrixAutoUpdate = false;
         mesh.matrix.fromArray(shape.pose);
@@ -80,6 +108,42 @@ export class RobotView {
     }
   }
 
+  // A placeholder at the visual's pose that the mesh fills once loaded. Missing on the server
+  // (no url): nothing to draw, the scene message's warnings say so.
+  addMeshVisual(group, shape, index) {
+    const entry = { link: group.name, file: shape.file, url: shape.url, format: shape.format, holder: null,
+      state: shape.url ? 'loading' : 'missing', vertices: 0, problem: shape.url ? null : shape.missing };
+    this.meshes.push(entry);
+    if (!shape.url) return;
+    const holder = new THREE.Group();
+    holder.matrixAutoUpdate = false;
+    holder.matrix.fromArray(shape.pose);
+    holder.visible = this.robotVisible;
+    group.add(holder);
+    this.visualMeshes.push(holder);
+    entry.holder = holder;
+    const generation = this.generation;
+    loadMesh(shape.url, shape.format).then((object) => {
+      if (generation !== this.generation) return;
+      object.scale.multiply(new THREE.Vector3(...shape.scale));
+      colourMesh(object, shape, index, this.opacity);
+      holder.add(object);
+      Object.assign(entry, { state: 'loaded', vertices: triangleVertexCount(object) });
+      this.group.dispatchEvent({ type: 'meshloaded' });
+    }).catch((error) => {
+      if (generation !== this.generation) return;
+      const problem = `link '${group.name}': mesh '${shape.file}' (${shape.url}) could not be drawn: ${error?.message ?? error}`;
+      Object.assign(entry, { state: 'failed', problem });
+      this.group.dispatchEvent({ type: 'mesherror', message: problem });
+    });
+  }
+
+  // For tests: each mesh visual, its link, url, state ('loading', 'loaded', 'failed',
+  // 'missing'), the vertices drawn and the problem if any.
+  meshVisuals() {
+    return this.meshes.map(({ holder, ...m }) => ({ ...m, visible: !!holder?.visible }));
+  }
+
   // `poses`: a state's "links", 16 numbers (column-major T_world_link) per link.
   setLinkPoses(poses) {
     poses.forEach((pose, k) => {
@@ -94,8 +158,12 @@ export class RobotView {
     return this.linkGroups.map((group) => ({
       name: group.name,
       visuals: group.children.filter((o) => this.visualMeshes.includes(o)).map((m) => {
-        m.material.color.getRGB(srgb, THREE.SRGBColorSpace);
-        return { rgb: [srgb.r, srgb.g, srgb.b], opacity: m.material.opacity };
+        // A mesh visual: its first triangle mesh's material (none until loaded).
+        let material = m.material;
+        m.traverse((o) => { if (!material && o.isMesh) material = [].concat(o.material)[0]; });
+        if (!material) return { rgb: null, opacity: null };
+        material.color.getRGB(srgb, THREE.SRGBColorSpace);
+        return { rgb: [srgb.r, srgb.g, srgb.b], opacity: material.opacity };
       }),
     }));
   }

@@ -15,14 +15,19 @@ namespace shapectl {
 
 enum class JointType { Fixed, Revolute, Continuous, Prismatic };
 
-// A primitive attached to a link. Cylinders run along z of their own frame (URDF convention).
+// A primitive or (visuals only) a mesh attached to a link. Cylinders run along z of their own
+// frame (URDF convention).
 struct Shape {
-  enum class Kind { Sphere, Box, Cylinder };
+  enum class Kind { Sphere, Box, Cylinder, Mesh };
   Kind kind = Kind::Sphere;
   Eigen::Isometry3d T_link_shape = Eigen::Isometry3d::Identity();
   Vec3 box_size = Vec3::Zero();  // full edge lengths along x, y, z (box), metres
   double radius = 0;             // sphere, cylinder; metres
   double length = 0;             // cylinder; metres
+  // Mesh: the file name as the URDF writes it ("package://pkg/meshes/a.stl"; visual_meshes.hpp
+  // finds the file) and the URDF's per-axis scale, applied before T_link_shape.
+  std::string mesh_filename;
+  Vec3 mesh_scale = Vec3::Ones();
   // The URDF material's colour (visuals only): red, green, blue, alpha in [0, 1]; none when the
   // URDF gives no colour (the GUI then picks one per link).
   std::optional<Eigen::Vector4d> rgba;
@@ -30,9 +35,11 @@ struct Shape {
 
 struct Link {
   std::string name;
-  int parent_joint = -1;                // index into joints(); -1 for the root
-  std::vector<Shape> collision_shapes;  // meshes are not loaded (a warning says so)
-  std::vector<Shape> visual_shapes;
+  int parent_joint = -1;  // index into joints(); -1 for the root
+  // Collision meshes are not loaded: the collision spheres are the collision model (one warning
+  // says so); `shapectl author` covers them with spheres (urdf_collision.hpp).
+  std::vector<Shape> collision_shapes;
+  std::vector<Shape> visual_shapes;  // primitives and meshes
 };
 
 struct Joint {

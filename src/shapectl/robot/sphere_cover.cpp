@@ -102,6 +102,7 @@ std::vector<CoverSphere> cover_shape(const Shape& shape) {
     case Shape::Kind::Sphere: local = {{Vec3::Zero(), shape.radius}}; break;
     case Shape::Kind::Box: local = cover_box(shape.box_size); break;
     case Shape::Kind::Cylinder: local = cover_cylinder(shape.radius, shape.length); break;
+    case Shape::Kind::Mesh: break;  // a mesh file: cover_triangle_mesh once it is read
   }
   for (auto& s : local) s.center = shape.T_link_shape * s.center;
   return local;

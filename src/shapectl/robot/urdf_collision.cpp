@@ -25,11 +25,6 @@ Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
   return T;
 }
 
-bool exists_file(const std::filesystem::path& p) {
-  std::error_code error;
-  return std::filesystem::is_regular_file(p, error);
-}
-
 }  // namespace
 
 std::vector<MeshCollision> read_mesh_collisions(const RobotModel& model,
@@ -62,27 +57,6 @@ std::vector<MeshCollision> read_mesh_collisions(const RobotModel& model,
     }
   }
   return meshes;
-}
-
-std::optional<std::filesystem::path> resolve_mesh_file(
-    const std::string& filename, const std::filesystem::path& urdf_directory,
-    const std::vector<std::filesystem::path>& package_paths) {
-  const std::string package = "package://", file = "file://";
-  if (filename.rfind(package, 0) == 0) {
-    const std::string rest = filename.substr(package.size());
-    const auto slash = rest.find('/');
-    const std::filesystem::path within = slash == std::string::npos ? "" : rest.substr(slash + 1);
-    for (const auto& dir : package_paths) {
-      if (exists_file(dir / rest)) return dir / rest;
-      if (!within.empty() && exists_file(dir / within)) return dir / within;
-    }
-    return std::nullopt;
-  }
-  std::filesystem::path path =
-      filename.rfind(file, 0) == 0 ? filename.substr(file.size()) : filename;
-  if (path.is_relative()) path = urdf_directory / path;
-  if (exists_file(path)) return path;
-  return std::nullopt;
 }
 
 }  // namespace shapectl

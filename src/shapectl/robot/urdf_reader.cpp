@@ -169,10 +169,11 @@ class UrdfReader {
                          "not reachable from the root " + named("link", urdf->getRoot()->name) +
                              " (a kinematic loop?)");
     resolve_mimics(*urdf, model);
-    if (skipped_meshes_ > 0)
-      model.warnings_.push_back(
-          source_ + ": " + std::to_string(skipped_meshes_) +
-          " mesh geometries skipped (meshes are not loaded), first: " + first_skipped_);
+    if (ignored_collision_meshes_ > 0)
+      model.warnings_.push_back(source_ + ": " + std::to_string(ignored_collision_meshes_) +
+                                " collision meshes ignored for the collision model (the "
+                                "collision spheres are the collision model), first: " +
+                                first_ignored_);
     model.fixed_values_ = Eigen::VectorXd::Zero(model.joint_count());
     std::vector<std::string> movable;
     for (const Joint& joint : model.joints_)
@@ -351,7 +352,7 @@ class UrdfReader {
     return rgba.cwiseMax(0.0).cwiseMin(1.0);
   }
 
-  // Returns whether a shape was added (meshes are skipped).
+  // Returns whether a shape was added (collision meshes are not).
   bool add_shape(const std::string& link, const std::string& kind,
                  const urdf::GeometrySharedPtr& geometry, const urdf::Pose& origin,
                  std::vector<Shape>& shapes) {
@@ -386,13 +387,22 @@ class UrdfReader {
         shape.length = positive(cylinder.length, "cylinder length");
         break;
       }
-      default: {
-        if (skipped_meshes_++ == 0)
-          first_skipped_ = element + " mesh '" +
-                           bounded_preview(static_cast<const urdf::Mesh&>(*geometry).filename) +
-                           "'";
-        return false;
+      case urdf::Geometry::MESH: {
+        const auto& mesh = static_cast<const urdf::Mesh&>(*geometry);
+        if (kind != "visual") {
+          if (ignored_collision_meshes_++ == 0)
+            first_ignored_ = element + " mesh '" + bounded_preview(mesh.filename) + "'";
+          return false;
+        }
+        shape.kind = Shape::Kind::Mesh;
+        shape.mesh_filename = mesh.filename;
+        shape.mesh_scale = {mesh.scale.x, mesh.scale.y, mesh.scale.z};
+        if (!shape.mesh_scale.allFinite() || !(shape.mesh_scale.cwiseAbs().minCoeff() > 0))
+          throw InputError(where, element + " mesh scale", "three finite non-zero numbers",
+                           vec_text(shape.mesh_scale));
+        break;
       }
+      default: return false;
     }
     shapes.push_back(shape);
     return true;
@@ -432,8 +442,8 @@ class UrdfReader {
   std::string source_;
   std::map<std::string, int> joint_lines_;
   std::map<std::string, int> link_lines_;
-  int skipped_meshes_ = 0;
-  std::string first_skipped_;
+  int ignored_collision_meshes_ = 0;
+  std::string first_ignored_;
 };
 
 RobotModel RobotModel::from_urdf_string(const std::string& xml, const std::string& source_name) {

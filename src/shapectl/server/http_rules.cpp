@@ -113,6 +113,20 @@ std::optional<std::filesystem::path> resolve_static_file(const std::filesystem::
   return file;
 }
 
+std::optional<RobotMeshRequest> parse_robot_mesh_target(std::string_view target) {
+  std::string_view path = target.substr(0, target.find('?'));
+  if (!path.starts_with(robot_mesh_prefix)) return std::nullopt;
+  path.remove_prefix(robot_mesh_prefix.size());
+  const std::size_t dot = path.find('.');
+  if (dot == std::string_view::npos) return std::nullopt;
+  const std::string_view number = path.substr(0, dot), extension = path.substr(dot + 1);
+  if (!all_digits(number) || number.size() > 6 || (number.size() > 1 && number[0] == '0'))
+    return std::nullopt;
+  if (extension != "stl" && extension != "obj" && extension != "dae") return std::nullopt;
+  return RobotMeshRequest{static_cast<std::size_t>(std::stoul(std::string(number))),
+                          std::string(extension)};
+}
+
 std::string content_type(const std::filesystem::path& file) {
   const std::string ext = lower(file.extension().string());
   if (ext == ".html") return "text/html; charset=utf-8";
@@ -123,6 +137,9 @@ std::string content_type(const std::filesystem::path& file) {
   if (ext == ".svg") return "image/svg+xml";
   if (ext == ".ico") return "image/x-icon";
   if (ext == ".md" || ext == ".txt") return "text/plain; charset=utf-8";
+  if (ext == ".stl") return "model/stl";
+  if (ext == ".obj") return "model/obj";
+  if (ext == ".dae") return "model/vnd.collada+xml";
   return "application/octet-stream";
 }
 

@@ -15,7 +15,18 @@ namespace shapectl::server {
 std::optional<std::filesystem::path> resolve_static_file(const std::filesystem::path& web_root,
                                                          std::string_view target);
 
-// "text/javascript; charset=utf-8" for .js, and so on; application/octet-stream when unknown.
+// A robot mesh the page asks for: "/robot-mesh/<n>.<ext>" (an optional "?..." ignored) gives the
+// table index n and ext ("stl"); nullopt for anything else. No path ever comes from the request:
+// the session maps n to a file the URDF named (Session::robot_mesh_file).
+inline constexpr std::string_view robot_mesh_prefix = "/robot-mesh/";
+struct RobotMeshRequest {
+  std::size_t index = 0;
+  std::string extension;
+};
+std::optional<RobotMeshRequest> parse_robot_mesh_target(std::string_view target);
+
+// "text/javascript; charset=utf-8" for .js, model/stl for .stl, and so on;
+// application/octet-stream when unknown.
 std::string content_type(const std::filesystem::path& file);
 
 // DNS rebinding guard: the Host header must name a loopback or literal IP address, or the

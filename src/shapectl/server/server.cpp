@@ -253,7 +253,12 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     if (websocket::is_upgrade(request)) return upgrade(std::move(request), host);
     if (request.method() != http::verb::get && request.method() != http::verb::head)
       return reply_text(request, http::status::method_not_allowed, "GET or HEAD only\n");
-    const auto file = resolve_static_file(server_.options.web_root, view(request.target()));
+    const std::string_view target = view(request.target());
+    std::optional<std::filesystem::path> file;
+    if (!target.starts_with(robot_mesh_prefix))
+      file = resolve_static_file(server_.options.web_root, target);
+    else if (const auto mesh = parse_robot_mesh_target(target))
+      file = server_.session.robot_mesh_file(mesh->index, mesh->extension);
     if (!file) return reply_text(request, http::status::not_found, "not found\n");
     http::file_body::value_type body;
     body.open(file->c_str(), beast::file_mode::scan, ec);

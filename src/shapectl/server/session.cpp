@@ -12,6 +12,7 @@
 #include <shapectl/link/robot_link.hpp>
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
+#include <shapectl/server/http_rules.hpp>  // robot_mesh_prefix
 
 namespace shapectl::server {
 
@@ -82,6 +83,7 @@ const char* kind_name(Shape::Kind kind) {
     case Shape::Kind::Sphere: return "sphere";
     case Shape::Kind::Box: return "box";
     case Shape::Kind::Cylinder: return "cylinder";
+    case Shape::Kind::Mesh: return "mesh";
   }
   return "sphere";
 }
@@ -96,12 +98,34 @@ nlohmann::json shape_json(const Shape& s) {
                            : nlohmann::json(nullptr)}};
 }
 
-nlohmann::json robot_json(const RobotSetup& setup) {
+// A mesh visual's file for the page: "url" /robot-mesh/<n>.<ext> (n: its index in `meshes`,
+// the table the server answers from), or null with "missing" when it cannot be drawn.
+void add_mesh_file(nlohmann::json& visual, const VisualMesh& mesh, std::size_t index,
+                   const RobotModel& model) {
+  const Shape& s = model.links()[static_cast<std::size_t>(mesh.link)]
+                       .visual_shapes[static_cast<std::size_t>(mesh.shape)];
+  visual["scale"] = vec3_json(s.mesh_scale);
+  visual["format"] = to_string(mesh.format);
+  visual["file"] = s.mesh_filename;
+  visual["url"] = mesh.file ? nlohmann::json(std::string(robot_mesh_prefix) +
+                                             std::to_string(index) + "." + to_string(mesh.format))
+                            : nlohmann::json(nullptr);
+  if (!mesh.file) visual["missing"] = visual_mesh_warning(model, mesh);
+}
+
+nlohmann::json robot_json(const RobotSetup& setup, const std::vector<VisualMesh>& meshes) {
   const RobotModel& model = *setup.model;
   nlohmann::json links = nlohmann::json::array();
+  std::size_t next_mesh = 0;  // meshes are in link and visual order
   for (const Link& link : model.links()) {
     nlohmann::json visuals = nlohmann::json::array();
-    for (const Shape& s : link.visual_shapes) visuals.push_back(shape_json(s));
+    for (const Shape& s : link.visual_shapes) {
+      visuals.push_back(shape_json(s));
+      if (s.kind == Shape::Kind::Mesh && next_mesh < meshes.size()) {
+        add_mesh_file(visuals.back(), meshes[next_mesh], next_mesh, model);
+        ++next_mesh;
+      }
+    }
     links.push_back({{"name", link.name}, {"visuals", visuals}});
   }
   nlohmann::json spheres = nlohmann::json::array();
@@ -120,6 +144,14 @@ nlohmann::json robot_json(const RobotSetup& setup) {
           {"reference_joints", vector_json(setup.reference_joints)},
           {"end_effectors", end_effectors},
           {"collision_spheres", spheres}};
+}
+
+// What the page must show as a warning: each visual mesh that cannot be drawn.
+nlohmann::json mesh_warnings(const Scene& scene, const std::vector<VisualMesh>& meshes) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const VisualMesh& m : meshes)
+    if (!m.file && scene.robot) out.push_back(visual_mesh_warning(*scene.robot->model, m));
+  return out;
 }
 
 nlohmann::json link_status_json(const LinkStatus& s) {
@@ -181,11 +213,13 @@ std::vector<SceneEntry> find_bundled_scenes(const std::filesystem::path& directo
 }
 
 Session::Session(const std::filesystem::path& scene, std::vector<SceneEntry> scenes,
-                 RobotLink* link, ControllerOptions options, OnlineCalibrationOptions calibration)
+                 RobotLink* link, ControllerOptions options, OnlineCalibrationOptions calibration,
+                 std::vector<std::filesystem::path> package_paths)
     : scenes_(std::move(scenes)),
       link_(link),
       options_(options),
-      calibration_options_(std::move(calibration)) {
+      calibration_options_(std::move(calibration)),
+      package_paths_(std::move(package_paths)) {
   const std::string name = scene.filename().string();
   auto same = [&](const SceneEntry& e) { return e.name == name; };
   auto it = std::find_if(scenes_.begin(), scenes_.end(), same);
@@ -238,7 +272,19 @@ void Session::load(const SceneEntry& entry) {
   logged_sequence_ = 0;
   // Only an armed link has something to say about it (at start-up it is disarmed already).
   if (link_ && link_->status().armed) link_->disarm("scene changed to " + entry.name);
+  robot_meshes_ = find_visual_meshes(*scene.robot->model, package_paths_);
   scene_description_ = describe_scene();
+}
+
+std::optional<std::filesystem::path> Session::robot_mesh_file(std::size_t index,
+                                                              std::string_view extension) const {
+  if (index >= robot_meshes_.size()) return std::nullopt;
+  const VisualMesh& mesh = robot_meshes_[index];
+  std::error_code error;
+  if (!mesh.file || extension != to_string(mesh.format) ||
+      std::filesystem::file_size(*mesh.file, error) > max_visual_mesh_bytes || error)
+    return std::nullopt;
+  return mesh.file;
 }
 
 double Session::now() const {
@@ -460,7 +506,9 @@ nlohmann::json Session::describe_scene() const {
           {"triangles", triangles},
           {"grips", grips},
           {"bar", bar},
-          {"robot", scene.robot ? robot_json(*scene.robot) : nlohmann::json(nullptr)},
+          {"robot",
+           scene.robot ? robot_json(*scene.robot, robot_meshes_) : nlohmann::json(nullptr)},
+          {"warnings", mesh_warnings(scene, robot_meshes_)},
           {"link", link_ != nullptr},
           {"limits",
            {{"max_message_bytes", max_message_bytes},

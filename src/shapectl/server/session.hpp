@@ -17,6 +17,7 @@
 #include <shapectl/calib/online_calibration.hpp>
 #include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/control/controller.hpp>
+#include <shapectl/robot/visual_meshes.hpp>
 #include <shapectl/server/protocol.hpp>
 
 namespace shapectl {
@@ -49,10 +50,11 @@ class Session {
   // load_scene may switch to; `scene` is added to them if absent. `link` may be null; with a
   // link, only the scenes with its robot's active joints are offered.
   // Observed frames (`observe`, the simulated world) go through an OnlineCalibration made
-  // with `calibration`.
+  // with `calibration`. The URDF's package:// meshes are searched in `package_paths`.
   Session(const std::filesystem::path& scene, std::vector<SceneEntry> scenes,
           RobotLink* link = nullptr, ControllerOptions options = {},
-          OnlineCalibrationOptions calibration = {});
+          OnlineCalibrationOptions calibration = {},
+          std::vector<std::filesystem::path> package_paths = {});
   ~Session();
 
   struct Reply {
@@ -79,6 +81,10 @@ class Session {
   // JSON "scene" message: static description (robot geometry, mesh triangles, grips, scene
   // list, limits, history). Sent on connect and after a scene switch.
   std::string scene_message() const;
+  // The file of the scene robot's visual mesh `index` (its "url" in the scene message) if it was
+  // found, has that extension and is still within max_visual_mesh_bytes; else nullopt.
+  std::optional<std::filesystem::path> robot_mesh_file(std::size_t index,
+                                                       std::string_view extension) const;
   // JSON "state" message for the latest snapshot (at most as old as the last tick()).
   std::string state_message(int clients) const;
   std::shared_ptr<const ControllerSnapshot> snapshot() const { return snapshot_; }
@@ -109,6 +115,8 @@ class Session {
   std::unique_ptr<OnlineCalibration> calibration_;  // of controller_: destroyed before it
   std::shared_ptr<const ControllerSnapshot> snapshot_;
   nlohmann::json scene_description_;  // the static part of scene_message()
+  std::vector<std::filesystem::path> package_paths_;
+  std::vector<VisualMesh> robot_meshes_;  // of the current scene's robot, found or not
   bool paused_ = false;  // as the clients set it (the controller ignores jogs unless paused)
   ShapeTargets targets_;
   // Joints asked for by jogs since the last pause: quick jogs of two joints must not undo each
