@@ -15,6 +15,7 @@
 #include "closed_loop_options.hpp"
 #include "commands.hpp"
 #include "link_options.hpp"
+#include "result_json.hpp"
 
 namespace shapectl::cli {
 
@@ -30,7 +31,8 @@ struct ServeArgs {
   std::string web_root;
   std::string scenes_dir;
   double rate = 30;
-  ClosedLoopArgs loop;  // the simulated real object, the online calibration
+  double tolerance = 1e-3;  // m
+  ClosedLoopArgs loop;      // the simulated real object, the online calibration
 };
 
 // The session log if --log names one, opened with a "session" event; else null.
@@ -79,8 +81,10 @@ void run_serve(const ServeArgs& args) {
       link->start();
     }
   }
-  server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(), {},
-                          online_calibration_options(args.loop, "serve"));
+  ControllerOptions controller_options;
+  controller_options.tolerance = args.tolerance;
+  server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(),
+                          controller_options, online_calibration_options(args.loop, "serve"));
   session.set_log(log.get());
   if (!args.loop.world.empty()) {
     if (args.robot != "sim")
@@ -136,6 +140,7 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--rate", args->rate, "State messages per second to each page")
       ->check(CLI::Range(1.0, 120.0))
       ->capture_default_str();
+  add_tolerance_option(*cmd, args->tolerance);
   cmd->callback([args] { run_serve(*args); });
 }
 

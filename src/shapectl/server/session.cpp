@@ -48,6 +48,12 @@ nlohmann::json model_json(const ControllerSnapshot& s, const Scene& scene) {
 }
 
 // The session's calibration: whether one runs, and the newest result (docs/gui.md).
+// The closest checked sphere pair, as indices into the scene message's collision_spheres.
+nlohmann::json closest_pair_json(const SphereClearance& pair) {
+  if (pair.first < 0) return nullptr;
+  return {{"spheres", {pair.first, pair.second}}, {"clearance", finite_or_null(pair.clearance)}};
+}
+
 nlohmann::json calibration_json(const OnlineCalibrationStatus& c) {
   nlohmann::json result = nullptr;
   if (const CalibrationResult* r = c.result.get()) {
@@ -96,8 +102,38 @@ nlohmann::json shape_json(const Shape& s) {
                            : nlohmann::json(nullptr)}};
 }
 
+// The active joints (θ indices) in chain order, depth first from the root link so each arm's
+// joints run shoulder to wrist (a URDF may list them in any order), with each one's position
+// in its chain (1: the first movable joint from the root).
+struct ChainOrder {
+  std::vector<int> joints;
+  std::vector<int> positions;  // per θ index
+};
+ChainOrder chain_order(const RobotModel& model) {
+  ChainOrder out;
+  out.positions.assign(static_cast<std::size_t>(model.active_count()), 0);
+  std::vector<std::pair<int, int>> links;  // link, active joints above it
+  for (int l = 0; l < model.link_count(); ++l)
+    if (model.links()[l].parent_joint < 0) links.push_back({l, 0});
+  while (!links.empty()) {
+    auto [link, depth] = links.back();
+    links.pop_back();
+    const int parent = model.links()[link].parent_joint;
+    if (parent >= 0 && model.active_index(parent) >= 0) {
+      out.joints.push_back(model.active_index(parent));
+      out.positions[static_cast<std::size_t>(model.active_index(parent))] = ++depth;
+    }
+    // Children pushed in reverse so the first-listed child is visited first.
+    for (int j = model.joint_count() - 1; j >= 0; --j)
+      if (model.joints()[j].parent_link == link)
+        links.push_back({model.joints()[j].child_link, depth});
+  }
+  return out;
+}
+
 nlohmann::json robot_json(const RobotSetup& setup) {
   const RobotModel& model = *setup.model;
+  const ChainOrder chain = chain_order(model);
   nlohmann::json links = nlohmann::json::array();
   for (const Link& link : model.links()) {
     nlohmann::json visuals = nlohmann::json::array();
@@ -117,6 +153,8 @@ nlohmann::json robot_json(const RobotSetup& setup) {
           {"joint_names", model.active_joint_names()},
           {"lower_limits", vector_json(model.lower_limits())},
           {"upper_limits", vector_json(model.upper_limits())},
+          {"chain_order", chain.joints},
+          {"chain_positions", chain.positions},
           {"reference_joints", vector_json(setup.reference_joints)},
           {"end_effectors", end_effectors},
           {"collision_spheres", spheres}};
@@ -464,7 +502,8 @@ nlohmann::json Session::describe_scene() const {
           {"limits",
            {{"max_message_bytes", max_message_bytes},
             {"max_coordinate", max_coordinate},
-            {"max_centerline_points", max_centerline_points}}}};
+            {"max_centerline_points", max_centerline_points},
+            {"max_jog_step", options_.max_jog_step}}}};
 }
 
 std::string Session::scene_message() const {
@@ -488,10 +527,16 @@ std::string Session::state_message(int clients) const {
       {"time", t},
       {"controller_time", s.time},
       {"status", to_string(s.status)},
+      {"status_reason", s.status_reason},
+      {"unreachable", shortfall_names(s.shortfalls)},
+      {"tolerance", s.tolerance},
       {"paused", s.paused},
       {"safe", s.safe},
       {"within_limits", s.within_limits},
       {"min_clearance", finite_or_null(s.min_clearance)},
+      {"colliding_links", s.colliding_links},
+      {"jog_refused_links", s.jog_refused_links},
+      {"closest_pair", closest_pair_json(s.closest_pair)},
       {"iterations", s.iterations},
       {"iterations_per_second", finite_or_null(s.iterations_per_second)},
       {"objective", finite_or_null(s.objective)},
