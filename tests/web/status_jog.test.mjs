@@ -108,7 +108,7 @@ describe('status and jogging', () => {
     const { lower_limits: lower, upper_limits: upper, reference_joints: reference } = scene.robot;
     // Another program walks joints in server-sized steps until a jog is refused for collision.
     let found = null;
-    for (const [k, dir] of [[7, -1], [0, 1], [1, 1], [8, 1], [1, -1], [8, -1], [0, -1], [7, 1]]) {
+    for (const [k, dir] of [[7, 1], [0, -1], [1, 1], [8, 1]]) {
       await send(ws, Command.Reset);
       await waitFor(async () => (await state(page)).joints.every((v, j) => Math.abs(v - reference[j]) < 1e-9), 'the reference joints');
       let value = reference[k], reply;
@@ -155,7 +155,7 @@ describe('status and jogging', () => {
     // With the collision spheres shown, the closest pair is highlighted.
     await hooks(page, () => window.shapectl.setSpheresVisible(true));
     const spheres = await hooks(page, () => window.shapectl.highlightedSpheres());
-    assert.deepEqual(spheres.spheres, s.closest_pair.spheres);
+    assert.deepEqual(spheres.spheres, [...s.closest_pair.spheres].sort((a, b) => a - b));
     assert.ok(spheres.visible);
     // Resuming clears the refusal's red.
     await page.click('#pause');
