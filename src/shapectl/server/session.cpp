@@ -102,32 +102,33 @@ nlohmann::json shape_json(const Shape& s) {
                            : nlohmann::json(nullptr)}};
 }
 
-// The active joints (θ indices) in chain order, depth first from the root link so each arm's
-// joints run shoulder to wrist (a URDF may list them in any order), with each one's position
-// in its chain (1: the first movable joint from the root).
+// The active joints (θ indices) in chain order: each arm shoulder to wrist (a URDF may list
+// them in any order), the arms in θ order of their first joints; with each one's position in
+// its chain (1: the first movable joint from the root).
 struct ChainOrder {
   std::vector<int> joints;
   std::vector<int> positions;  // per θ index
 };
 ChainOrder chain_order(const RobotModel& model) {
+  const auto count = static_cast<std::size_t>(model.active_count());
   ChainOrder out;
-  out.positions.assign(static_cast<std::size_t>(model.active_count()), 0);
-  std::vector<std::pair<int, int>> links;  // link, active joints above it
-  for (int l = 0; l < model.link_count(); ++l)
-    if (model.links()[l].parent_joint < 0) links.push_back({l, 0});
-  while (!links.empty()) {
-    auto [link, depth] = links.back();
-    links.pop_back();
-    const int parent = model.links()[link].parent_joint;
-    if (parent >= 0 && model.active_index(parent) >= 0) {
-      out.joints.push_back(model.active_index(parent));
-      out.positions[static_cast<std::size_t>(model.active_index(parent))] = ++depth;
+  out.positions.assign(count, 0);
+  std::vector<int> first(count, 0);  // per θ index: the θ index of its chain's first joint
+  for (std::size_t k = 0; k < count; ++k) {
+    // Up from the joint to the root, counting the active joints on the way.
+    int depth = 0, top = static_cast<int>(k);
+    for (int joint = model.active_joints()[k]; joint >= 0;) {
+      if (model.active_index(joint) >= 0) ++depth, top = model.active_index(joint);
+      joint = model.links()[model.joints()[joint].parent_link].parent_joint;
     }
-    // Children pushed in reverse so the first-listed child is visited first.
-    for (int j = model.joint_count() - 1; j >= 0; --j)
-      if (model.joints()[j].parent_link == link)
-        links.push_back({model.joints()[j].child_link, depth});
+    out.positions[k] = depth;
+    first[k] = top;
   }
+  out.joints.resize(count);
+  for (std::size_t k = 0; k < count; ++k) out.joints[k] = static_cast<int>(k);
+  std::stable_sort(out.joints.begin(), out.joints.end(), [&](int a, int b) {
+    return std::pair(first[a], out.positions[a]) < std::pair(first[b], out.positions[b]);
+  });
   return out;
 }
 
