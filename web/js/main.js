@@ -6,7 +6,7 @@ import { ConvergencePlot } from './plot.js';
 import { CalibrationPanel } from './calibration_panel.js';
 import { Command } from './protocol.js';
 import { statusBadge } from './status_badge.js';
-import { boundedJog, chainOrder, limitText, JOG_STEP } from './joint_jog.js';
+import { boundedJog, chainOrder, limitText } from './joint_jog.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
@@ -96,7 +96,7 @@ function buildJointSliders(robot) {
     const limits = limitText(robot.lower_limits[k], robot.upper_limits[k]);
     const position = robot.chain_positions?.[k] ? `${robot.chain_positions[k]}. ` : '';
     row.innerHTML = `<span class="name" title="${name}: joint ${position}in its chain, ${limits}">${position}${name}</span>
-      <input type="range" min="${lo}" max="${hi}" step="${JOG_STEP}" aria-label="${name}" data-joint="${k}">
+      <input type="range" min="${lo}" max="${hi}" step="any" aria-label="${name}" data-joint="${k}">
       <span class="value"></span><div class="limit"><i></i></div><span class="limits">${limits}</span>`;
     const slider = row.querySelector('input');
     slider.addEventListener('pointerdown', () => { slider.dragging = true; });
