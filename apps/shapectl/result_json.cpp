@@ -24,6 +24,15 @@ nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints) {
   return out;
 }
 
+void add_tolerance_option(CLI::App& command, double& tolerance) {
+  command
+      .add_option("--tolerance", tolerance,
+                  "M: the largest target error (m) that counts as reached; above it the status "
+                  "is best effort, with the reasons")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+}
+
 void print_scene_notes(const Scene& scene, const std::vector<std::string>& package_paths) {
   if (scene.robot) print_robot_notes(*scene.robot->model, package_paths);
   for (const auto& w : scene.warnings) std::cerr << "warning: " << w << "\n";

@@ -12,6 +12,8 @@ namespace shapectl::cli {
 
 // {"joints": {name: rad}, "tools": {ee name: {"position": [..], "rotation": [[..]..]}}}
 nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints);
+// --tolerance M: the target error (m) under which a result counts as reached (default 1 mm).
+void add_tolerance_option(CLI::App& command, double& tolerance);
 // Throws SolverFailure ("<what>: <field> is not finite (<context>)") if any number in `result` is
 // NaN or infinite: JSON would write it as null, and a result is never written with one.
 void require_finite(const nlohmann::json& result, const std::string& what,

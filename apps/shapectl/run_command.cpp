@@ -6,8 +6,9 @@
 //              [--no-feedback] [--no-online-calibration] [--fit LIST]
 // The controller and the robot link without a GUI: the optimizer's best θ goes to the link
 // whenever it changes; the link's governor moves the robot (only if armed). With
-// --until-settled it exits 0 once the optimizer has converged and the robot has arrived, or 2
-// with the reason when that cannot happen (optimizer stuck, link disarmed, timeout).
+// --until-settled it exits 0 once the optimizer reached the targets (within --tolerance) and
+// the robot has arrived, or 2 with the reason when that cannot happen (best effort: the
+// targets unreachable, with why; optimizer failed, link disarmed, timeout).
 // Observed frames (the simulated world's camera, or UDP datagrams from a real one) close the
 // loop: model-error feedback on their markers and, in the background, calibration of the
 // --fit parameters from a sliding window of them (calib/online_calibration.hpp).
@@ -51,6 +52,7 @@ struct RunArgs {
   bool arm = false;
   bool until_settled = false;
   double timeout = 0;         // s; 0: none
+  double tolerance = 1e-3;    // m: a target error at most this is reached
   std::string robot = "sim";  // a LinkKind name
   LinkArgs link_options;
   LinkConfig link;      // from link_options and the scene (load_run_inputs)
@@ -82,9 +84,11 @@ nlohmann::json link_json(const LinkStatus& s) {
 
 // Why running on cannot settle, or empty.
 std::string cannot_settle(const ControllerSnapshot& s, const LinkStatus& link, bool armed_once) {
-  // With the loop closed, a stuck optimizer is judged by what is observed (settle_decided).
-  if (s.status == ControllerStatus::Stuck && !s.feedback)
-    return "optimizer stuck: no acceptable step (error " + std::to_string(s.error.mean) + " m)";
+  // With the loop closed, the model's best effort is judged by what is observed
+  // (settle_decided).
+  if (s.status == ControllerStatus::BestEffort && !s.feedback)
+    return "targets not reached (best effort): " + s.status_reason;
+  if (s.status == ControllerStatus::Failed) return "optimizer failed: " + s.status_reason;
   if (!s.last_error.empty()) return "optimizer: " + s.last_error;
   if (armed_once && !link.armed) return "robot link disarmed: " + link.reason;
   return {};
@@ -210,13 +214,14 @@ bool settle_decided(const ControllerSnapshot& s, const LinkStatus& st, bool arme
                     RunOutcome& outcome) {
   outcome.failure = cannot_settle(s, st, armed);
   if (!outcome.failure.empty()) return true;
-  const bool stationary = s.status == ControllerStatus::Converged ||
-                          (s.feedback && s.status == ControllerStatus::Stuck);
+  const bool stationary = s.status == ControllerStatus::Reached ||
+                          (s.feedback && s.status == ControllerStatus::BestEffort);
   if (!stationary) return false;
   // Not armed, the robot is never asked to move: it cannot arrive, so say so.
   if (!armed) {
     outcome.failure =
-        "the optimizer converged, but the robot is not armed (--arm), so it cannot arrive";
+        "the optimizer reached the targets, but the robot is not armed (--arm), so it cannot "
+        "arrive";
     return true;
   }
   outcome.settled = st.arrived;
@@ -336,10 +341,13 @@ LinkStatus stop_run(RobotLink& link, Controller& controller, const std::string& 
 nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status,
                           RobotLink& link, const Observers& observers) {
   const ControllerSnapshot& snap = *outcome.snapshot;
-  nlohmann::json result = {{"settled", outcome.settled},         {"status", to_string(snap.status)},
-                           {"error_mean", snap.error.mean},      {"error_max", snap.error.max},
-                           {"iterations", snap.iterations},      {"joint_names", snap.joint_names},
-                           {"joints", vector_json(snap.joints)}, {"link", link_json(final_status)}};
+  nlohmann::json result = {
+      {"settled", outcome.settled},          {"status", to_string(snap.status)},
+      {"status_reason", snap.status_reason}, {"unreachable", shortfall_names(snap.shortfalls)},
+      {"tolerance", snap.tolerance},         {"error_mean", snap.error.mean},
+      {"error_max", snap.error.max},         {"iterations", snap.iterations},
+      {"joint_names", snap.joint_names},     {"joints", vector_json(snap.joints)},
+      {"link", link_json(final_status)}};
   if (auto* egm = dynamic_cast<EgmLink*>(&link)) {
     const LatencyStats l = egm->latency();
     result["latency_us"] = {{"samples", l.samples},
@@ -375,7 +383,9 @@ void run(RunArgs args) {
   RunInputs inputs = load_run_inputs(args);
   const std::shared_ptr<SessionLog> log = open_session_log(args, inputs.scene);
   const auto link = make_run_link(args, inputs.scene, log);
-  Controller controller(inputs.scene);
+  ControllerOptions options;
+  options.tolerance = args.tolerance;
+  Controller controller(inputs.scene, options);
   set_run_targets(controller, inputs.targets, log.get());
   if (observed(args)) controller.set_feedback(args.loop.feedback);
   OnlineCalibration calibration(controller, inputs.scene, inputs.calibration);
@@ -406,9 +416,11 @@ void add_run_command(CLI::App& app) {
   cmd->add_flag("--arm", args->arm, "arm the link: let the robot move (otherwise it holds)");
   cmd->add_option("--log", args->log, "session log to write (JSON lines)");
   cmd->add_flag("--until-settled", args->until_settled,
-                "exit 0 once converged and arrived; exit 2 with the reason if that cannot happen");
+                "exit 0 once the targets are reached and the robot arrived; exit 2 with the "
+                "reason if that cannot happen (best effort: the targets are unreachable)");
   cmd->add_option("--timeout", args->timeout, "seconds before giving up (0: none)")
       ->capture_default_str();
+  add_tolerance_option(*cmd, args->tolerance);
   add_link_options(*cmd, args->link_options);
   add_closed_loop_options(*cmd, args->loop, /*feedback_flag=*/true);
   cmd->add_option("--observations-udp", args->observations_udp,

@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "link_options.hpp"
 #include "robot_mesh_options.hpp"
+#include "result_json.hpp"
 
 namespace shapectl::cli {
 
@@ -31,6 +32,7 @@ struct ServeArgs {
   std::string web_root;
   std::string scenes_dir;
   double rate = 30;
+  double tolerance = 1e-3;  // m
   ClosedLoopArgs loop;  // the simulated real object, the online calibration
   // --package-path: the URDF's package:// meshes
   std::vector<std::string> package_paths;
@@ -82,8 +84,10 @@ void run_serve(const ServeArgs& args) {
       link->start();
     }
   }
-  server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(), {},
-                          online_calibration_options(args.loop, "serve"),
+  ControllerOptions controller_options;
+  controller_options.tolerance = args.tolerance;
+  server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(),
+                          controller_options, online_calibration_options(args.loop, "serve"),
                           package_paths(args.package_paths));
   print_robot_notes(session.controller().robot(), args.package_paths);
   session.set_log(log.get());
@@ -142,6 +146,7 @@ void add_serve_command(CLI::App& app) {
       ->check(CLI::Range(1.0, 120.0))
       ->capture_default_str();
   add_package_path_option(*cmd, args->package_paths);
+  add_tolerance_option(*cmd, args->tolerance);
   cmd->callback([args] { run_serve(*args); });
 }
 

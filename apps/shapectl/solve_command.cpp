@@ -1,12 +1,13 @@
 // shapectl solve SCENE.json --targets TARGETS.json --out RESULT.json [--vtu DEFORMED.vtu]
 //   [--surface SURFACE.ply|SURFACE.obj]
 //   [--optimizer lbfgs|gauss-newton] [--gradient sensitivity|adjoint|finite-difference]
-//   [--max-iterations N] [--max-seconds S]
+//   [--max-iterations N] [--max-seconds S] [--tolerance M]
 // Finds joint angles whose equilibrium shape best matches the targets.
 #include <iostream>
 #include <limits>
 
 #include <shapectl/control/centerline.hpp>
+#include <shapectl/control/controller.hpp>
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/atomic_file.hpp>
@@ -32,6 +33,7 @@ struct SolveArgs {
   std::string gradient = "sensitivity";
   int max_iterations = 100;
   double max_seconds = 60;
+  double tolerance = 1e-3;  // m
 };
 
 // The targets the file asks for, checked against this object (InputError naming the file).
@@ -83,6 +85,15 @@ void run_solve(const SolveArgs& args) {
   out["converged"] = result.converged();
   out["termination"] = to_string(result.termination);
   out["reason"] = result.reason;
+  // The run's verdict in the controller's words: reached, best effort (with why) or failed.
+  const ControllerStatus status =
+      stopped_status(best, result.termination == Termination::Failed, args.tolerance);
+  out["status"] = to_string(status);
+  out["tolerance"] = args.tolerance;
+  ShortfallReport shortfall;
+  if (status == ControllerStatus::BestEffort) shortfall = find_shortfalls(objective, best);
+  out["unreachable"] = shortfall_names(shortfall.reasons);
+  out["status_reason"] = shortfall.detail;
   out["iterations"] = result.iterations;
   out["error_mean"] = best.error.mean;
   out["error_max"] = best.error.max;
@@ -121,7 +132,9 @@ void run_solve(const SolveArgs& args) {
   if (!args.surface.empty())
     files.push_back(surface_file(args.surface, object.mesh(), best.positions));
   write_files_atomically(files);
-  std::cerr << "solve: " << result.reason << "; mean error " << best.error.mean * 1e3 << " mm, max "
+  std::cerr << "solve: " << to_string(status)
+            << (shortfall.detail.empty() ? "" : " (" + shortfall.detail + ")") << "; "
+            << result.reason << "; mean error " << best.error.mean * 1e3 << " mm, max "
             << best.error.max * 1e3 << " mm, min clearance " << best.min_clearance * 1e3 << " mm\n";
 }
 
@@ -146,6 +159,7 @@ void add_solve_command(CLI::App& app) {
       ->check(CLI::Range(1, 100000));
   cmd->add_option("--max-seconds", args->max_seconds, "time limit")->check(CLI::PositiveNumber);
   add_package_path_option(*cmd, args->package_paths);
+  add_tolerance_option(*cmd, args->tolerance);
   cmd->callback([args] { run_solve(*args); });
 }
 

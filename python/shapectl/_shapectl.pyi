@@ -134,6 +134,10 @@ class SolveResult:
     converged: bool
     termination: str
     reason: str
+    status: str  # reached, best effort, failed
+    unreachable: List[str]  # joint limit, collision, reach, buckling
+    status_reason: str
+    tolerance: float
     iterations: int
     error_mean: float
     error_max: float
@@ -149,12 +153,15 @@ class SolveResult:
 
 def solve(scene: Scene, targets: Targets, *, optimizer: str = "gauss-newton",
           gradient: str = "sensitivity", max_iterations: int = 100,
-          max_seconds: float = 60.0) -> SolveResult: ...
+          max_seconds: float = 60.0, tolerance: float = 1e-3) -> SolveResult: ...
 
 class ControllerSnapshot:
     sequence: int
     time: float
-    status: str
+    status: str  # idle, optimizing, reached, best effort, paused, failed
+    tolerance: float
+    unreachable: List[str]  # joint limit, collision, reach, buckling
+    status_reason: str
     joint_names: List[str]
     joints: FloatArray
     lower_limits: FloatArray

@@ -89,7 +89,18 @@ void bind_controller(py::module_& m) {
           "Seconds since the controller started.")
       .def_property_readonly(
           "status", [](const S& s) { return std::string(to_string(s.snapshot->status)); },
-          "'idle', 'optimizing', 'converged', 'stuck', 'out of time' or 'paused'.")
+          "'idle', 'optimizing', 'reached' (every target within the tolerance), 'best effort' "
+          "(stopped above it: see unreachable), 'paused' or 'failed'.")
+      .def_property_readonly(
+          "tolerance", [](const S& s) { return s.snapshot->tolerance; },
+          "m: a target error at most this counts as reached.")
+      .def_property_readonly(
+          "unreachable", [](const S& s) { return shortfall_names(s.snapshot->shortfalls); },
+          "'best effort': why, of 'joint limit', 'collision', 'reach', 'buckling' (empty: a "
+          "local minimum).")
+      .def_property_readonly(
+          "status_reason", [](const S& s) { return s.snapshot->status_reason; },
+          "'best effort' or 'failed' in words, with numbers; empty otherwise.")
       .def_property_readonly(
           "joint_names", [](const S& s) { return s.snapshot->joint_names; },
           "Active joints, θ order.")

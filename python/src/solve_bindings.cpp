@@ -5,6 +5,7 @@
 #include <optional>
 
 #include <shapectl/control/centerline.hpp>
+#include <shapectl/control/controller.hpp>
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/json_input.hpp>
@@ -22,6 +23,10 @@ struct SolveResult {
   bool converged = false;
   std::string termination;
   std::string reason;
+  std::string status;  // reached, best effort, failed
+  std::vector<std::string> unreachable;
+  std::string status_reason;
+  double tolerance = 0;
   int iterations = 0;
   double error_mean = 0, error_max = 0, objective = 0;
   std::optional<double> min_clearance;
@@ -53,7 +58,7 @@ ShapeTargets resolve(const TargetsInput& in, const std::string& source,
 
 SolveResult solve(const SceneHandle& s, const py::object& targets_in,
                   const std::string& optimizer_name, const std::string& gradient_name,
-                  int max_iterations, double max_seconds) {
+                  int max_iterations, double max_seconds, double tolerance) {
   if (!s.scene->robot)
     throw InputError(s.scene->source.string(), "robot", "a robot to optimize (missing key)");
   const GrippedObject& object = *s.object;
@@ -65,6 +70,7 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
     throw InputError("gradient", "", "one of the gradient names", gradient_name);
   if (max_iterations < 1) throw InputError("max_iterations", "", "a number >= 1", max_iterations);
   if (!(max_seconds > 0)) throw InputError("max_seconds", "", "a positive number", max_seconds);
+  if (!(tolerance > 0)) throw InputError("tolerance", "", "a positive number of metres", tolerance);
   std::string source;
   const TargetsInput input = read_targets_from(targets_in, object.node_count(), source);
 
@@ -86,6 +92,15 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
   out.converged = result.converged();
   out.termination = to_string(result.termination);
   out.reason = result.reason;
+  const ControllerStatus status =
+      stopped_status(best, result.termination == Termination::Failed, tolerance);
+  out.status = to_string(status);
+  out.tolerance = tolerance;
+  if (status == ControllerStatus::BestEffort) {
+    const ShortfallReport shortfall = find_shortfalls(objective, best);
+    out.unreachable = shortfall_names(shortfall.reasons);
+    out.status_reason = shortfall.detail;
+  }
   out.iterations = result.iterations;
   out.error_mean = best.error.mean;
   out.error_max = best.error.max;
@@ -141,6 +156,15 @@ void bind_solve(py::module_& m) {
       .def_readonly("termination", &SolveResult::termination,
                     "'converged', 'iteration limit', 'time limit', 'stuck' or 'failed'.")
       .def_readonly("reason", &SolveResult::reason, "The termination in words, with numbers.")
+      .def_readonly("status", &SolveResult::status,
+                    "'reached' (every target error within tolerance), 'best effort' (above it: "
+                    "see unreachable) or 'failed'.")
+      .def_readonly("unreachable", &SolveResult::unreachable,
+                    "'best effort': why, of 'joint limit', 'collision', 'reach', 'buckling' "
+                    "(empty: a local minimum).")
+      .def_readonly("status_reason", &SolveResult::status_reason,
+                    "'best effort' in words, with names and numbers; else empty.")
+      .def_readonly("tolerance", &SolveResult::tolerance, "m, as given.")
       .def_readonly("iterations", &SolveResult::iterations, "Optimizer iterations.")
       .def_readonly("error_mean", &SolveResult::error_mean,
                     "Mean distance of targeted nodes from their targets, m.")
@@ -168,7 +192,7 @@ void bind_solve(py::module_& m) {
   m.def(
       "solve", &solve, py::arg("scene"), py::arg("targets"), py::kw_only(),
       py::arg("optimizer") = "gauss-newton", py::arg("gradient") = "sensitivity",
-      py::arg("max_iterations") = 100, py::arg("max_seconds") = 60.0,
+      py::arg("max_iterations") = 100, py::arg("max_seconds") = 60.0, py::arg("tolerance") = 1e-3,
       "From the reference joints, θ whose equilibrium best matches `targets`, as `shapectl solve`. "
       "targets: a TARGETS.json path, or a dict of its schema ({'targets': [{'node': i, 'position': "
       "[x, y, z]}, …]} or {'centerline': [[x, y, z], …]}, numpy arrays allowed). optimizer: "

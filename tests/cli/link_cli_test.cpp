@@ -66,7 +66,8 @@ TEST(RunCli, SimRobotSettlesAndTheLogReplaysWithinTheLimits) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto result = nlohmann::json::parse(run.out);
   EXPECT_TRUE(result["settled"].get<bool>());
-  EXPECT_EQ(result["status"], "converged");
+  EXPECT_EQ(result["status"], "reached");
+  EXPECT_EQ(result["unreachable"], nlohmann::json::array());
   EXPECT_EQ(result["link"]["kind"], "sim");
   // The robot stands exactly at the optimizer's θ.
   EXPECT_EQ(result["link"]["measured"], result["joints"]);

@@ -54,6 +54,17 @@ TEST(SolveCli, ReachesTargetsTakenFromAnotherConfiguration) {
   EXPECT_GT(result["history"][0]["error_mean"].get<double>(), 3e-3);
   EXPECT_GT(result["timing"]["statics_solves"].get<int>(), 0);
   EXPECT_GT(result["timing"]["gradient_seconds"].get<double>(), 0);
+  EXPECT_EQ(result["status"],
+            result["error_max"].get<double>() <= 1e-3 ? "reached" : "best effort");
+  // A tolerance tighter than the error reached says best effort, with why in words.
+  const auto strict = dir.path() / "strict.json";
+  const auto tight = run_json({"solve", kBar, "--targets", targets_file.string(), "--out",
+                               strict.string(), "--tolerance", "1e-9"},
+                              strict);
+  EXPECT_EQ(tight["status"], "best effort");
+  EXPECT_EQ(tight["tolerance"], 1e-9);
+  EXPECT_TRUE(tight["unreachable"].is_array());
+  EXPECT_FALSE(tight["status_reason"].get<std::string>().empty());
 }
 
 TEST(SolveCli, ASolveResultIsAcceptedAsJointsByStatics) {

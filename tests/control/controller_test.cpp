@@ -61,9 +61,11 @@ TEST(Controller, PauseAndJogMoveTheRobotWithoutTheOptimizer) {
   Controller controller(test::two_arm_scene());
   controller.set_paused(true);
   Eigen::VectorXd jog = controller.snapshot()->joints;
-  jog[0] += 0.2;
-  controller.set_joints(jog);
-  controller.step_once();
+  for (int k = 0; k < 4; ++k) {  // 0.2 rad in four steps of at most max_jog_step
+    jog[0] += 0.05;
+    controller.set_joints(jog);
+    controller.step_once();
+  }
   const auto s = controller.snapshot();
   EXPECT_TRUE(s->paused);
   EXPECT_EQ(s->status, ControllerStatus::Paused);
@@ -77,6 +79,111 @@ TEST(Controller, PauseAndJogMoveTheRobotWithoutTheOptimizer) {
   controller.step_once();
   EXPECT_NEAR((controller.snapshot()->joints - controller.scene().robot->reference_joints).norm(),
               0, 1e-12);
+}
+
+TEST(Controller, AJogFartherThanOneStepIsRefusedAndChangesNothing) {
+  Controller controller(test::two_arm_scene());
+  controller.set_paused(true);
+  controller.step_once();
+  const Eigen::VectorXd before = controller.snapshot()->joints;
+  Eigen::VectorXd jog = before;
+  jog[1] += 2.1;  // a slider click's jump
+  try {
+    controller.set_joints(jog);
+    ADD_FAILURE() << "a 2.1 rad jog was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("jog refused: l2: expected a step of at most 0.05"),
+              std::string::npos)
+        << e.what();
+  }
+  controller.step_once();
+  EXPECT_EQ(controller.snapshot()->joints, before);
+}
+
+TEST(Controller, AJogIntoSelfCollisionIsRefusedNamingTheLinks) {
+  // The third links' spheres 1 cm apart; the arms swing towards each other 5 mrad a jog.
+  Controller controller(test::two_arm_scene_with_clearance(0.01));
+  controller.set_paused(true);
+  controller.step_once();
+  std::string refusal;
+  for (double a = 0.005; a < 0.1 && refusal.empty(); a += 0.005) {
+    try {
+      controller.set_joints(test::arms_swung_in(a));
+      controller.step_once();
+    } catch (const InputError& e) {
+      refusal = e.what();
+    }
+  }
+  ASSERT_FALSE(refusal.empty()) << "the arms swung through each other";
+  EXPECT_NE(refusal.find("self-collision: l_link3 and r_link3 would overlap by"), std::string::npos)
+      << refusal;
+  controller.step_once();
+  const auto s = controller.snapshot();
+  EXPECT_GE(s->min_clearance, 0);  // the joints stayed where they were: no overlap
+  EXPECT_TRUE(s->colliding_links.empty());
+  EXPECT_GE(s->closest_pair.first, 0);
+  EXPECT_NEAR(s->closest_pair.clearance, s->min_clearance, 1e-12);
+  const std::vector<int> both = {controller.robot().link_index("l_link3"),
+                                 controller.robot().link_index("r_link3")};
+  EXPECT_EQ(s->jog_refused_links, both);  // drawn red until the next jog
+  controller.set_joints(test::arms_swung_in(0));
+  controller.step_once();
+  EXPECT_TRUE(controller.snapshot()->jog_refused_links.empty());
+}
+
+TEST(Controller, OverlappingLinksArePublishedAndJoggingOutIsAllowed) {
+  Controller controller(test::two_arm_scene_with_clearance(-0.005));  // 5 mm into each other
+  const auto s = controller.snapshot();
+  const std::vector<int> both = {controller.robot().link_index("l_link3"),
+                                 controller.robot().link_index("r_link3")};
+  EXPECT_EQ(s->colliding_links, both);
+  EXPECT_LT(s->closest_pair.clearance, 0);
+  EXPECT_FALSE(s->safe);
+  controller.set_paused(true);
+  controller.step_once();
+  controller.set_joints(test::arms_swung_in(-0.01));  // apart: allowed
+  controller.step_once();
+  EXPECT_GT(controller.snapshot()->min_clearance, s->min_clearance);
+}
+
+TEST(Controller, StatusSaysReachedOnlyWithinTheTolerance) {
+  const Scene scene = test::two_arm_scene();
+  GrippedObject probe(scene);
+  ReducedObjective probe_objective(probe);
+  Eigen::VectorXd goal = probe.reference_joints();
+  goal << 0.05, -0.35, 0.95, -0.05, -0.25, 0.85;
+  const Evaluation e = probe_objective.evaluate(goal, probe.reference_positions());
+  ShapeTargets reachable, beyond;
+  for (int i = 0; i < probe.node_count(); i += 5) {
+    reachable.nodes.push_back(i);
+    reachable.positions.push_back(e.positions.segment<3>(3 * i));
+    beyond.nodes.push_back(i);
+    beyond.positions.push_back(e.positions.segment<3>(3 * i) + Vec3(0, 0, 0.6));
+  }
+  const auto stopped = [](const ControllerSnapshot& s) {
+    return !s.targets.empty() && s.status != ControllerStatus::Optimizing;
+  };
+  Controller controller(scene);
+  controller.start();
+  controller.set_targets(reachable);
+  auto s = wait_until(controller, stopped, 60);
+  EXPECT_EQ(s->status, ControllerStatus::Reached) << to_string(s->status) << s->status_reason;
+  EXPECT_LE(s->error.max, s->tolerance);
+  EXPECT_TRUE(s->shortfalls.empty());
+  // 60 cm above: beyond the arms' reach. Stopped there, the status says so, with the reason.
+  controller.set_targets(beyond);
+  s = wait_until(
+      controller,
+      [&](const ControllerSnapshot& s) {
+        return s.targets.positions == beyond.positions && stopped(s);
+      },
+      60);
+  EXPECT_EQ(s->status, ControllerStatus::BestEffort) << to_string(s->status);
+  EXPECT_GT(s->error.max, s->tolerance);
+  EXPECT_NE(s->status_reason.find("above the tolerance 1.0 mm"), std::string::npos)
+      << s->status_reason;
+  EXPECT_FALSE(s->shortfalls.empty()) << s->status_reason;
+  controller.stop();
 }
 
 TEST(Centerline, StraightSketchAlongTheBarTargetsItsCentreNodes) {

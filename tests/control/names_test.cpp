@@ -29,8 +29,10 @@ void expect_round_trip(std::initializer_list<E> values) {
 
 TEST(Names, EveryStatusAndKindRoundTrips) {
   expect_round_trip({ControllerStatus::Idle, ControllerStatus::Optimizing,
-                     ControllerStatus::Converged, ControllerStatus::Stuck,
-                     ControllerStatus::OutOfTime, ControllerStatus::Paused});
+                     ControllerStatus::Reached, ControllerStatus::BestEffort,
+                     ControllerStatus::Paused, ControllerStatus::Failed});
+  expect_round_trip(
+      {Shortfall::JointLimit, Shortfall::Collision, Shortfall::Reach, Shortfall::Buckling});
   expect_round_trip({Termination::Converged, Termination::IterationLimit, Termination::TimeLimit,
                      Termination::Stuck, Termination::Failed});
   expect_round_trip({OptimizerKind::GaussNewton, OptimizerKind::Lbfgs});
@@ -46,8 +48,12 @@ TEST(Names, TheWebClientKnowsEveryControllerStatus) {
   std::stringstream text;
   text << in.rdbuf();
   for (ControllerStatus s :
-       {ControllerStatus::Idle, ControllerStatus::Optimizing, ControllerStatus::Converged,
-        ControllerStatus::Stuck, ControllerStatus::OutOfTime, ControllerStatus::Paused})
+       {ControllerStatus::Idle, ControllerStatus::Optimizing, ControllerStatus::Reached,
+        ControllerStatus::BestEffort, ControllerStatus::Paused, ControllerStatus::Failed})
+    EXPECT_NE(text.str().find("'" + std::string(to_string(s)) + "'"), std::string::npos)
+        << to_string(s) << " is not in web/js/protocol.js";
+  for (Shortfall s :
+       {Shortfall::JointLimit, Shortfall::Collision, Shortfall::Reach, Shortfall::Buckling})
     EXPECT_NE(text.str().find("'" + std::string(to_string(s)) + "'"), std::string::npos)
         << to_string(s) << " is not in web/js/protocol.js";
 }

@@ -41,8 +41,9 @@ def test_targets_set_from_another_thread_are_reached(cli, write_json, bar_scene)
         setter = threading.Thread(target=controller.set_targets, args=(targets,))
         setter.start()
         setter.join()
-        done = wait_until(controller, lambda s: s.status == "converged")
+        done = wait_until(controller, lambda s: s.status == "reached")
     assert done.error_mean < 1e-3 and done.safe and done.iterations > 0
+    assert done.unreachable == [] and done.status_reason == "" and done.tolerance == 1e-3
     np.testing.assert_array_equal(done.target_nodes, nodes)
     assert done.target_positions.shape == (len(nodes), 3) and done.target_positions.dtype == np.float64
     assert done.joints.shape == (14,) and sorted(done.links) == sorted(bar_scene.robot.link_names)

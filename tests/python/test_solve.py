@@ -30,6 +30,10 @@ def test_solve_matches_the_cli(cli, write_json, bar_scene, optimizer):
     r = run.result
     assert (py.converged, py.termination, py.reason, py.iterations) == (
         r["converged"], r["termination"], r["reason"], r["iterations"])
+    # The same verdict in the controller's words: reached only within the tolerance.
+    assert (py.status, py.unreachable, py.status_reason, py.tolerance) == (
+        r["status"], r["unreachable"], r["status_reason"], r["tolerance"])
+    assert py.status == ("reached" if py.error_max <= 1e-3 else "best effort")
     assert sorted(py.joint_names) == sorted(r["joints"])  # the CLI's JSON sorts keys
     np.testing.assert_allclose(py.joints, [r["joints"][n] for n in py.joint_names], rtol=0, atol=1e-12)
     np.testing.assert_allclose(py.positions, r["positions"], rtol=0, atol=1e-12)

@@ -216,14 +216,24 @@ TEST_F(SessionTest, DegenerateCentrelineAndAbsurdTargetsGetAnErrorAndChangeNothi
 }
 
 TEST_F(SessionTest, JoggingNeedsPauseAndArmingNeedsALink) {
-  const auto jog = R"({"type":"set_joint","joint":0,"value":0.0})";
+  // One jog step (at most 0.05 rad) from where joint 0 is, and a jump of 1 rad.
+  const double goal =
+      nlohmann::json::parse(session.state_message(1))["joints"][0].get<double>() + 0.04;
+  const std::string jog = R"({"type":"set_joint","joint":0,"value":)" + std::to_string(goal) + "}";
+  const std::string jump =
+      R"({"type":"set_joint","joint":0,"value":)" + std::to_string(goal + 1) + "}";
   EXPECT_FALSE(session.handle(jog).ok);
   EXPECT_TRUE(session.handle(R"({"type":"set_paused","paused":true})").ok);
   EXPECT_TRUE(wait_until(session, [](const ControllerSnapshot& s) { return s.paused; })->paused);
+  EXPECT_NE(reply_json(session.handle(jump))["message"].get<std::string>().find(
+                "jog refused: yumi_joint_1_l: expected a step of at most 0.05 rad"),
+            std::string::npos);
   EXPECT_TRUE(session.handle(jog).ok);
-  const auto s =
-      wait_until(session, [](const ControllerSnapshot& s) { return std::abs(s.joints[0]) < 1e-9; });
-  EXPECT_NEAR(s->joints[0], 0.0, 1e-9);
+  const double sent = std::stod(std::to_string(goal));
+  const auto s = wait_until(session, [&](const ControllerSnapshot& s) {
+    return std::abs(s.joints[0] - sent) < 1e-9;
+  });
+  EXPECT_NEAR(s->joints[0], sent, 1e-9);
   EXPECT_NE(reply_json(session.handle(R"({"type":"arm"})"))["message"].get<std::string>().find(
                 "no robot link"),
             std::string::npos);

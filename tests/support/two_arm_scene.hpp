@@ -78,4 +78,25 @@ inline Scene two_arm_scene(const std::array<int, 3>& cells = {12, 1, 1}) {
   return s;
 }
 
+// Both arms swung about z by `a` towards each other (their third links close in).
+inline Eigen::VectorXd arms_swung_in(double a) {
+  Eigen::VectorXd theta(6);
+  theta << -a, -0.3, 0.9, a, -0.3, 0.9;
+  return theta;
+}
+
+// two_arm_scene with the third links' collision spheres grown so that their clearance at the
+// reference joints is `clearance` (m; negative: they overlap).
+inline Scene two_arm_scene_with_clearance(double clearance) {
+  Scene s = two_arm_scene();
+  const CollisionModel& old = *s.robot->collisions;
+  const double now =
+      old.min_clearance(forward_kinematics(*s.robot->model, s.robot->reference_joints));
+  std::vector<CollisionSphere> spheres = old.spheres();
+  for (CollisionSphere& sphere : spheres) sphere.radius += (now - clearance) / 2;
+  s.robot->collisions = std::make_shared<const CollisionModel>(*s.robot->model, spheres,
+                                                               old.margin(), old.stiffness());
+  return s;
+}
+
 }  // namespace shapectl::test

@@ -75,11 +75,16 @@ describe('robot visuals in the 3D view', () => {
     const { scene, state } = await hooks(page, () => ({ scene: window.shapectl.scene, state: window.shapectl.state }));
     const [lo, hi] = [scene.robot.lower_limits[0], scene.robot.upper_limits[0]];
     const joints = [...state.joints];
-    joints[0] = joints[0] - lo > hi - joints[0] ? 0.9 * lo + 0.1 * hi : 0.1 * lo + 0.9 * hi;
+    const far = joints[0] - lo > hi - joints[0] ? 0.9 * lo + 0.1 * hi : 0.1 * lo + 0.9 * hi;
     ws.sendJson({ type: Command.SetPaused, paused: true, id: 'pause' });
     assert.equal((await reply('pause')).type, Message.Ok);
-    ws.sendJson({ type: Command.SetJoints, joints, id: 'jog' });
-    assert.equal((await reply('jog')).type, Message.Ok);
+    // In jog steps: the server moves a joint at most limits.max_jog_step per jog.
+    for (let n = 0; joints[0] !== far; n++) {
+      const step = scene.limits.max_jog_step;
+      joints[0] = Math.abs(far - joints[0]) <= step ? far : joints[0] + Math.sign(far - joints[0]) * step;
+      ws.sendJson({ type: Command.SetJoints, joints, id: `jog${n}` });
+      assert.equal((await reply(`jog${n}`)).type, Message.Ok);
+    }
     ws.close();
 
     await page.click('#arm');

@@ -6,18 +6,14 @@ import { ConvergencePlot } from './plot.js';
 import { CalibrationPanel } from './calibration_panel.js';
 import { TargetEditor } from './target_editing.js';
 import { ViewTools } from './view_tools.js';
-import { Command, ControllerStatus } from './protocol.js';
+import { Command } from './protocol.js';
+import { statusBadge } from './status_badge.js';
+import { boundedJog, chainOrder, limitText } from './joint_jog.js';
 
 const $ = (id) => document.getElementById(id);
 const DEG = 180 / Math.PI;
 // Metres as mm for the panel; '–' for none.
 const mm = (v) => (v === null || v === undefined ? '–' : (1000 * v).toFixed(2));
-// Mean error below which the targets count as reached (the paper's 1 mm).
-const REACHED = 1e-3;
-// Badge style per controller status; the others are plain.
-const STATUS_BADGE = {
-  [ControllerStatus.Converged]: 'ok', [ControllerStatus.Optimizing]: 'busy', [ControllerStatus.Stuck]: 'bad',
-};
 
 const page = {
   scene: null,       // the last "scene" message
@@ -41,7 +37,7 @@ const editor = new TargetEditor({
 const plot = new ConvergencePlot($('plot'), $('plot-legend'), { readout: $('plot-readout'), logScale: $('plot-log') });
 const tools = new ViewTools(view, {
   frames: $('show-frames'), screenshot: $('screenshot'), helpButton: $('help-button'), help: $('help'), scaleBar: $('scale-bar'),
-  hover: $('hover-readout'), notice: $('notice'), deleteButton: $('delete'), clipped: [$('status'), $('status-detail')],
+  hover: $('hover-readout'), notice: $('notice'), deleteButton: $('delete'), clipped: [$('status'), $('status-detail'), $('status-reason')],
 });
 const calibration = new CalibrationPanel({
   button: $('calibrate'), auto: $('auto-calibration'), status: $('calibration-status'), model: $('model'),
@@ -77,10 +73,11 @@ function toast(text) {
   toast.timer = setTimeout(() => t.classList.remove('shown'), 4000);
 }
 
-function setBadge(id, text, kind) {
+function setBadge(id, text, kind, title = '') {
   const b = $(id);
   b.textContent = text;
   b.className = `badge ${kind ?? ''}`;
+  b.title = title;
 }
 
 // ---- scene ----
@@ -119,23 +116,31 @@ function buildJointSliders(robot) {
   box.replaceChildren();
   page.sliders = [];
   if (!robot) return;
-  robot.joint_names.forEach((name, k) => {
+  // In chain order (shoulder to wrist, arm by arm), each with its limits.
+  chainOrder(robot).forEach((k) => {
+    const name = robot.joint_names[k];
     const lo = robot.lower_limits[k] ?? -Math.PI, hi = robot.upper_limits[k] ?? Math.PI;
     const row = document.createElement('div');
     row.className = 'joint';
-    row.innerHTML = `<span class="name" title="${name}">${name}</span>
-      <input type="range" min="${lo}" max="${hi}" step="0.001" aria-label="${name}" data-joint="${k}">
-      <span class="value"></span><div class="limit"><i></i></div>`;
+    const limits = limitText(robot.lower_limits[k], robot.upper_limits[k]);
+    const position = robot.chain_positions?.[k] ? `${robot.chain_positions[k]}. ` : '';
+    row.innerHTML = `<span class="name" title="${name}: joint ${position}in its chain, ${limits}">${position}${name}</span>
+      <input type="range" min="${lo}" max="${hi}" step="any" aria-label="${name}" data-joint="${k}">
+      <span class="value"></span><div class="limit"><i></i></div><span class="limits">${limits}</span>`;
     const slider = row.querySelector('input');
     slider.addEventListener('pointerdown', () => { slider.dragging = true; });
     slider.addEventListener('pointerup', () => { slider.dragging = false; });
     slider.addEventListener('blur', () => { slider.dragging = false; });
     slider.addEventListener('input', () => {
       slider.editedAt = performance.now();
-      command(Command.SetJoint, { joint: k, value: Number(slider.value) });
+      // At most one jog step from the last value sent (or the state's), whatever was clicked.
+      const value = boundedJog(Number(slider.value), slider.jogFrom ?? page.state.joints[k]);
+      slider.value = value;
+      slider.jogFrom = value;
+      command(Command.SetJoint, { joint: k, value });
     });
     box.appendChild(row);
-    page.sliders.push({ slider, row, value: row.querySelector('.value'), mark: row.querySelector('.limit i'), lo, hi });
+    page.sliders[k] = { slider, row, value: row.querySelector('.value'), mark: row.querySelector('.limit i'), lo, hi };
   });
 }
 
@@ -146,21 +151,17 @@ function onState(state) {
   if (state.editing) page.stats.editingStates++;
   page.stats.stateTimes.push(performance.now());
   if (page.stats.stateTimes.length > 200) page.stats.stateTimes.shift();
+  // Red: links that overlap, and those a refused jog would have made overlap.
+  view.robotView.setCollisions([...state.colliding_links, ...state.jog_refused_links], state.closest_pair);
   view.setState(state);
   editor.update(state);
   tools.setState(state);
   plot.add(state.time, plotValues(state), state.editing);
   drawPlot();
 
-  // "converged" means stationary; away from the targets that is no success to show in green.
-  const missed = state.status === ControllerStatus.Converged && state.targets.length > 0 &&
-    state.error.mean !== null && state.error.mean > REACHED;
-  // With observations of the real object, "reached" is about the real object, not the model.
-  const realMiss = state.status === ControllerStatus.Converged && state.observations > 0 &&
-    state.observed_error !== null && state.observed_error > REACHED;
-  if (missed) setBadge('status', `${state.status}, not reached`, 'busy');
-  else if (realMiss) setBadge('status', `${state.status}, real object ${mm(state.observed_error)} mm off`, 'busy');
-  else setBadge('status', state.status, STATUS_BADGE[state.status]);
+  const badge = statusBadge(state);
+  setBadge('status', badge.text, badge.kind, badge.title);
+  $('status-reason').textContent = badge.title;
   $('error-mean').textContent = state.targets.length ? mm(state.error.mean) : '–';
   $('error-max').textContent = state.targets.length ? mm(state.error.max) : '–';
   $('rate').textContent = (state.iterations_per_second ?? 0).toFixed(0);
@@ -176,7 +177,7 @@ function onState(state) {
     s.slider.disabled = !state.paused;
     // Don't fight the user's hand: a slider being moved keeps its own value.
     const recentlyEdited = performance.now() - (s.slider.editedAt ?? -1e9) < 500;
-    if (!s.slider.dragging && !recentlyEdited) s.slider.value = v;
+    if (!s.slider.dragging && !recentlyEdited) { s.slider.value = v; s.slider.jogFrom = undefined; }
     s.value.textContent = `${(v * DEG).toFixed(1)}°`;
     s.mark.style.left = `calc(${(100 * (v - s.lo) / (s.hi - s.lo)).toFixed(2)}% - 1px)`;
     const margin = 0.05 * (s.hi - s.lo);
@@ -290,6 +291,8 @@ window.shapectl = {
   robotColors: () => view.robotView.visualColors(),
   robotMeshes: () => view.robotView.meshVisuals(),
   get robotWarnings() { return page.robotWarnings; },
+  highlightedSpheres: () => view.robotView.highlightedSpheres(),
+  setSpheresVisible: (on) => { $('show-spheres').checked = on; view.setSpheresVisible(on); view.render(); },
   ghost: () => ({ visible: view.ghostView.visible, links: view.ghostView.robotView.linkPoses(),
     colors: view.ghostView.robotView.visualColors(), meshes: view.ghostView.group.children.reduce((n, g) => n + g.children.length, 0),
     meshVisuals: view.ghostView.robotView.meshVisuals() }),

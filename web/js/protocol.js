@@ -31,15 +31,26 @@ export const Message = Object.freeze({
   State: 'state',
 });
 
-// A state's "status": what the optimizer is doing.
+// A state's "status": what the optimizer is doing, and once it stopped, whether the targets were
+// met: "reached" (every target error within the state's "tolerance"), "best effort" (stopped
+// above it; why in "unreachable" and "status_reason"), or "failed" (see "status_reason").
 // The same list as ControllerStatus in src/shapectl/control/controller.hpp (to_string there).
 export const ControllerStatus = Object.freeze({
   Idle: 'idle',  // no targets
   Optimizing: 'optimizing',
-  Converged: 'converged',
-  Stuck: 'stuck',
-  OutOfTime: 'out of time',  // an iteration ran out of its budget
+  Reached: 'reached',
+  BestEffort: 'best effort',
   Paused: 'paused',
+  Failed: 'failed',
+});
+
+// A state's "unreachable": why a best effort stays above the tolerance (src/shapectl/control/
+// shortfall.hpp says how each is found). Empty: a local minimum.
+export const Shortfall = Object.freeze({
+  JointLimit: 'joint limit',
+  Collision: 'collision',
+  Reach: 'reach',
+  Buckling: 'buckling',
 });
 
 // A state's "link.kind", and the `serve --robot` value that chooses it.

@@ -8,6 +8,12 @@ import { MeshFormat, ShapeKind } from './protocol.js';
 import { loadMesh, triangleVertexCount } from './mesh_loader.js';
 
 const SPHERE_MATERIAL = new THREE.MeshBasicMaterial({ color: 0x66ccff, wireframe: true, transparent: true, opacity: 0.35 });
+// The closest checked sphere pair: solid, red when the two overlap, yellow otherwise.
+const CLOSEST_MATERIAL = new THREE.MeshBasicMaterial({ color: 0xffd23f, transparent: true, opacity: 0.7 });
+const OVERLAP_MATERIAL = new THREE.MeshBasicMaterial({ color: 0xff2a2a, transparent: true, opacity: 0.8 });
+// A link whose spheres overlap another's.
+export const COLLIDING_COLOR = new THREE.Color(0xff2a2a);
+const SHARED_MATERIALS = [SPHERE_MATERIAL, CLOSEST_MATERIAL, OVERLAP_MATERIAL];
 
 function linkColor(index) {
   // Golden-angle hues: neighbouring links get clearly different colours.
@@ -64,13 +70,15 @@ export class RobotView {
     this.spheresVisible = false;
     this.meshes = [];         // per mesh visual: {link, url, format, holder, state, vertices, problem}
     this.generation = 0;      // loads for an older robot are dropped
+    this.collidingLinks = new Set();  // link indices drawn red
+    this.closestPair = null;          // the state's closest_pair
   }
 
   // Rebuilds the links from a scene message's "robot" (null: no robot).
   setRobot(robot) {
     this.group.traverse((o) => {
       o.geometry?.dispose();
-      if (o.material !== SPHERE_MATERIAL) o.material?.dispose();
+      if (!SHARED_MATERIALS.includes(o.material)) o.material?.dispose();
     });
     this.group.clear();
     this.linkGroups = [];
@@ -78,6 +86,8 @@ export class RobotView {
     this.sphereMeshes = [];
     this.meshes = [];
     this.generation++;
+    this.collidingLinks = new Set();
+    this.closestPair = null;
     if (!robot) return;
     robot.links.forEach((link, index) => {
       const group = new THREE.Group();
@@ -92,6 +102,7 @@ export class RobotView {
         mesh.matrixAutoUpdate = false;
         mesh.matrix.fromArray(shape.pose);
         mesh.visible = this.robotVisible;
+        mesh.userData.color = mesh.material.color.clone();
         group.add(mesh);
         this.visualMeshes.push(mesh);
       }
@@ -150,6 +161,32 @@ export class RobotView {
       const group = this.linkGroups[k];
       if (group) { group.matrix.fromArray(pose); group.matrixWorldNeedsUpdate = true; }
     });
+  }
+
+  // A state's colliding_links (red) and closest_pair (highlighted among the spheres).
+  setCollisions(collidingLinks, closestPair) {
+    this.collidingLinks = new Set(collidingLinks);
+    this.linkGroups.forEach((group, k) => {
+      const red = this.collidingLinks.has(k);
+      for (const mesh of group.children) {
+        if (!this.visualMeshes.includes(mesh)) continue;
+        mesh.material.color.copy(red ? COLLIDING_COLOR : mesh.userData.color);
+        mesh.material.emissive?.setHex(red ? 0x550000 : 0x000000);
+      }
+    });
+    this.closestPair = closestPair;
+    const pair = closestPair?.spheres ?? [];
+    const highlight = closestPair && closestPair.clearance !== null && closestPair.clearance < 0 ? OVERLAP_MATERIAL : CLOSEST_MATERIAL;
+    this.sphereMeshes.forEach((mesh, k) => { mesh.material = pair.includes(k) ? highlight : SPHERE_MATERIAL; });
+  }
+
+  // For tests: the highlighted spheres (indices into the scene's collision_spheres) and whether
+  // they are shown, red (overlapping) or yellow.
+  highlightedSpheres() {
+    const spheres = [];
+    this.sphereMeshes.forEach((mesh, k) => { if (mesh.material !== SPHERE_MATERIAL) spheres.push(k); });
+    const overlap = spheres.length > 0 && this.sphereMeshes[spheres[0]].material === OVERLAP_MATERIAL;
+    return { spheres, visible: this.spheresVisible, overlap };
   }
 
   // For tests: per link in scene order, its name and each drawn visual's sRGB colour and opacity.

@@ -1,8 +1,10 @@
 #include <shapectl/control/controller.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/enum_names.hpp>
@@ -20,33 +22,45 @@ struct Inbox {
   bool clear = false;
   std::optional<bool> paused;
   std::optional<Eigen::VectorXd> jog;
+  std::optional<std::vector<int>> jog_refused_links;  // a jog refused for self-collision
   bool reset = false;
   std::optional<ShapeObservation> observation;  // the newest only: an older one is stale
   std::optional<bool> feedback;
   std::optional<Scene> model;
   bool empty() const {
-    return !targets && !centerline && !clear && !paused && !jog && !reset && !observation &&
-           !feedback && !model;
+    return !targets && !centerline && !clear && !paused && !jog && !jog_refused_links && !reset &&
+           !observation && !feedback && !model;
   }
 };
 
 constexpr auto kControllerStatuses =
     enum_names<ControllerStatus>(std::pair{ControllerStatus::Idle, "idle"},
                                  std::pair{ControllerStatus::Optimizing, "optimizing"},
-                                 std::pair{ControllerStatus::Converged, "converged"},
-                                 std::pair{ControllerStatus::Stuck, "stuck"},
-                                 std::pair{ControllerStatus::OutOfTime, "out of time"},
-                                 std::pair{ControllerStatus::Paused, "paused"});
+                                 std::pair{ControllerStatus::Reached, "reached"},
+                                 std::pair{ControllerStatus::BestEffort, "best effort"},
+                                 std::pair{ControllerStatus::Paused, "paused"},
+                                 std::pair{ControllerStatus::Failed, "failed"});
 
-// The status once iterations stopped with `outcome`.
-ControllerStatus status_after(StepOutcome outcome) {
-  switch (outcome) {
-    case StepOutcome::Converged: return ControllerStatus::Converged;
-    case StepOutcome::Stuck: return ControllerStatus::Stuck;
-    case StepOutcome::OutOfTime: return ControllerStatus::OutOfTime;
-    case StepOutcome::Improved: break;
+std::string millimetres(double metres) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f mm", metres * 1e3);
+  return text;
+}
+
+// Which links overlap another's spheres, and the closest pair, at `joints`.
+void find_collisions(const CollisionModel& collisions, const KinematicsState& kinematics,
+                     ControllerSnapshot& s) {
+  const auto pairs = collisions.closest_pairs(kinematics, collisions.spheres().size());
+  if (pairs.empty()) return;
+  s.closest_pair = pairs.front();
+  for (const SphereClearance& p : pairs) {
+    if (p.clearance >= 0) break;
+    for (int sphere : {p.first, p.second})
+      s.colliding_links.push_back(collisions.spheres()[sphere].link);
   }
-  return ControllerStatus::Optimizing;
+  std::sort(s.colliding_links.begin(), s.colliding_links.end());
+  s.colliding_links.erase(std::unique(s.colliding_links.begin(), s.colliding_links.end()),
+                          s.colliding_links.end());
 }
 }  // namespace
 
@@ -54,6 +68,11 @@ const char* to_string(ControllerStatus status) { return kControllerStatuses.name
 
 bool parse(std::string_view name, ControllerStatus* status) {
   return kControllerStatuses.parse(name, status);
+}
+
+ControllerStatus stopped_status(const Evaluation& best, bool failed, double tolerance) {
+  if (failed || !best.statics.converged()) return ControllerStatus::Failed;
+  return best.error.max <= tolerance ? ControllerStatus::Reached : ControllerStatus::BestEffort;
 }
 
 struct Controller::State {
@@ -74,6 +93,10 @@ struct Controller::State {
   bool paused = false;
   bool idle = true;  // nothing to do until a request arrives
   StepOutcome last_outcome = StepOutcome::Improved;
+  // How the last run of iterations ended: failed (no equilibrium, an error), or else the
+  // reasons the targets stay beyond the tolerance (empty detail when within it).
+  bool failed = false;
+  ShortfallReport shortfall;
   std::uint64_t iterations = 0;
   double rate = 0;
   Clock::time_point last_iteration = Clock::now();
@@ -94,6 +117,9 @@ struct Controller::State {
   mutable std::mutex inbox_mutex;
   std::condition_variable inbox_changed;
   Inbox inbox;
+  // The joints the last accepted jog asked for (guarded by inbox_mutex): the next jog's step is
+  // measured from there, as the snapshot may not show it yet. Cleared by pause, resume, reset.
+  std::optional<Eigen::VectorXd> jogged_to;
 
   mutable std::mutex snapshot_mutex;
   mutable std::condition_variable snapshot_changed;
@@ -123,14 +149,47 @@ struct Controller::State {
   // Whether the corrected targets moved (RMS over the targets) past the threshold, or past
   // what the estimate's noise explains for observations of noise `sigma`, from those aimed at.
   bool moved_enough(const ShapeTargets& corrected, double sigma) const;
+  // Judges the state the optimizer stopped at (failed, shortfall).
+  void judge_stop();
+  ControllerStatus status() const;
   void iterate();
   void publish();
   void run();
   void validate(const ShapeTargets& t) const;
+  // Throws InputError for a jog from `from` to `to` that steps too far. For one into
+  // self-collision, returns why (else empty) and the links that would overlap.
+  std::string jog_collision(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                            std::vector<int>& links) const;
+  std::vector<int> jog_refused_links;  // of the last jog refused for self-collision
 };
 
 void Controller::State::validate(const ShapeTargets& t) const {
   check_targets(t, loaded->node_count(), "targets");
+}
+
+std::string Controller::State::jog_collision(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                             std::vector<int>& links) const {
+  const RobotModel& robot = loaded->robot();
+  Eigen::Index j = 0;
+  const double step = (to - from).cwiseAbs().maxCoeff(&j);
+  if (step > options.max_jog_step + 1e-12) {
+    char expected[64];
+    std::snprintf(expected, sizeof expected, "a step of at most %.3g rad from the current joints",
+                  options.max_jog_step);
+    throw InputError("jog refused", robot.active_joint_names()[j], expected,
+                     std::to_string(step) + " rad");
+  }
+  const auto& collisions = loaded->scene().robot->collisions;
+  if (!collisions || collisions->pair_count() == 0) return {};
+  const SphereClearance worst = collisions->closest_pairs(forward_kinematics(robot, to), 1).front();
+  // Out of a collision is allowed: only a jog that makes (or deepens) an overlap is refused.
+  if (worst.clearance >= 0 ||
+      worst.clearance >= collisions->min_clearance(forward_kinematics(robot, from)))
+    return {};
+  const auto& spheres = collisions->spheres();
+  links = {spheres[worst.first].link, spheres[worst.second].link};
+  return "jog refused: self-collision: " + robot.links()[links[0]].name + " and " +
+         robot.links()[links[1]].name + " would overlap by " + millimetres(-worst.clearance);
 }
 
 void Controller::State::apply(Inbox in) {
@@ -141,6 +200,7 @@ void Controller::State::apply(Inbox in) {
     objective->rescore(current);
     optimizer->reset();
     last_error.clear();
+    jog_refused_links.clear();
   }
   if (in.clear) {
     retarget({});
@@ -162,8 +222,12 @@ void Controller::State::apply(Inbox in) {
       last_error = std::string("centre-line refused: ") + e.what();
     }
   }
-  if (in.paused) paused = *in.paused;
+  if (in.paused) {
+    paused = *in.paused;
+    if (!paused) jog_refused_links.clear();
+  }
   if (in.jog && paused) {
+    jog_refused_links.clear();
     const Eigen::VectorXd theta =
         in.jog->cwiseMax(object->robot().lower_limits()).cwiseMin(object->robot().upper_limits());
     Evaluation e = objective->evaluate(theta, current.positions, 0, &current);
@@ -172,8 +236,11 @@ void Controller::State::apply(Inbox in) {
       last_error.clear();
     } else {
       last_error = "jog refused: statics " + e.statics.reason;
+      std::lock_guard lock(inbox_mutex);
+      if (jogged_to && *jogged_to == theta) jogged_to = current.joints;  // stayed here
     }
   }
+  if (in.jog_refused_links) jog_refused_links = *in.jog_refused_links;  // after the jog before it
   if (in.reset) feedback->reset(), observed_markers.clear(), last_observation.reset();
   const bool remodelled = in.model && replace_model(*in.model);
   if (in.feedback) {
@@ -268,22 +335,44 @@ void Controller::State::iterate() {
   if (had_requests) apply(std::move(in));
   const bool work = !paused && !objective->targets().empty() && !idle;
   if (work) {
+    failed = false;
     try {
       last_outcome = optimizer->step(*objective, current);
     } catch (const std::exception& e) {  // e.g. the start state is no stable equilibrium
       last_outcome = StepOutcome::Stuck;
       last_error = std::string("optimizer stopped: ") + e.what();
+      failed = true;
     }
     ++iterations;
     const auto now = Clock::now();
     const double dt = std::chrono::duration<double>(now - last_iteration).count();
     last_iteration = now;
     if (dt > 0) rate = rate == 0 ? 1 / dt : 0.8 * rate + 0.2 / dt;
-    if (last_outcome != StepOutcome::Improved) idle = true;  // wait for the next request
+    if (last_outcome != StepOutcome::Improved) {
+      idle = true;  // wait for the next request
+      judge_stop();
+    }
   } else if (objective->targets().empty() || paused) {
     idle = true;
   }
   if (work || had_requests) publish();
+}
+
+void Controller::State::judge_stop() {
+  shortfall = {};
+  if (stopped_status(current, failed, options.tolerance) != ControllerStatus::BestEffort) return;
+  try {
+    shortfall = find_shortfalls(*objective, current);
+  } catch (const std::exception& e) {  // the probes' statics: the reasons stay unknown
+    shortfall.detail = std::string("reasons unknown: ") + e.what();
+  }
+}
+
+ControllerStatus Controller::State::status() const {
+  if (paused) return ControllerStatus::Paused;
+  if (objective->targets().empty()) return ControllerStatus::Idle;
+  if (!idle) return ControllerStatus::Optimizing;
+  return stopped_status(current, failed, options.tolerance);
 }
 
 void Controller::State::publish() {
@@ -317,10 +406,18 @@ void Controller::State::publish() {
   s->model_updates = model_updates;
   s->observations_ignored = observations_ignored;
   s->observation_problem = observation_problem;
-  s->status = paused                         ? ControllerStatus::Paused
-              : objective->targets().empty() ? ControllerStatus::Idle
-              : !idle                        ? ControllerStatus::Optimizing
-                                             : status_after(last_outcome);
+  s->status = status();
+  s->tolerance = options.tolerance;
+  s->jog_refused_links = jog_refused_links;
+  if (s->status == ControllerStatus::BestEffort) {
+    s->shortfalls = shortfall.reasons;
+    s->status_reason = "error " + millimetres(current.error.max) + " above the tolerance " +
+                       millimetres(options.tolerance) + "; " + shortfall.detail;
+  } else if (s->status == ControllerStatus::Failed) {
+    s->status_reason = last_error;
+  }
+  if (const auto& collisions = object->scene().robot->collisions)
+    find_collisions(*collisions, current.state->kinematics(), *s);
   {
     std::lock_guard lock(snapshot_mutex);
     s->sequence = ++sequence;
@@ -420,7 +517,10 @@ void Controller::clear_targets() {
 }
 
 void Controller::set_paused(bool paused) {
-  post(*state_, [&](Inbox& in) { in.paused = paused; });
+  post(*state_, [&](Inbox& in) {
+    in.paused = paused;
+    state_->jogged_to.reset();
+  });
 }
 
 void Controller::set_joints(const Eigen::VectorXd& joints) {
@@ -429,12 +529,27 @@ void Controller::set_joints(const Eigen::VectorXd& joints) {
                      "one value per active joint (" +
                          std::to_string(state_->loaded->joint_count()) + ")");
   if (!joints.allFinite()) throw InputError("joints", "", "finite values");
+  const RobotModel& robot = state_->loaded->robot();
+  const Eigen::VectorXd theta =
+      joints.cwiseMax(robot.lower_limits()).cwiseMin(robot.upper_limits());
+  std::string refusal;
   {
     std::lock_guard lock(state_->inbox_mutex);
-    const bool pausing = state_->inbox.paused.value_or(snapshot()->paused);
+    const auto now = snapshot();
+    const bool pausing = state_->inbox.paused.value_or(now->paused);
     if (!pausing) throw InputError("joints", "", "the optimizer to be paused before jogging");
+    const Eigen::VectorXd& from = state_->jogged_to ? *state_->jogged_to : now->joints;
+    std::vector<int> links;
+    refusal = state_->jog_collision(from, theta, links);
+    if (refusal.empty()) {
+      state_->inbox.jog = state_->jogged_to = theta;
+      state_->inbox.jog_refused_links.reset();
+    } else {
+      state_->inbox.jog_refused_links = links;  // shown red until the next jog
+    }
   }
-  post(*state_, [&](Inbox& in) { in.jog = joints; });
+  state_->inbox_changed.notify_all();
+  if (!refusal.empty()) throw InputError(refusal);
 }
 
 void Controller::observe(ShapeObservation observation) {
@@ -477,9 +592,10 @@ void Controller::set_model(const Scene& model) {
 }
 
 void Controller::reset() {
-  post(*state_, [](Inbox& in) {
+  post(*state_, [&](Inbox& in) {
     in = Inbox{};
     in.reset = true;
+    state_->jogged_to.reset();
   });
 }
 

@@ -18,6 +18,8 @@
 #include <shapectl/control/model_error_feedback.hpp>
 #include <shapectl/control/optimize.hpp>
 #include <shapectl/control/shape_targets.hpp>
+#include <shapectl/control/shortfall.hpp>
+#include <shapectl/robot/collision_spheres.hpp>
 
 namespace shapectl {
 
@@ -25,6 +27,12 @@ struct ControllerOptions {
   OptimizerKind optimizer = OptimizerKind::GaussNewton;
   GradientMethod gradient = GradientMethod::Sensitivity;
   FeedbackOptions feedback;
+  // The user's tolerance: stopped with every target within it is "reached", above it "best
+  // effort" (with the reasons, control/shortfall.hpp). Metres.
+  double tolerance = 1e-3;
+  // A jog (set_joints) may move each joint at most this far from the current (or last
+  // requested) joints, rad; farther is refused. A slider click must not swing an arm.
+  double max_jog_step = 0.05;
 };
 
 // An observation of the real object for the closed loop: tracked markers at mesh nodes (world
@@ -36,19 +44,24 @@ struct ShapeObservation {
   double time = 0;       // s, as the observer stamped it
 };
 
-// What the controller is doing, as published.
+// What the controller is doing, as published. Once the optimizer stops (stationary, no
+// acceptable step or out of its iteration budget) the status says whether the targets were
+// met, never merely that iterating ended.
 enum class ControllerStatus {
   Idle,        // no targets
   Optimizing,  // iterating
-  Converged,   // stationary at the targets
-  Stuck,       // no acceptable step
-  OutOfTime,   // an iteration ran out of its budget
+  Reached,     // stopped with every target within the tolerance
+  BestEffort,  // stopped above the tolerance: unreachable from here, reasons in the snapshot
   Paused,
+  Failed,  // the optimizer could not go on (no equilibrium, an error): see last_error
 };
-// "idle", "optimizing", "converged", "stuck", "out of time", "paused" (the GUI's names too:
+// "idle", "optimizing", "reached", "best effort", "paused", "failed" (the GUI's names too:
 // web/js/protocol.js).
 const char* to_string(ControllerStatus status);
 bool parse(std::string_view name, ControllerStatus* status);
+// How a stopped run ended at `best`: Failed (`failed`, or no converged equilibrium), Reached
+// (every target error within `tolerance`, m) or BestEffort. `solve` says the same.
+ControllerStatus stopped_status(const Evaluation& best, bool failed, double tolerance);
 
 // One published state. Everything in the world frame, metres and radians.
 struct ControllerSnapshot {
@@ -70,7 +83,17 @@ struct ControllerSnapshot {
   double iterations_per_second = 0;
   bool paused = false;
   ControllerStatus status = ControllerStatus::Idle;
-  std::string last_error;  // e.g. statics failure while jogging; empty when fine
+  double tolerance = 1e-3;            // m, ControllerOptions::tolerance
+  std::vector<Shortfall> shortfalls;  // BestEffort: why; empty otherwise (or a local minimum)
+  std::string status_reason;          // BestEffort/Failed in words, with numbers; else empty
+  std::string last_error;             // e.g. statics failure while jogging; empty when fine
+  // Self-collision at θ (with a collision model): the link indices whose spheres overlap
+  // another's, ascending, and the closest checked sphere pair (first < 0 without pairs).
+  std::vector<int> colliding_links;
+  SphereClearance closest_pair;
+  // The two links a jog refused for self-collision would have made overlap (shown red until
+  // the next accepted jog, resume or reset); empty otherwise.
+  std::vector<int> jog_refused_links;
   // The closed loop (set_feedback, observe): the last observation, its model error (observed
   // vs predicted at its joints, RMS, m) and observed error (observed vs targets at the
   // observed target nodes, mean, m; NaN when no target node is observed).
@@ -113,7 +136,10 @@ class Controller {
   void set_centerline(std::vector<Vec3> polyline);
   void clear_targets();
   void set_paused(bool paused);
-  // Jog: only while paused; θ is clamped to the hard limits, statics follows.
+  // Jog: only while paused; θ is clamped to the hard limits, statics follows. Refused
+  // (InputError, nothing changed) when a joint would move more than max_jog_step from the
+  // current joints (or the last jog still pending), or when it would make spheres overlap
+  // that do not already (the message names the two links).
   void set_joints(const Eigen::VectorXd& joints);
   void reset();  // reference joints and shape, targets cleared
   // The closed loop: each observation updates the model-error estimate (control/

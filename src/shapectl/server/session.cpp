@@ -49,6 +49,12 @@ nlohmann::json model_json(const ControllerSnapshot& s, const Scene& scene) {
 }
 
 // The session's calibration: whether one runs, and the newest result (docs/gui.md).
+// The closest checked sphere pair, as indices into the scene message's collision_spheres.
+nlohmann::json closest_pair_json(const SphereClearance& pair) {
+  if (pair.first < 0) return nullptr;
+  return {{"spheres", {pair.first, pair.second}}, {"clearance", finite_or_null(pair.clearance)}};
+}
+
 nlohmann::json calibration_json(const OnlineCalibrationStatus& c) {
   nlohmann::json result = nullptr;
   if (const CalibrationResult* r = c.result.get()) {
@@ -113,8 +119,39 @@ void add_mesh_file(nlohmann::json& visual, const VisualMesh& mesh, std::size_t i
   if (!mesh.file) visual["missing"] = visual_mesh_warning(model, mesh);
 }
 
+// The active joints (θ indices) in chain order: each arm shoulder to wrist (a URDF may list
+// them in any order), the arms in θ order of their first joints; with each one's position in
+// its chain (1: the first movable joint from the root).
+struct ChainOrder {
+  std::vector<int> joints;
+  std::vector<int> positions;  // per θ index
+};
+ChainOrder chain_order(const RobotModel& model) {
+  const auto count = static_cast<std::size_t>(model.active_count());
+  ChainOrder out;
+  out.positions.assign(count, 0);
+  std::vector<int> first(count, 0);  // per θ index: the θ index of its chain's first joint
+  for (std::size_t k = 0; k < count; ++k) {
+    // Up from the joint to the root, counting the active joints on the way.
+    int depth = 0, top = static_cast<int>(k);
+    for (int joint = model.active_joints()[k]; joint >= 0;) {
+      if (model.active_index(joint) >= 0) ++depth, top = model.active_index(joint);
+      joint = model.links()[model.joints()[joint].parent_link].parent_joint;
+    }
+    out.positions[k] = depth;
+    first[k] = top;
+  }
+  out.joints.resize(count);
+  for (std::size_t k = 0; k < count; ++k) out.joints[k] = static_cast<int>(k);
+  std::stable_sort(out.joints.begin(), out.joints.end(), [&](int a, int b) {
+    return std::pair(first[a], out.positions[a]) < std::pair(first[b], out.positions[b]);
+  });
+  return out;
+}
+
 nlohmann::json robot_json(const RobotSetup& setup, const std::vector<VisualMesh>& meshes) {
   const RobotModel& model = *setup.model;
+  const ChainOrder chain = chain_order(model);
   nlohmann::json links = nlohmann::json::array();
   std::size_t next_mesh = 0;  // meshes are in link and visual order
   for (const Link& link : model.links()) {
@@ -141,6 +178,8 @@ nlohmann::json robot_json(const RobotSetup& setup, const std::vector<VisualMesh>
           {"joint_names", model.active_joint_names()},
           {"lower_limits", vector_json(model.lower_limits())},
           {"upper_limits", vector_json(model.upper_limits())},
+          {"chain_order", chain.joints},
+          {"chain_positions", chain.positions},
           {"reference_joints", vector_json(setup.reference_joints)},
           {"end_effectors", end_effectors},
           {"collision_spheres", spheres}};
@@ -513,7 +552,8 @@ nlohmann::json Session::describe_scene() const {
           {"limits",
            {{"max_message_bytes", max_message_bytes},
             {"max_coordinate", max_coordinate},
-            {"max_centerline_points", max_centerline_points}}}};
+            {"max_centerline_points", max_centerline_points},
+            {"max_jog_step", options_.max_jog_step}}}};
 }
 
 std::string Session::scene_message() const {
@@ -537,10 +577,16 @@ std::string Session::state_message(int clients) const {
       {"time", t},
       {"controller_time", s.time},
       {"status", to_string(s.status)},
+      {"status_reason", s.status_reason},
+      {"unreachable", shortfall_names(s.shortfalls)},
+      {"tolerance", s.tolerance},
       {"paused", s.paused},
       {"safe", s.safe},
       {"within_limits", s.within_limits},
       {"min_clearance", finite_or_null(s.min_clearance)},
+      {"colliding_links", s.colliding_links},
+      {"jog_refused_links", s.jog_refused_links},
+      {"closest_pair", closest_pair_json(s.closest_pair)},
       {"iterations", s.iterations},
       {"iterations_per_second", finite_or_null(s.iterations_per_second)},
       {"objective", finite_or_null(s.objective)},
