@@ -90,7 +90,9 @@ StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double
           .force_roundoff = roundoff.force,
           .energy_roundoff = roundoff.energy,
           .max_iterations = scene.statics.max_iterations,
-          .backend = scene.statics.backend};
+          .backend = scene.statics.backend,
+          .krylov_steps = scene.statics.krylov_steps,
+          .chord_steps = scene.statics.chord_steps};
 }
 }  // namespace
 
