@@ -35,14 +35,15 @@ bool random_goal(const ReducedObjective& objective, const Evaluation& reference,
 }
 
 std::optional<std::pair<double, int>> steps_to_1mm(const ReducedObjective& goal,
-                                                   const Evaluation& reference,
-                                                   OptimizerKind kind) {
+                                                   const Evaluation& reference, OptimizerKind kind,
+                                                   double max_seconds) {
   Evaluation current = reference;
   goal.rescore(current);
   auto optimizer = make_optimizer(kind, GradientMethod::Sensitivity);
   const auto t0 = BenchClock::now();
   int it = 0;
-  while (current.error.mean >= 1e-3 && it < 200 && seconds_between(t0, BenchClock::now()) < 10) {
+  while (current.error.mean >= 1e-3 && it < 200 &&
+         seconds_between(t0, BenchClock::now()) < max_seconds) {
     if (optimizer->step(goal, current) != StepOutcome::Improved) break;
     ++it;
   }

@@ -23,8 +23,10 @@ bool random_goal(const ReducedObjective& objective, const Evaluation& reference,
                  ShapeTargets& targets);
 
 // Optimizer steps from the reference shape until the mean error to `goal`'s targets is below
-// 1 mm (at most 200 steps or 10 s): the seconds and steps it took, or none if it stopped short.
+// 1 mm (at most 200 steps or max_seconds): the seconds and steps it took, or none if it stopped
+// short.
 std::optional<std::pair<double, int>> steps_to_1mm(const ReducedObjective& goal,
-                                                   const Evaluation& reference, OptimizerKind kind);
+                                                   const Evaluation& reference, OptimizerKind kind,
+                                                   double max_seconds = 10);
 
 }  // namespace shapectl::cli
