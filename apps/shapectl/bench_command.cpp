@@ -1,4 +1,4 @@
-// shapectl bench [SCENE.json ...] [--trials N] [--seed S]
+// shapectl bench [SCENE.json ...] [--trials N] [--seed S] [--scaling | --sizes 1.5k,6k,...]
 // Reproduces the paper's performance figures (Section V-A) on the bundled scenes: time per
 // reduced gradient by sensitivities, adjoint and finite differences, and the time and
 // iterations from a target change to a mean error below 1 mm.
@@ -19,6 +19,8 @@
 #include <shapectl/scene_io/scene_file.hpp>
 
 #include "bench_closed_loop.hpp"
+#include "bench_scaling.hpp"
+#include "bench_targets.hpp"
 #include "commands.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
@@ -27,43 +29,17 @@ namespace shapectl::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
-}
-
-double percentile(std::vector<double> v, double p) {
-  if (v.empty()) return NAN;
-  std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5))];
-}
+using Clock = BenchClock;
+constexpr auto seconds = seconds_between;
 
 struct BenchArgs {
   std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::vector<std::string> scenes = {"scenes/yumi_bar.json", "scenes/yumi_frame.json"};
   int trials = 20;
   unsigned seed = 1;
+  std::string sizes;  // --sizes / --scaling: the scaling table instead of the paper's
+  bool no_krylov = false;
 };
-
-// A safe, reachable goal: random joints near the reference, its equilibrium, some of its nodes.
-bool random_goal(const ReducedObjective& objective, const Evaluation& reference, std::mt19937& rng,
-                 ShapeTargets& targets) {
-  std::uniform_real_distribution<double> u(-0.15, 0.15);
-  Eigen::VectorXd theta = reference.joints;
-  for (int j = 0; j < theta.size(); ++j) theta[j] += u(rng);
-  const Evaluation goal = objective.evaluate(theta, reference.positions);
-  if (!goal.safe()) return false;
-  const int n = static_cast<int>(goal.positions.size() / 3);
-  std::vector<int> nodes(n);
-  for (int i = 0; i < n; ++i) nodes[i] = i;
-  std::shuffle(nodes.begin(), nodes.end(), rng);
-  targets = {};
-  for (int k = 0; k < std::min(20, n); ++k) {
-    targets.nodes.push_back(nodes[k]);
-    targets.positions.push_back(goal.positions.segment<3>(3 * nodes[k]));
-  }
-  return true;
-}
 
 // Timings of one reduced-gradient variant, seconds.
 struct GradientTimes {
@@ -126,23 +102,6 @@ void print_gradient_times(const GradientTimes& t) {
   row("finite differences, Newton re-solves", t.fd_newton);
 }
 
-// Optimizer steps from the reference shape until the mean error to `goal`'s targets is below
-// 1 mm (at most 200 steps or 10 s): the seconds and steps it took, or none if it stopped short.
-std::optional<std::pair<double, int>> time_to_1mm(const ReducedObjective& goal,
-                                                  const Evaluation& reference, OptimizerKind kind) {
-  Evaluation current = reference;
-  goal.rescore(current);
-  auto optimizer = make_optimizer(kind, GradientMethod::Sensitivity);
-  const auto t0 = Clock::now();
-  int it = 0;
-  while (current.error.mean >= 1e-3 && it < 200 && seconds(t0, Clock::now()) < 10) {
-    if (optimizer->step(goal, current) != StepOutcome::Improved) break;
-    ++it;
-  }
-  if (current.error.mean >= 1e-3) return std::nullopt;
-  return std::pair{seconds(t0, Clock::now()), it};
-}
-
 // 2. Target change → mean error below 1 mm, from the reference equilibrium.
 void bench_target_changes(const ReducedObjective& objective, const Evaluation& reference,
                           OptimizerKind kind, const char* name, const BenchArgs& args) {
@@ -152,7 +111,7 @@ void bench_target_changes(const ReducedObjective& objective, const Evaluation& r
   for (int trial = 0; trial < args.trials; ++trial) {
     ShapeTargets targets;
     if (!random_goal(objective, reference, goals, targets)) continue;
-    if (const auto reached = time_to_1mm(objective.with_targets(targets), reference, kind)) {
+    if (const auto reached = steps_to_1mm(objective.with_targets(targets), reference, kind)) {
       times.push_back(reached->first);
       iterations.push_back(reached->second);
     } else {
@@ -284,17 +243,37 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
 
 }  // namespace
 
+// The scaling table's sizes by default; 50k (≈ 2 min more) only when asked for.
+constexpr const char* kDefaultSizes = "1.5k,6k,12k,25k";
+
 void add_bench_command(CLI::App& app) {
   auto args = std::make_shared<BenchArgs>();
   auto* cmd =
       app.add_subcommand("bench", "Reproduce the paper's performance table on the bundled scenes");
-  cmd->add_option("scenes", args->scenes,
-                  "scene files (default: scenes/yumi_bar.json scenes/yumi_frame.json)");
+  auto* scenes =
+      cmd->add_option("scenes", args->scenes,
+                      "scene files (default: scenes/yumi_bar.json scenes/yumi_frame.json; with "
+                      "--sizes the first only, default scenes/yumi_bar.json)");
   cmd->add_option("--trials", args->trials, "random target sets per measurement")
       ->check(CLI::Range(1, 10000));
   cmd->add_option("--seed", args->seed, "random seed");
   add_package_path_option(*cmd, args->package_paths);
-  cmd->callback([args] {
+  cmd->add_option("--sizes", args->sizes,
+                  "instead: the scaling table, the scene's box mesh refined to about these tet "
+                  "counts (e.g. 1.5k,6k,12k,25k,50k)");
+  cmd->add_flag("--no-krylov", args->no_krylov,
+                "with --sizes: statics without conjugate-gradient steps (to measure them)");
+  cmd->add_flag_callback(
+      "--scaling", [args] { args->sizes = kDefaultSizes; },
+      std::string("the scaling table at ") + kDefaultSizes + " tets (--sizes " + kDefaultSizes +
+          ")");
+  cmd->callback([args, scenes] {
+    if (!args->sizes.empty()) {
+      const auto counts = parse_tet_counts(args->sizes, "--sizes");
+      bench_scaling(scenes->count() ? args->scenes.front() : "scenes/yumi_bar.json", counts,
+                    args->trials, args->seed, !args->no_krylov);
+      return;
+    }
     for (const auto& s : args->scenes) bench_scene(s, *args);
   });
 }

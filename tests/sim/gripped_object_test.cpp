@@ -114,5 +114,38 @@ TEST(GrippedObject, SensitivityMatchesCentralDifferencesOfStatics) {
   }
 }
 
+// The same check with the perturbed equilibria re-solved by Krylov steps (conjugate gradients
+// preconditioned with x̂(θ)'s factorization, tolerance StaticsOptions::krylov_tolerance), chord
+// steps off: Newton stops on the true residual, so the central differences are of exact
+// equilibria and still match the sensitivities to 1e-5.
+TEST(GrippedObject, SensitivityMatchesCentralDifferencesWithKrylovResolves) {
+  Scene scene = test::two_arm_scene();
+  scene.statics.relative_tolerance = 1e-11;
+  scene.statics.chord_steps = false;
+  GrippedObject object(scene);
+  std::mt19937 rng(5);
+  int krylov_steps = 0, factorizations = 0;
+  for (int trial = 0; trial < 2; ++trial) {
+    const Eigen::VectorXd theta = random_joints(object, 0.25, rng);
+    ObjectState state = object.solve_from(theta, object.reference_positions());
+    ASSERT_TRUE(state.statics().converged());
+    const Positions x = state.positions();
+    const Eigen::MatrixXd dx = object.sensitivity(state);  // factors at x̂: the preconditioner
+    const auto equilibrium = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
+      const ObjectState moved = object.solve_from(t, x, 0, &state);
+      EXPECT_TRUE(moved.statics().converged()) << moved.statics().reason;
+      for (const auto& it : moved.statics().log) krylov_steps += it.krylov > 0;
+      factorizations += moved.statics().factorizations;
+      return moved.positions();
+    };
+    EXPECT_TRUE(
+        test::derivative_matches(dx, test::central_difference_jacobian(equilibrium, theta, 1e-5),
+                                 1e-5, "sensitivity dx/dθ, Krylov re-solves"))
+        << "trial " << trial;
+  }
+  EXPECT_GT(krylov_steps, 0);
+  EXPECT_EQ(factorizations, 0);
+}
+
 }  // namespace
 }  // namespace shapectl

@@ -80,6 +80,12 @@ std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
   return fixed;
 }
 
+// Krylov steps pay where a factorization is dear: measured (`shapectl bench --sizes 1.5k,12k`,
+// docs/benchmarks.md) a third faster target change at 8,019 unknowns, no gain at 1,275, where
+// a factorization costs about what assembling the Hessian and the conjugate gradients do.
+// With chord steps off they are the only reuse of a nearby factorization: then always.
+constexpr int kKrylovFrom = 5000;  // unknowns
+
 StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double weight) {
   // Converged when every nodal force is a tiny fraction of the weight (or, for a weightless
   // object, of the force that strains it by 0.1 %) — but never below what round-off leaves.
@@ -90,7 +96,10 @@ StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double
           .force_roundoff = roundoff.force,
           .energy_roundoff = roundoff.energy,
           .max_iterations = scene.statics.max_iterations,
-          .backend = scene.statics.backend};
+          .backend = scene.statics.backend,
+          .krylov_steps = scene.statics.krylov_steps &&
+                          (!scene.statics.chord_steps || 3 * placed.node_count() >= kKrylovFrom),
+          .chord_steps = scene.statics.chord_steps};
 }
 }  // namespace
 

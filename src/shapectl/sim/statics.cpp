@@ -1,5 +1,6 @@
 #include <shapectl/sim/statics.hpp>
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -24,6 +25,8 @@ std::vector<char> dof_mask(const std::vector<char>& fixed_node) {
     for (int k = 0; k < 3; ++k) dof[3 * i + k] = fixed_node[i];
   return dof;
 }
+std::atomic<long long> total_iterations{0}, total_factorizations{0};
+
 std::string sci(double v) {
   std::ostringstream s;
   s.precision(3);
@@ -31,6 +34,8 @@ std::string sci(double v) {
   return s.str();
 }
 }  // namespace
+
+StaticsTotals statics_totals() { return {total_iterations.load(), total_factorizations.load()}; }
 
 StaticsSolver::StaticsSolver(int node_count, std::vector<char> fixed_node, StaticsOptions options)
     : node_count_(node_count), fixed_dof_(dof_mask(fixed_node)), options_(options) {}
@@ -69,6 +74,7 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
     ws.analyzed = true;
   }
   const bool ok = ws.cholesky.factorize(H);
+  ++total_factorizations;
   ws.has_factor = ok && !projected;
   if (ws.has_factor) ws.factor_x = x;
   return ok;
@@ -158,6 +164,46 @@ bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace&
   x = std::move(trial);
   at = {e_trial, std::move(g_trial), r_trial};
   return true;
+}
+
+Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
+                                                const StaticsWorkspace& chord, const Positions& x,
+                                                const Eigen::VectorXd& g,
+                                                NewtonIterate& log) const {
+  // Preconditioned conjugate gradients on H dx = −g. The chord's factor is of the Hessian at a
+  // nearby state: H is close to it, so few products reach the tolerance. Assembling H costs a
+  // fraction of factoring it on large meshes. Fixed dofs: H has identity rows there and g zeros,
+  // so dx stays zero on them.
+  ws.triplets.clear();
+  for (const auto* t : terms) t->add_hessian(x, ws.triplets, false);
+  const SparseMatrix& H = ws.assembler.assemble(ws.triplets);
+  auto precondition = [&](const Eigen::VectorXd& r) {
+    std::lock_guard lock(*chord.solve_mutex);
+    return Eigen::VectorXd(chord.cholesky.solve(r));
+  };
+  Eigen::VectorXd dx = Eigen::VectorXd::Zero(g.size());
+  Eigen::VectorXd r = -g;
+  Eigen::VectorXd z = precondition(r);
+  Eigen::VectorXd p = z;
+  double rz = r.dot(z);
+  const double target = options_.krylov_tolerance * g.norm();
+  for (int k = 1; k <= options_.krylov_iterations; ++k) {
+    const Eigen::VectorXd Hp = H.selfadjointView<Eigen::Lower>() * p;
+    const double curvature = p.dot(Hp);
+    if (!(curvature > 0)) return {};  // not positive definite along p: Newton factors
+    const double alpha = rz / curvature;
+    dx += alpha * p;
+    r -= alpha * Hp;
+    if (r.norm() <= target) {
+      log.krylov = k;
+      return g.dot(dx) < 0 ? dx : Eigen::VectorXd();
+    }
+    z = precondition(r);
+    const double rz_next = r.dot(z);
+    p = z + (rz_next / rz) * p;
+    rz = rz_next;
+  }
+  return {};
 }
 
 Eigen::VectorXd StaticsSolver::newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
@@ -251,9 +297,21 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
       return result;
     }
     NewtonIterate log{.iteration = it, .residual = at.residual, .energy = at.energy};
-    if (may_chord && chord_step(terms, *chord, x, at, log)) {
+    ++total_iterations;
+    if (may_chord && options_.chord_steps && chord_step(terms, *chord, x, at, log)) {
       result.log.push_back(log);
       continue;
+    }
+    // Then a Newton step solved by conjugate gradients with the chord's factor: kept while it
+    // takes full steps (a shorter one means the factor no longer fits: Newton factors anew).
+    if (may_chord && options_.krylov_steps) {
+      const Eigen::VectorXd dx = krylov_direction(terms, ws, *chord, x, at.gradient, log);
+      if (dx.size() > 0 && line_search(terms, dx, x, at, log)) {
+        may_chord = log.step_length == 1;
+        result.log.push_back(log);
+        continue;
+      }
+      log.krylov = 0;
     }
     may_chord = false;
     const Eigen::VectorXd dx =

@@ -41,6 +41,13 @@ struct StaticsOptions {
   int max_iterations = 100;
   // Which sparse Cholesky; by default chosen by system size (SparseCholesky::choose).
   std::optional<SparseCholesky::Backend> backend;
+  // When a chord step fails, a Newton step whose system is solved by conjugate gradients
+  // preconditioned with the chord's (stale) factorization, before factoring anew: an inexact
+  // Newton step (relative residual krylov_tolerance, at most krylov_iterations products).
+  bool krylov_steps = true;
+  bool chord_steps = true;  // off: a nearby factorization is used by Krylov steps only (tests)
+  double krylov_tolerance = 1e-4;
+  int krylov_iterations = 25;
 };
 
 struct NewtonIterate {
@@ -51,6 +58,7 @@ struct NewtonIterate {
   double step_length = 0;  // line-search factor α
   bool projected = false;  // the PSD-projected Hessian was used
   bool chord = false;      // an earlier factorization was reused (no new one)
+  int krylov = 0;          // conjugate-gradient products of a Krylov step (0: none)
 };
 
 struct StaticsResult {
@@ -87,6 +95,14 @@ struct StaticsWorkspace {
 };
 
 using EnergyTerms = std::vector<const EnergyTerm*>;
+
+// Totals over the whole process since it started, for benchmarks (`shapectl bench --sizes`):
+// Newton and chord iterations, and numeric factorizations (stability checks included).
+struct StaticsTotals {
+  long long iterations = 0;
+  long long factorizations = 0;
+};
+StaticsTotals statics_totals();
 
 // The fixed description of a statics problem (size, fixed dofs, options) and the algorithms on
 // it. Const and shareable across threads; everything that changes lives in the caller's
@@ -138,6 +154,12 @@ class StaticsSolver {
   // The steps of solve(): each returns false when it cannot move x (x and `at` unchanged).
   bool chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord, Positions& x, Point& at,
                   NewtonIterate& log) const;
+  // Newton's direction at x by conjugate gradients on the true Hessian (assembled into `ws`,
+  // not factored), preconditioned with `chord`'s factorization; empty when they do not converge
+  // within the options' limits or meet non-positive curvature.
+  Eigen::VectorXd krylov_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
+                                   const StaticsWorkspace& chord, const Positions& x,
+                                   const Eigen::VectorXd& g, NewtonIterate& log) const;
   // Empty when not even the projected Hessian factors.
   Eigen::VectorXd newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                    const Positions& x, const Eigen::VectorXd& g, NewtonIterate& log,

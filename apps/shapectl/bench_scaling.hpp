@@ -1,0 +1,19 @@
+#pragma once
+// The scaling table of `shapectl bench --sizes 1.5k,6k,...`: one scene's box mesh refined to
+// about each tet count, with target changes, warm re-solves, statics from rest, peak memory
+// and how the times grow with the tet count.
+#include <string>
+#include <vector>
+
+namespace shapectl::cli {
+
+// "1.5k,6k,12k" → {1500, 6000, 12000}. Throws InputError naming `option` for anything else.
+std::vector<int> parse_tet_counts(const std::string& text, const std::string& option);
+
+// Runs and prints the table for the scene file (its object must be a box mesh without hole);
+// `trials` random reachable target sets per size; krylov_steps off measures statics without
+// the conjugate-gradient steps.
+void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_counts, int trials,
+                   unsigned seed, bool krylov_steps);
+
+}  // namespace shapectl::cli

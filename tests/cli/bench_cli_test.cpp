@@ -1,0 +1,41 @@
+// `shapectl bench --sizes`: the scaling table (its timings are measurements for
+// docs/benchmarks.md, not assertions) and its option's errors.
+#include <gtest/gtest.h>
+
+#include <regex>
+
+#include "support/test_support.hpp"
+
+namespace shapectl::test {
+namespace {
+
+TEST(BenchCli, ScalingTableHasARowPerSizeAndTheGrowthExponents) {
+  const std::string bar = source_path("scenes/yumi_bar.json").string();
+  const CliRun run = run_cli({"bench", bar, "--sizes", "0.4k,1.5k", "--trials", "2"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  // 0.4k: the bar's 16 × 4 × 4 cells scaled by (400 / 1536)^⅓ → 10 × 3 × 3 cells, 540 tets.
+  EXPECT_TRUE(std::regex_search(run.out, std::regex(R"(\n +540 \|)"))) << run.out;
+  EXPECT_TRUE(std::regex_search(run.out, std::regex(R"(\n +1536 \|)"))) << run.out;
+  // Both sizes reached the targets of both trials, and three finite exponents follow.
+  EXPECT_EQ(std::regex_search(run.out, std::regex(R"(\b[01]/2 ok)")), false) << run.out;
+  EXPECT_TRUE(std::regex_search(
+      run.out, std::regex(R"(target change -?\d+\.\d+, statics from rest -?\d+\.\d+, warm )")))
+      << run.out;
+}
+
+TEST(BenchCli, BadSizesAreRefusedNamingTheOptionAndTheItem) {
+  const CliRun run = run_cli({"bench", "--sizes", "1.5k,lots"});
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("--sizes"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("\"lots\""), std::string::npos) << run.err;
+}
+
+TEST(BenchCli, SizesNeedABoxMeshWithoutHole) {
+  const CliRun run =
+      run_cli({"bench", source_path("scenes/yumi_frame.json").string(), "--sizes", "1k"});
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_NE(run.err.find("object.mesh"), std::string::npos) << run.err;
+}
+
+}  // namespace
+}  // namespace shapectl::test
