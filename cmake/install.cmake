@@ -76,7 +76,13 @@ install(FILES ${three}/LICENSE ${three}/package.json
 install(FILES ${three}/build/three.module.js ${three}/build/three.core.js
         DESTINATION ${shapectl_data_dir}/web/node_modules/three/build)
 install(FILES ${three}/examples/jsm/controls/OrbitControls.js
+              ${three}/examples/jsm/controls/TransformControls.js
         DESTINATION ${shapectl_data_dir}/web/node_modules/three/examples/jsm/controls)
+# Screen-width lines for centre-lines and sketches (web/js/screen_line.js).
+install(FILES ${three}/examples/jsm/lines/Line2.js ${three}/examples/jsm/lines/LineGeometry.js
+              ${three}/examples/jsm/lines/LineMaterial.js ${three}/examples/jsm/lines/LineSegments2.js
+              ${three}/examples/jsm/lines/LineSegmentsGeometry.js
+        DESTINATION ${shapectl_data_dir}/web/node_modules/three/examples/jsm/lines)
 # The robot's mesh visuals (web/js/mesh_loader.js), with what ColladaLoader imports.
 install(FILES ${three}/examples/jsm/loaders/STLLoader.js ${three}/examples/jsm/loaders/OBJLoader.js
               ${three}/examples/jsm/loaders/ColladaLoader.js ${three}/examples/jsm/loaders/TGALoader.js

@@ -15,8 +15,8 @@
 #include "closed_loop_options.hpp"
 #include "commands.hpp"
 #include "link_options.hpp"
-#include "robot_mesh_options.hpp"
 #include "result_json.hpp"
+#include "robot_mesh_options.hpp"
 
 namespace shapectl::cli {
 
@@ -33,7 +33,7 @@ struct ServeArgs {
   std::string scenes_dir;
   double rate = 30;
   double tolerance = 1e-3;  // m
-  ClosedLoopArgs loop;  // the simulated real object, the online calibration
+  ClosedLoopArgs loop;      // the simulated real object, the online calibration
   // --package-path: the URDF's package:// meshes
   std::vector<std::string> package_paths;
 };

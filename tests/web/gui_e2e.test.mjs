@@ -143,7 +143,8 @@ describe('browser GUI', () => {
     await waitFor(() => slider.isEnabled(), 'the slider to be enabled');
     const grip = (await hooks(page, () => window.shapectl.scene)).grips[0].nodes[0];
     const gripBefore = await hooks(page, (n) => window.shapectl.nodePosition(n), grip);
-    // Drag the slider's thumb a few pixels to the right.
+    // Drag the slider's thumb a few pixels to the right (the panel scrolls: bring it into view).
+    await slider.scrollIntoViewIfNeeded();
     const box = await slider.boundingBox();
     const [lo, hi] = [Number(await slider.getAttribute('min')), Number(await slider.getAttribute('max'))];
     const x = box.x + 8 + (box.width - 16) * (paused.joints[0] - lo) / (hi - lo), y = box.y + box.height / 2;

@@ -9,7 +9,7 @@ import http from 'node:http';
 import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { startServer, launchChromium, openPage, waitFor } from './support.mjs';
+import { startServer, launchChromium, openPage, waitFor, closeAll } from './support.mjs';
 import { MeshFormat, ShapeKind } from '../../web/js/protocol.js';
 
 const hooks = (page, f, arg) => page.evaluate(f, arg);
@@ -145,9 +145,11 @@ describe('robot mesh visuals (package:// STL, OBJ, DAE)', () => {
     scene = await hooks(page, () => window.shapectl.scene);
   });
   after(async () => {
-    await browser?.close();
-    await server?.stop();
-    if (dir) rmSync(dir, { recursive: true, force: true });
+    try {
+      await closeAll(browser, server);
+    } finally {
+      if (dir) rmSync(dir, { recursive: true, force: true });
+    }
   });
 
   // The scene message's mesh visuals, by file name.

@@ -13,6 +13,7 @@ const CLOSEST_MATERIAL = new THREE.MeshBasicMaterial({ color: 0xffd23f, transpar
 const OVERLAP_MATERIAL = new THREE.MeshBasicMaterial({ color: 0xff2a2a, transparent: true, opacity: 0.8 });
 // A link whose spheres overlap another's.
 export const COLLIDING_COLOR = new THREE.Color(0xff2a2a);
+const COLLIDING_EMISSIVE = new THREE.Color(0x550000);
 const SHARED_MATERIALS = [SPHERE_MATERIAL, CLOSEST_MATERIAL, OVERLAP_MATERIAL];
 
 function linkColor(index) {
@@ -55,6 +56,15 @@ function colourMesh(object, shape, index, opacity) {
       m.depthWrite = m.opacity >= 1;
     }
   });
+}
+
+// A visual's material red while its link collides, its own colour (kept at the first call) after.
+function paintCollision(material, red) {
+  if (!material?.color) return;
+  material.userData.color ??= material.color.clone();
+  material.userData.emissive ??= material.emissive?.clone();
+  material.color.copy(red ? COLLIDING_COLOR : material.userData.color);
+  if (material.emissive) material.emissive.copy(red ? COLLIDING_EMISSIVE : material.userData.emissive);
 }
 
 export class RobotView {
@@ -102,7 +112,6 @@ export class RobotView {
         mesh.matrixAutoUpdate = false;
         mesh.matrix.fromArray(shape.pose);
         mesh.visible = this.robotVisible;
-        mesh.userData.color = mesh.material.color.clone();
         group.add(mesh);
         this.visualMeshes.push(mesh);
       }
@@ -168,11 +177,11 @@ export class RobotView {
     this.collidingLinks = new Set(collidingLinks);
     this.linkGroups.forEach((group, k) => {
       const red = this.collidingLinks.has(k);
-      for (const mesh of group.children) {
-        if (!this.visualMeshes.includes(mesh)) continue;
-        mesh.material.color.copy(red ? COLLIDING_COLOR : mesh.userData.color);
-        mesh.material.emissive?.setHex(red ? 0x550000 : 0x000000);
-      }
+      // Primitive and loaded mesh visuals alike; the collision spheres keep their own colours.
+      group.traverse((o) => {
+        if (!o.isMesh || this.sphereMeshes.includes(o)) return;
+        for (const material of Array.isArray(o.material) ? o.material : [o.material]) paintCollision(material, red);
+      });
     });
     this.closestPair = closestPair;
     const pair = closestPair?.spheres ?? [];

@@ -222,10 +222,11 @@ export class View3D {
     const box = new THREE.Box3().setFromBufferAttribute(object).union(new THREE.Box3().setFromObject(robot));
     fitCamera(this.camera, this.orbit, box.getCenter(new THREE.Vector3()), FRONT_VIEW, (visit) => {
       for (let i = 0; i < object.count; i++) visit(point.fromBufferAttribute(object, i));
-      for (const mesh of this.robotView.visualMeshes) {
-        const vertices = mesh.geometry.getAttribute('position');
-        for (let i = 0; i < vertices.count; i++) visit(point.fromBufferAttribute(vertices, i).applyMatrix4(mesh.matrixWorld));
-      }
+      // Primitive visuals, and loaded mesh visuals inside their holders.
+      for (const visual of this.robotView.visualMeshes) visual.traverse((mesh) => {
+        const vertices = mesh.isMesh ? mesh.geometry.getAttribute('position') : null;
+        for (let i = 0; i < (vertices?.count ?? 0); i++) visit(point.fromBufferAttribute(vertices, i).applyMatrix4(mesh.matrixWorld));
+      });
     });
     this.requestRender();
   }
