@@ -3,7 +3,7 @@
 // report state and project world points to the screen; every action goes through the UI.
 import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { startServer, launchChromium, waitFor, differingFraction, openPage, closeAll } from './support.mjs';
+import { startServer, launchChromium, waitFor, differingFraction, openPage, closeAll, openSession, closeSession } from './support.mjs';
 
 const hooks = (page, f, arg) => page.evaluate(f, arg);
 const state = (page) => hooks(page, () => window.shapectl.state);
@@ -27,14 +27,14 @@ async function mouseStroke(page, points) {
 describe('browser GUI', () => {
   let server, browser, page;
 
+  let session;
   before(async () => {
-    server = await startServer([]);
-    browser = await launchChromium();
-    page = await openPage(browser, server.url);
+    session = await openSession();
+    ({ server, browser, page } = session);
   });
 
   after(async () => {
-    await closeAll(browser, server);  // fails on any console problem of the run
+    await closeSession(session);  // fails on any console problem of the run
   });
 
   it('loads with robot and object visible', async () => {

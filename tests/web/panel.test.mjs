@@ -7,7 +7,7 @@
 import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { readFileSync } from 'node:fs';
-import { startServer, launchChromium, waitFor, differingFraction, openPage, RawWebSocket } from './support.mjs';
+import { startServer, launchChromium, waitFor, differingFraction, openPage, RawWebSocket, openSession, closeSession } from './support.mjs';
 import { Command, LinkKind } from '../../web/js/protocol.js';
 
 const hooks = (page, f, arg) => page.evaluate(f, arg);
@@ -34,15 +34,14 @@ async function drag(page, from, to) {
 describe('side panel and view tools', () => {
   let server, browser, page;
 
+  let session;
   before(async () => {
-    server = await startServer([]);
-    browser = await launchChromium();
-    page = await openPage(browser, server.url);
+    session = await openSession();
+    ({ server, browser, page } = session);
   });
 
   after(async () => {
-    await browser?.close();
-    await server?.stop();
+    await closeSession(session);  // fails on any console problem of the run
   });
 
   it('offers Delete only for a selected target that exists', async () => {

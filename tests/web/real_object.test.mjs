@@ -8,7 +8,7 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { startServer, launchChromium, openPage, waitFor, differingFraction, RawWebSocket, sourceDir, closeAll } from './support.mjs';
+import { startServer, launchChromium, openPage, waitFor, differingFraction, RawWebSocket, sourceDir, closeAll, openSession, closeSession } from './support.mjs';
 import { Command, LinkKind, Message, Parameter } from '../../web/js/protocol.js';
 import { SERIES } from '../../web/js/plot.js';
 
@@ -165,16 +165,14 @@ describe('the real object: plot and calibration (serve --world)', () => {
 describe('the real object: an observed point cloud (serve)', () => {
   let server, browser, page, ws;
 
+  let session;
   before(async () => {
-    server = await startServer([]);
-    browser = await launchChromium();
-    page = await openPage(browser, server.url);
-    ws = await RawWebSocket.connect(server.port);
+    session = await openSession([], { socket: true });
+    ({ server, browser, page, ws } = session);
   });
 
   after(async () => {
-    ws?.close();
-    await closeAll(browser, server);  // fails on any console problem of the run
+    await closeSession(session);  // fails on any console problem of the run
   });
 
   it('draws the points of the last observed frame over the model, and hides them with the checkbox', async () => {

@@ -5,7 +5,7 @@
 // YuMi + foam bar scene; Chromium headless via playwright-core.
 import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { startServer, launchChromium, waitFor, openPage, RawWebSocket } from './support.mjs';
+import { startServer, launchChromium, waitFor, openPage, RawWebSocket, openSession, closeSession } from './support.mjs';
 import { ControllerStatus, Shortfall, Message, Command } from '../../web/js/protocol.js';
 import { JOG_STEP } from '../../web/js/joint_jog.js';
 
@@ -32,17 +32,14 @@ async function send(ws, type, fields = {}) {
 describe('status and jogging', () => {
   let server, browser, page, ws;
 
+  let session;
   before(async () => {
-    server = await startServer([]);
-    browser = await launchChromium();
-    page = await openPage(browser, server.url);
-    ws = await RawWebSocket.connect(server.port);
+    session = await openSession([], { socket: true });
+    ({ server, browser, page, ws } = session);
   });
 
   after(async () => {
-    ws?.close();
-    await browser?.close();
-    await server?.stop();
+    await closeSession(session);  // fails on any console problem of the run
   });
 
   it('says reached for a reachable target, in green', async () => {

@@ -275,3 +275,18 @@ export class RawWebSocket {
   json(match) { return this.messages.filter((m) => m.text).map((m) => JSON.parse(m.text)).filter(match); }
   close() { this.socket.destroy(); }
 }
+
+// One test file's session: `serve` with `args`, Chromium, a page on it, and with `socket` a raw
+// WebSocket beside the page. closeSession fails on any console problem of the run.
+export async function openSession(args = [], { socket = false } = {}) {
+  const server = await startServer(args);
+  const browser = await launchChromium();
+  const page = await openPage(browser, server.url);
+  const ws = socket ? await RawWebSocket.connect(server.port) : null;
+  return { server, browser, page, ws };
+}
+
+export async function closeSession(session) {
+  session?.ws?.close();
+  await closeAll(session?.browser, session?.server);
+}
