@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 
@@ -109,11 +110,19 @@ TEST_F(ClosedLoopCli, TheOnlineCalibrationLearnsTheWorldWhileTheLoopReachesTheTa
   EXPECT_LT(r["true_error"].get<double>(), 1e-3);
   ASSERT_TRUE(r.contains("calibration")) << r.dump();
   EXPECT_GE(r["calibration"]["applied"].get<int>(), 1) << r.dump();
-  EXPECT_LT(r["model_error"].get<double>(), 1e-3) << "the calibrated model predicts the world";
   const auto calibrations = log_events(log, "calibration");
   ASSERT_FALSE(calibrations.empty());
   EXPECT_LT(calibrations.front()["rms_after"].get<double>(),
             calibrations.front()["rms_before"].get<double>());
+  // The calibrated model predicts the world: the last applied fit's residual over its window of
+  // observed frames. (Not the run's last model_error: when the run settles, the newest frame may
+  // predate a fit still in the background, so that figure depends on the machine's speed.)
+  const auto applied = std::find_if(calibrations.rbegin(), calibrations.rend(), [](const auto& c) {
+    return c["applied"].template get<bool>();
+  });
+  ASSERT_NE(applied, calibrations.rend());
+  EXPECT_LT((*applied)["rms_after"].get<double>(), 1e-3)
+      << "the calibrated model predicts the world";
   const CommandLogCheck check = check_command_log(read_session_log(log), log.string());
   EXPECT_TRUE(check.ok()) << check.violations.front();
 }
