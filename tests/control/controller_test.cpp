@@ -100,6 +100,30 @@ TEST(Controller, AJogFartherThanOneStepIsRefusedAndChangesNothing) {
   EXPECT_EQ(controller.snapshot()->joints, before);
 }
 
+// A jog sent right after the pause is a jog while paused, not an error: it is judged by the
+// last pause asked for, not by the snapshot (which shows the pause only once the thread has
+// applied and published it; a loaded machine widens that window, which this single-threaded
+// test cannot open, so it checks the pending case and that a reset keeps a pending pause).
+TEST(Controller, AJogRightAfterThePauseIsAcceptedBeforeThePauseIsPublished) {
+  Controller controller(test::two_arm_scene());
+  const Eigen::VectorXd before = controller.snapshot()->joints;
+  controller.set_paused(true);
+  ASSERT_FALSE(controller.snapshot()->paused) << "no step applied the pause yet";
+  Eigen::VectorXd jog = before;
+  jog[1] += 0.04;
+  controller.set_joints(jog);
+  controller.step_once();
+  EXPECT_TRUE(controller.snapshot()->paused);
+  EXPECT_NEAR(controller.snapshot()->joints[1], jog[1], 1e-12);
+  // A reset does not undo a pause that is still pending.
+  controller.set_paused(false);
+  controller.step_once();
+  controller.set_paused(true);
+  controller.reset();
+  controller.step_once();
+  EXPECT_TRUE(controller.snapshot()->paused);
+}
+
 TEST(Controller, AJogIntoSelfCollisionIsRefusedNamingTheLinks) {
   // The third links' spheres 1 cm apart; the arms swing towards each other 5 mrad a jog.
   Controller controller(test::two_arm_scene_with_clearance(0.01));

@@ -83,7 +83,8 @@ describe('robot visuals in the 3D view', () => {
       const step = scene.limits.max_jog_step;
       joints[0] = Math.abs(far - joints[0]) <= step ? far : joints[0] + Math.sign(far - joints[0]) * step;
       ws.sendJson({ type: Command.SetJoints, joints, id: `jog${n}` });
-      assert.equal((await reply(`jog${n}`)).type, Message.Ok);
+      const answer = await reply(`jog${n}`);
+      assert.equal(answer.type, Message.Ok, `jog ${n}: ${answer.message}`);
     }
     ws.close();
 

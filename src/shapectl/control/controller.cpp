@@ -120,6 +120,9 @@ struct Controller::State {
   // The joints the last accepted jog asked for (guarded by inbox_mutex): the next jog's step is
   // measured from there, as the snapshot may not show it yet. Cleared by pause, resume, reset.
   std::optional<Eigen::VectorXd> jogged_to;
+  // The last set_paused (under inbox_mutex): a jog right after a pause is judged by it, not by
+  // a snapshot that may not show the pause yet (the thread applies, then publishes).
+  bool pause_requested = false;
 
   mutable std::mutex snapshot_mutex;
   mutable std::condition_variable snapshot_changed;
@@ -519,6 +522,7 @@ void Controller::clear_targets() {
 void Controller::set_paused(bool paused) {
   post(*state_, [&](Inbox& in) {
     in.paused = paused;
+    state_->pause_requested = paused;
     state_->jogged_to.reset();
   });
 }
@@ -536,8 +540,8 @@ void Controller::set_joints(const Eigen::VectorXd& joints) {
   {
     std::lock_guard lock(state_->inbox_mutex);
     const auto now = snapshot();
-    const bool pausing = state_->inbox.paused.value_or(now->paused);
-    if (!pausing) throw InputError("joints", "", "the optimizer to be paused before jogging");
+    if (!state_->pause_requested)
+      throw InputError("joints", "", "the optimizer to be paused before jogging");
     const Eigen::VectorXd& from = state_->jogged_to ? *state_->jogged_to : now->joints;
     std::vector<int> links;
     refusal = state_->jog_collision(from, theta, links);
@@ -593,8 +597,10 @@ void Controller::set_model(const Scene& model) {
 
 void Controller::reset() {
   post(*state_, [&](Inbox& in) {
+    const std::optional<bool> paused = in.paused;  // a reset does not undo a pause
     in = Inbox{};
     in.reset = true;
+    in.paused = paused;
     state_->jogged_to.reset();
   });
 }
