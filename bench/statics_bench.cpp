@@ -164,6 +164,60 @@ BENCHMARK_CAPTURE(factorize, solve14_band, SparseCholesky::Backend::Band, 14)
 BENCHMARK_CAPTURE(factorize, solve14_cholmod, SparseCholesky::Backend::CholmodSupernodal, 14)
     ->Unit(benchmark::kMillisecond);
 
+// The pieces of one optimizer iteration on a refined bar (12,288 tets: the 12k size),
+// at its equilibrium: energy, gradient, Hessian assembly, numeric factorization, a solve with
+// 14 right-hand sides (dx̂/dθ for two 7-joint arms). Which piece dominates decides what to cut.
+enum class Piece { Energy, Gradient, Hessian, Factorize, Solve14 };
+void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::Backend> backend) {
+  const int n = static_cast<int>(state.range(0));
+  Scene scene = clamped_bar({4 * n, n, n});
+  scene.statics.backend = backend;
+  ObjectStatics statics(scene);
+  StaticsWorkspace ws = statics.make_workspace();
+  Positions x = scene.world_rest_positions();
+  if (!statics.solve(ws, x).converged()) state.SkipWithError("statics failed");
+  const EnergyTerms terms = statics.terms();
+  const StaticsSolver& solver = statics.solver();
+  if (!solver.factor(terms, ws, x)) state.SkipWithError("not positive definite");
+  const Eigen::MatrixXd rhs = Eigen::MatrixXd::Ones(x.size(), 14);
+  for (auto _ : state) {
+    switch (which) {
+      case Piece::Energy: benchmark::DoNotOptimize(solver.energy(terms, x)); break;
+      case Piece::Gradient: benchmark::DoNotOptimize(solver.gradient(terms, x)); break;
+      case Piece::Hessian: benchmark::DoNotOptimize(solver.hessian(terms, x)); break;
+      case Piece::Factorize: benchmark::DoNotOptimize(solver.factor(terms, ws, x)); break;
+      case Piece::Solve14: benchmark::DoNotOptimize(solver.solve_with_factor(ws, rhs)); break;
+    }
+  }
+  state.counters["tets"] = statics.mesh().tet_count();
+}
+BENCHMARK_CAPTURE(piece, energy, Piece::Energy, std::nullopt)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, gradient, Piece::Gradient, std::nullopt)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, hessian, Piece::Hessian, std::nullopt)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, assemble_and_factor_auto, Piece::Factorize, std::nullopt)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, assemble_and_factor_band, Piece::Factorize, SparseCholesky::Backend::Band)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, assemble_and_factor_cholmod, Piece::Factorize,
+                  SparseCholesky::Backend::CholmodSupernodal)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, solve14_auto, Piece::Solve14, std::nullopt)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, solve14_cholmod, Piece::Solve14,
+                  SparseCholesky::Backend::CholmodSupernodal)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+
 }  // namespace
 }  // namespace shapectl
 
