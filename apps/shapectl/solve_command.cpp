@@ -3,6 +3,8 @@
 //   [--optimizer lbfgs|gauss-newton] [--gradient sensitivity|adjoint|finite-difference]
 //   [--max-iterations N] [--max-seconds S] [--tolerance M]
 // Finds joint angles whose equilibrium shape best matches the targets.
+#include <algorithm>
+#include <chrono>
 #include <iostream>
 #include <limits>
 
@@ -57,6 +59,16 @@ ShapeTargets resolve_targets(const TargetsInput& in, const std::string& file,
 }
 
 void run_solve(const SolveArgs& args) {
+  // --max-seconds bounds the whole command: the statics at the start, each trial's statics and
+  // the buckling probe stop at it too, not only the optimizer's steps. Checks come between
+  // pieces that cannot be cut (a Newton iteration, a factorization, a sensitivity solve: up to
+  // ~0.5 s each at 50k tets), so they aim at 90 % of the budget.
+  const auto started = std::chrono::steady_clock::now();
+  const auto elapsed = [started] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  };
+  const double aim = 0.9 * args.max_seconds;
+  const StopRequest out_of_time = [&] { return elapsed() > aim; };
   check_surface_option("solve", args.surface);
   const Scene scene = load_scene(args.scene);
   print_scene_notes(scene, args.package_paths);
@@ -73,12 +85,14 @@ void run_solve(const SolveArgs& args) {
     throw InputError("--gradient", "", "one of the gradient names", args.gradient);
   auto optimizer = make_optimizer(kind, gradient);
   const Evaluation start =
-      objective.evaluate(object.reference_joints(), object.reference_positions());
+      objective.evaluate(object.reference_joints(), object.reference_positions(), 0, nullptr,
+                         out_of_time);
   if (!start.statics.converged())
-    throw SolverFailure("statics at the reference joints: " + start.statics.reason);
-  const OptimizeResult result =
-      optimize(objective, *optimizer, start,
-               {.max_iterations = args.max_iterations, .max_seconds = args.max_seconds});
+    throw SolverFailure("statics at the reference joints: " + start.statics.reason +
+                        (out_of_time() ? " (--max-seconds reached)" : ""));
+  const OptimizeResult result = optimize(objective, *optimizer, start,
+                                         {.max_iterations = args.max_iterations,
+                                          .max_seconds = std::max(0.0, aim - elapsed())});
 
   const Evaluation& best = result.best;
   nlohmann::json out = robot_json(scene, best.joints);
@@ -91,7 +105,8 @@ void run_solve(const SolveArgs& args) {
   out["status"] = to_string(status);
   out["tolerance"] = args.tolerance;
   ShortfallReport shortfall;
-  if (status == ControllerStatus::BestEffort) shortfall = find_shortfalls(objective, best);
+  if (status == ControllerStatus::BestEffort)
+    shortfall = find_shortfalls(objective, best, out_of_time);
   out["unreachable"] = shortfall_names(shortfall.reasons);
   out["status_reason"] = shortfall.detail;
   out["iterations"] = result.iterations;

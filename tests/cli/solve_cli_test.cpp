@@ -157,6 +157,21 @@ TEST(SolveCli, BadTargetsAreBadInput) {
   }
 }
 
+TEST(SolveCli, MaxSecondsReachesIntoTheStaticsAtTheStart) {
+  // A budget far shorter than the statics at the reference joints: the solve stops inside
+  // them, says why, exits 2 (a solver failure) and writes nothing (no equilibrium, no result).
+  TempDir dir;
+  const auto targets =
+      dir.write("t.json", R"({"targets": [{"node": 0, "position": [0.3, 0, 0.3]}]})");
+  const auto out = dir.path() / "r.json";
+  const auto run = run_cli({"solve", kBar, "--targets", targets.string(), "--out", out.string(),
+                            "--max-seconds", "1e-6"});
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_NE(run.err.find("stopped (time limit)"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("--max-seconds reached"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 TEST(SolveCli, CentreLineOnAnObjectThatIsNotBarLikeIsBadInput) {
   TempDir dir;
   const auto file = dir.write("line.json", R"({"centerline": [[0.3, 0, 0.3], [0.4, 0, 0.3]]})");

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 
 #include <shapectl/mesh/box_mesh.hpp>
@@ -112,6 +113,49 @@ TEST(Statics, KrylovStepsSaveFactorizationsAndReachTheSameEquilibrium) {
   // Converged on the true residual: the same equilibrium to a sub-micrometre.
   EXPECT_LE(rk.residual, statics.force_tolerance());
   EXPECT_LT((x - newton_x).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+TEST(Statics, ChordStepsFollowARigidTurnOfTheWholeObject) {
+  // The clamped bar's equilibrium turned 20° about a horizontal axis, clamps included: gravity
+  // now pulls partly along the bar, so the equilibrium there differs by a third of a millimetre.
+  // The factorization made before the turn, turned with it, still gives chord steps that converge
+  // (elasticity's Hessian turns with the object); unturned, it does not, and Newton factors.
+  const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
+  const Mat3 R = Eigen::AngleAxisd(0.35, Vec3::UnitY()).toRotationMatrix();
+  auto solve_turned = [&](bool rotate_chord) {
+    Scene s = scene;
+    s.statics.rotate_chord = rotate_chord;
+    s.statics.krylov_steps = false;
+    const ObjectStatics statics(s);
+    StaticsWorkspace ws = statics.make_workspace();
+    Positions x = s.world_rest_positions();
+    EXPECT_TRUE(statics.solve(ws, x).converged());
+    for (int i = 0; i < statics.mesh().node_count(); ++i)
+      x.segment<3>(3 * i) = R * x.segment<3>(3 * i);
+    const Positions turned = x;
+    const StaticsResult r = statics.solve(ws, x, nullptr, 0, &ws);
+    EXPECT_TRUE(r.converged()) << r.reason;
+    EXPECT_GT((x - turned).cwiseAbs().maxCoeff(), 1e-4);  // a real re-solve
+    return r;
+  };
+  const StaticsResult turned = solve_turned(true), plain = solve_turned(false);
+  EXPECT_EQ(turned.factorizations, 0);
+  EXPECT_GT(plain.factorizations, 0);
+}
+
+TEST(Statics, AStopRequestEndsTheSolveAndSaysSo) {
+  const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
+  const ObjectStatics statics(scene);
+  StaticsWorkspace ws = statics.make_workspace();
+  Positions x = scene.world_rest_positions();
+  int asked = 0;
+  const StaticsResult r = statics.solve(ws, x, nullptr, 0, nullptr, [&] { return ++asked > 1; });
+  EXPECT_EQ(r.status, StaticsStatus::NotConverged);
+  EXPECT_EQ(r.iterations, 1);
+  EXPECT_NE(r.reason.find("stopped (time limit)"), std::string::npos) << r.reason;
+  EXPECT_TRUE(x.allFinite());
+  Positions again = x;  // the same solve, not stopped, goes on from there and converges
+  EXPECT_TRUE(statics.solve(ws, again).converged());
 }
 
 TEST(Statics, CompressedSlenderBarIsNotPositiveDefinite) {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <shapectl/enum_names.hpp>
+#include <shapectl/sim/rigid_motion.hpp>
 
 namespace shapectl {
 
@@ -51,11 +52,11 @@ Evaluation evaluate_predicted(const ReducedObjective& objective, const Eigen::Ve
   // A trial whose statics need many Newton steps is far outside the linear model: better
   // rejected (and the step shortened) than solved at length.
   constexpr int kTrialNewtonLimit = 25;
-  Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit, &from);
+  Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit, &from, out_of_time);
   if (e.statics.status == StaticsStatus::Inverted && e.statics.iterations == 0 &&
       !(out_of_time && out_of_time()))
-    e = objective.evaluate(joints, from.positions, kTrialNewtonLimit,
-                           &from);  // the prediction itself inverted
+    e = objective.evaluate(joints, from.positions, kTrialNewtonLimit, &from,
+                           out_of_time);  // the prediction itself inverted
   return e;
 }
 
@@ -86,8 +87,9 @@ StepOutcome GaussNewton::step(const ReducedObjective& objective, Evaluation& cur
     if (largest < 1e-12) return StepOutcome::Converged;
     if (largest > max_step) delta *= max_step / largest;
     const Eigen::VectorXd theta = current.joints + delta;
-    // First-order prediction of the new equilibrium, the gripped nodes carried exactly.
-    Positions predicted_x = current.positions + dx * delta;
+    // First-order prediction of the new equilibrium with its rotation made finite (a linear
+    // one stretches the object), the gripped nodes carried exactly.
+    Positions predicted_x = with_finite_rotation(current.positions, dx * delta);
     objective.object().carry_gripped_nodes(current.joints, theta, current.positions, predicted_x);
     Evaluation trial = evaluate_predicted(objective, theta, current, predicted_x, out_of_time);
     const double predicted = current.objective - 0.5 * (r + J * delta).squaredNorm();
@@ -155,7 +157,7 @@ StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) 
     const Eigen::VectorXd theta = current.joints + t * d;
     // Warm start from the current shape: carrying the gripped nodes alone (without dx̂/dθ·Δθ
     // for the rest) measured no faster for these short steps.
-    Evaluation trial = objective.evaluate(theta, current.positions, 25, &current);
+    Evaluation trial = objective.evaluate(theta, current.positions, 25, &current, out_of_time);
     if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
     if (!objective.confirm_stable(trial)) continue;
     const bool tiny = negligible(current.objective, trial.objective);

@@ -92,10 +92,11 @@ Evaluation ReducedObjective::describe(ObjectState state) const {
 }
 
 Evaluation ReducedObjective::evaluate(const Eigen::VectorXd& joints, const Positions& x,
-                                      int max_newton, const Evaluation* from) const {
+                                      int max_newton, const Evaluation* from,
+                                      const StopRequest& stop) const {
   const auto t0 = Clock::now();
   const ObjectState* chord = from && options_.chord_steps ? from->state.get() : nullptr;
-  ObjectState state = object_->solve_from(joints, x, max_newton, chord);
+  ObjectState state = object_->solve_from(joints, x, max_newton, chord, stop);
   count_statics(seconds_since(t0));
   return describe(std::move(state));
 }

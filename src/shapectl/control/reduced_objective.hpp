@@ -78,9 +78,10 @@ class ReducedObjective {
 
   // Solves statics at θ from the warm start `x` (chord steps with `from`'s factorization if
   // given, e.g. the state x came from) and scores it. max_newton > 0 caps the Newton
-  // iterations (a trial that needs more is not worth it).
+  // iterations (a trial that needs more is not worth it); `stop` may end statics early (a time
+  // budget: the evaluation is then not converged).
   Evaluation evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton = 0,
-                      const Evaluation* from = nullptr) const;
+                      const Evaluation* from = nullptr, const StopRequest& stop = {}) const;
   // True if `e` is a stable equilibrium (the Hessian there positive definite); otherwise
   // marks it Unstable, objective +inf. Optimizers ask before accepting a state: an unstable
   // equilibrium is no shape a robot can hold. The factorization it needs is the one the next

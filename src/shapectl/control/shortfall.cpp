@@ -112,10 +112,11 @@ std::string reach(const ReducedObjective& objective, const Evaluation& at) {
 
 // Whether a step along d loses the equilibrium or snaps to another one.
 std::string buckling(const ReducedObjective& objective, const Evaluation& at,
-                     const Eigen::VectorXd& d) {
+                     const Eigen::VectorXd& d, const StopRequest& stop) {
   if (d.norm() == 0) return {};
   const Eigen::VectorXd step = kBucklingProbe * d.normalized();
-  Evaluation next = objective.evaluate(at.joints + step, at.positions, 0, &at);
+  Evaluation next = objective.evaluate(at.joints + step, at.positions, 0, &at, stop);
+  if (!next.statics.converged() && stop && stop()) return {};  // out of time: not judged
   if (!objective.confirm_stable(next)) return "no stable equilibrium 0.02 rad further";
   const Eigen::VectorXd predicted = objective.sensitivity(at, false) * step;
   double moved = 0, expected = 0;
@@ -141,7 +142,8 @@ std::vector<std::string> shortfall_names(const std::vector<Shortfall>& shortfall
   return names;
 }
 
-ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluation& at) {
+ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluation& at,
+                                const StopRequest& stop) {
   ShortfallReport report;
   if (objective.targets().empty() || !at.statics.converged()) return report;
   const Eigen::VectorXd d = shape_descent(objective, at);
@@ -149,7 +151,7 @@ ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluat
       {Shortfall::JointLimit, joint_limit(objective, at, d)},
       {Shortfall::Collision, collision(objective, at, d)},
       {Shortfall::Reach, reach(objective, at)},
-      {Shortfall::Buckling, buckling(objective, at, d)}};
+      {Shortfall::Buckling, buckling(objective, at, d, stop)}};
   for (const auto& [reason, words] : found) {
     if (words.empty()) continue;
     report.reasons.push_back(reason);

@@ -33,7 +33,9 @@ struct ShortfallReport {
   std::string detail;              // in words, with names and numbers
 };
 
-// The reasons that hold at `at` (a converged equilibrium) for `objective`'s targets.
-ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluation& at);
+// The reasons that hold at `at` (a converged equilibrium) for `objective`'s targets. `stop` (a
+// time budget) may cut the buckling probe's statics short: buckling is then not reported.
+ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluation& at,
+                                const StopRequest& stop = {});
 
 }  // namespace shapectl

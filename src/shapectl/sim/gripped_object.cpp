@@ -58,20 +58,22 @@ ObjectState GrippedObject::unsolved_state(const Positions& x) const {
 }
 
 const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::VectorXd& joints,
-                                          int max_iterations, const ObjectState* chord) const {
+                                          int max_iterations, const ObjectState* chord,
+                                          const StopRequest& stop) const {
   state.joints_ = joints;
   state.kinematics_ = forward_kinematics(robot(), joints);
   const GripEnergy grip(*grips_, state.kinematics_);
   const StaticsWorkspace* chord_ws = chord ? chord->workspace_.get() : nullptr;
   state.statics_ =
-      statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations, chord_ws);
+      statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations, chord_ws, stop);
   return state.statics_;
 }
 
 ObjectState GrippedObject::solve_from(const Eigen::VectorXd& joints, const Positions& x,
-                                      int max_iterations, const ObjectState* chord) const {
+                                      int max_iterations, const ObjectState* chord,
+                                      const StopRequest& stop) const {
   ObjectState s = unsolved_state(x);  // solve() sets θ and the kinematics
-  solve(s, joints, max_iterations, chord);
+  solve(s, joints, max_iterations, chord, stop);
   return s;
 }
 

@@ -41,12 +41,13 @@ class GrippedObject {
   // Equilibrium at θ = joints, Newton from the state's positions; `state` then describes it.
   // Newton tries steps with `chord`'s factorization first if it holds one (a nearby state's,
   // e.g. the one the warm start came from; it may be `state` itself). max_iterations > 0
-  // caps Newton for this call.
+  // caps Newton for this call; `stop` may end it early (a time budget).
   const StaticsResult& solve(ObjectState& state, const Eigen::VectorXd& joints,
-                             int max_iterations = 0, const ObjectState* chord = nullptr) const;
+                             int max_iterations = 0, const ObjectState* chord = nullptr,
+                             const StopRequest& stop = {}) const;
   // A new state solved at θ = joints from the warm start x, chord steps from `chord`'s factor.
   ObjectState solve_from(const Eigen::VectorXd& joints, const Positions& x, int max_iterations = 0,
-                         const ObjectState* chord = nullptr) const;
+                         const ObjectState* chord = nullptr, const StopRequest& stop = {}) const;
 
   // A warm start for the equilibrium at `to` from the one at `from`: every gripped node of `x`
   // is set to its position in `at_from` moved rigidly with its end effector from `from` to

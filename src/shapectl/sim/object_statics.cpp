@@ -99,7 +99,8 @@ StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double
           .backend = scene.statics.backend,
           .krylov_steps = scene.statics.krylov_steps &&
                           (!scene.statics.chord_steps || 3 * placed.node_count() >= kKrylovFrom),
-          .chord_steps = scene.statics.chord_steps};
+          .chord_steps = scene.statics.chord_steps,
+          .rotate_chord = scene.statics.rotate_chord};
 }
 }  // namespace
 
@@ -121,14 +122,15 @@ EnergyTerms ObjectStatics::terms(const EnergyTerm* extra) const {
 }
 
 StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra,
-                                   int max_iterations, const StaticsWorkspace* chord) const {
+                                   int max_iterations, const StaticsWorkspace* chord,
+                                   const StopRequest& stop) const {
   if (!unheld_reason_.empty()) {
     StaticsResult r;
     r.status = StaticsStatus::Singular;
     r.reason = unheld_reason_;
     return r;
   }
-  return solver_.solve(terms(extra), ws, x, max_iterations, chord);
+  return solver_.solve(terms(extra), ws, x, max_iterations, chord, stop);
 }
 
 StaticsResult ObjectStatics::solve(Positions& x, int max_iterations) const {

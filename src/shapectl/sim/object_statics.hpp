@@ -26,7 +26,8 @@ class ObjectStatics {
   // the energy plus `extra`, in `ws` (see StaticsSolver::solve for `chord`). An object that
   // nothing holds is reported as Singular without iterating.
   StaticsResult solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra = nullptr,
-                      int max_iterations = 0, const StaticsWorkspace* chord = nullptr) const;
+                      int max_iterations = 0, const StaticsWorkspace* chord = nullptr,
+                      const StopRequest& stop = {}) const;
   // The same from scratch (a workspace of its own, no earlier factorization).
   StaticsResult solve(Positions& x, int max_iterations = 0) const;
   // The true Hessian of the object's own energy at x (for tests and tools).

@@ -40,7 +40,8 @@ struct StaticsSettings {
   // Newton steps by conjugate gradients preconditioned with a nearby state's factorization
   // (StaticsOptions::krylov_steps); off only to measure what they save (`bench --no-krylov`).
   bool krylov_steps = true;
-  bool chord_steps = true;  // off: Krylov steps only (tests force that path with it)
+  bool chord_steps = true;   // off: Krylov steps only (tests force that path with it)
+  bool rotate_chord = true;  // StaticsOptions::rotate_chord; off only to measure what it saves
 };
 
 struct EndEffector {

@@ -5,6 +5,8 @@
 #include <limits>
 #include <sstream>
 
+#include <shapectl/sim/rigid_motion.hpp>
+
 namespace shapectl {
 
 const char* to_string(StaticsStatus status) {
@@ -142,15 +144,24 @@ double StaticsSolver::energy_noise(double energy) const {
   return std::max(options_.energy_roundoff, 1e-12 * std::abs(energy)) + 1e-300;
 }
 
+Mat3 StaticsSolver::chord_rotation(const StaticsWorkspace& chord, const Positions& x) const {
+  return options_.rotate_chord ? best_fit_rotation(chord.factor_x, x) : Mat3::Identity();
+}
+
+Eigen::VectorXd StaticsSolver::solve_rotated(const StaticsWorkspace& chord, const Mat3& R,
+                                             const Eigen::VectorXd& r) const {
+  // H(x) ≈ R H(x_chord) Rᵀ for an object turned by R, so H(x)⁻¹ r ≈ R H(x_chord)⁻¹ Rᵀ r. Fixed
+  // nodes have zero residual rows and stay zero (R turns a node's three dofs together).
+  const Eigen::VectorXd turned = rotate_nodes(R, r, /*transpose=*/true);
+  std::lock_guard lock(*chord.solve_mutex);
+  return rotate_nodes(R, chord.cholesky.solve(turned));
+}
+
 bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord,
                                Positions& x, Point& at, NewtonIterate& log) const {
   // The full step with the earlier factorization, kept while it lowers the energy and cuts the
   // force 4-fold.
-  Eigen::VectorXd dx;
-  {
-    std::lock_guard lock(*chord.solve_mutex);
-    dx = -chord.cholesky.solve(at.gradient);
-  }
+  const Eigen::VectorXd dx = -solve_rotated(chord, chord_rotation(chord, x), at.gradient);
   if (!(at.gradient.dot(dx) < 0)) return false;
   Positions trial = x + dx;
   const double e_trial = energy(terms, trial);
@@ -177,10 +188,8 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
   ws.triplets.clear();
   for (const auto* t : terms) t->add_hessian(x, ws.triplets, false);
   const SparseMatrix& H = ws.assembler.assemble(ws.triplets);
-  auto precondition = [&](const Eigen::VectorXd& r) {
-    std::lock_guard lock(*chord.solve_mutex);
-    return Eigen::VectorXd(chord.cholesky.solve(r));
-  };
+  const Mat3 R = chord_rotation(chord, x);
+  auto precondition = [&](const Eigen::VectorXd& r) { return solve_rotated(chord, R, r); };
   Eigen::VectorXd dx = Eigen::VectorXd::Zero(g.size());
   Eigen::VectorXd r = -g;
   Eigen::VectorXd z = precondition(r);
@@ -208,13 +217,15 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
 
 Eigen::VectorXd StaticsSolver::newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                                 const Positions& x, const Eigen::VectorXd& g,
-                                                NewtonIterate& log, int& factorizations) const {
+                                                NewtonIterate& log, int& factorizations,
+                                                const StopRequest& stop) const {
   // The true Hessian at x, if it gives a descent direction; else the PSD-projected one.
   ++factorizations;
   if (factor_at(terms, ws, x, false)) {
     Eigen::VectorXd dx = -ws.cholesky.solve(g);
     if (g.dot(dx) < 0) return dx;
   }
+  if (stop && stop()) return {};  // the caller reports the stop
   log.projected = true;
   ++factorizations;
   if (!factor_at(terms, ws, x, true)) return {};
@@ -248,8 +259,16 @@ bool StaticsSolver::line_search(const EnergyTerms& terms, const Eigen::VectorXd&
   return false;
 }
 
+StaticsResult StaticsSolver::stopped(StaticsResult& result, const Point& at, int it) const {
+  result.status = StaticsStatus::NotConverged;
+  result.reason = "stopped (time limit): residual " + sci(at.residual) + " N after " +
+                  std::to_string(it) + " iterations";
+  return result;
+}
+
 StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& ws, Positions& x,
-                                   int max_iterations, const StaticsWorkspace* chord) const {
+                                   int max_iterations, const StaticsWorkspace* chord,
+                                   const StopRequest& stop) const {
   if (max_iterations <= 0) max_iterations = options_.max_iterations;
   StaticsResult result;
   Point at;
@@ -296,6 +315,7 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
                       std::to_string(it) + " iterations";
       return result;
     }
+    if (stop && stop()) return stopped(result, at, it);
     NewtonIterate log{.iteration = it, .residual = at.residual, .energy = at.energy};
     ++total_iterations;
     if (may_chord && options_.chord_steps && chord_step(terms, *chord, x, at, log)) {
@@ -315,7 +335,8 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     }
     may_chord = false;
     const Eigen::VectorXd dx =
-        newton_direction(terms, ws, x, at.gradient, log, result.factorizations);
+        newton_direction(terms, ws, x, at.gradient, log, result.factorizations, stop);
+    if (dx.size() == 0 && stop && stop()) return stopped(result, at, it);
     if (dx.size() == 0) {
       result.status = StaticsStatus::Singular;
       result.reason = singular_reason(ws);

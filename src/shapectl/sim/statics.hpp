@@ -14,6 +14,7 @@
 // |∇E|², which Newton's step with the true Hessian descends: d/dα |∇E|² = −2|∇E|²).
 // "Not converged" thus means a force above that tolerance, never a tolerance out of reach.
 #include <algorithm>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <mutex>
@@ -47,7 +48,12 @@ struct StaticsOptions {
   bool krylov_steps = true;
   bool chord_steps = true;  // off: a nearby factorization is used by Krylov steps only (tests)
   double krylov_tolerance = 1e-4;
-  int krylov_iterations = 25;
+  // A CG product costs a solve with the factor (and a product with H): on the 12k-tet bar ~1/15
+  // of a factorization, so a Krylov step that needs more than this is better refactored.
+  int krylov_iterations = 12;
+  // Chord and Krylov steps turn the nearby factorization with the object's best-fit rotation
+  // since it was made (see rigid_motion.hpp); off only to measure what that saves.
+  bool rotate_chord = true;
 };
 
 struct NewtonIterate {
@@ -96,6 +102,10 @@ struct StaticsWorkspace {
 
 using EnergyTerms = std::vector<const EnergyTerm*>;
 
+// Asked before every Newton iteration; true stops the solve there (NotConverged, "stopped"):
+// a time budget (--max-seconds) reaches into long solves.
+using StopRequest = std::function<bool()>;
+
 // Totals over the whole process since it started, for benchmarks (`shapectl bench --sizes`):
 // Newton and chord iterations, and numeric factorizations (stability checks included).
 struct StaticsTotals {
@@ -120,7 +130,8 @@ class StaticsSolver {
   // holds a true-Hessian factorization (of a nearby state; it may be `ws` itself), Newton tries
   // steps with it first. max_iterations > 0 overrides the options' limit for this call.
   StaticsResult solve(const EnergyTerms& terms, StaticsWorkspace& ws, Positions& x,
-                      int max_iterations = 0, const StaticsWorkspace* chord = nullptr) const;
+                      int max_iterations = 0, const StaticsWorkspace* chord = nullptr,
+                      const StopRequest& stop = {}) const;
 
   // Total energy and its gradient (fixed dofs zeroed) at x.
   double energy(const EnergyTerms& terms, const Positions& x) const;
@@ -154,16 +165,22 @@ class StaticsSolver {
   // The steps of solve(): each returns false when it cannot move x (x and `at` unchanged).
   bool chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord, Positions& x, Point& at,
                   NewtonIterate& log) const;
+  // The object's rotation since `chord`'s factorization; the solve with that factor turned by it.
+  Mat3 chord_rotation(const StaticsWorkspace& chord, const Positions& x) const;
+  Eigen::VectorXd solve_rotated(const StaticsWorkspace& chord, const Mat3& R,
+                                const Eigen::VectorXd& r) const;
   // Newton's direction at x by conjugate gradients on the true Hessian (assembled into `ws`,
   // not factored), preconditioned with `chord`'s factorization; empty when they do not converge
   // within the options' limits or meet non-positive curvature.
   Eigen::VectorXd krylov_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                    const StaticsWorkspace& chord, const Positions& x,
                                    const Eigen::VectorXd& g, NewtonIterate& log) const;
-  // Empty when not even the projected Hessian factors.
+  // Empty when not even the projected Hessian factors, or when `stop` asks before it is tried.
   Eigen::VectorXd newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                    const Positions& x, const Eigen::VectorXd& g, NewtonIterate& log,
-                                   int& factorizations) const;
+                                   int& factorizations, const StopRequest& stop) const;
+  // `result` ended by a stop request at iteration `it`.
+  StaticsResult stopped(StaticsResult& result, const Point& at, int it) const;
   bool line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x, Point& at,
                    NewtonIterate& log) const;
   double largest_node_step(const Eigen::VectorXd& dx) const;
