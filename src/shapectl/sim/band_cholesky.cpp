@@ -116,7 +116,7 @@ class BandBlocks {
   BandBlocks(const double* ab, int n, int kd, int block) : ab_(ab), n_(n), kd_(kd), block_(block) {}
   int count() const { return (n_ + block_ - 1) / block_; }
 
-  // Block column k: its diagonal block, rectangle and corner (copied into `corner`).
+  // Block column k: its diagonal block and rectangle in place, the corner's extent.
   struct Column {
     int first = 0, size = 0;
     const double* diagonal = nullptr;
@@ -124,7 +124,7 @@ class BandBlocks {
     int rectangle_rows = 0;  // from row first + size
     int corner_rows = 0;     // from row first + kd + 1, columns first + 1 .. first + size - 1
   };
-  Column column(int k, std::vector<double>& corner) const {
+  Column column(int k) const {
     Column c;
     c.first = k * block_;
     c.size = std::min(block_, n_ - c.first);
@@ -132,12 +132,16 @@ class BandBlocks {
     c.rectangle = at(c.first + c.size, c.first);
     c.rectangle_rows = std::min(c.first + kd_, n_ - 1) - (c.first + c.size) + 1;
     c.corner_rows = std::min(c.size - 1, n_ - 1 - c.first - kd_);
-    corner.assign(static_cast<std::size_t>(std::max(c.corner_rows, 0)) * (c.size - 1), 0.0);
+    return c;
+  }
+  // The corner, corner_rows × (size − 1), zero below its diagonal. Copied after the rectangle
+  // was read: it ends the same columns of the band, so it is in cache by then.
+  void copy_corner(const Column& c, std::vector<double>& corner) const {
+    corner.assign(static_cast<std::size_t>(c.corner_rows) * (c.size - 1), 0.0);
     for (int col = 0; col < c.size - 1; ++col)
       for (int i = 0; i < c.corner_rows && i <= col; ++i)
         corner[i + static_cast<std::size_t>(col) * c.corner_rows] =
             *at(c.first + kd_ + 1 + i, c.first + 1 + col);
-    return c;
   }
   int leading() const { return kd_; }
 
@@ -155,25 +159,27 @@ void blocked_band_solve(const BandBlocks& blocks, int n, double* b, int columns)
   const int ld = blocks.leading();
   std::vector<double> corner;
   for (int k = 0; k < blocks.count(); ++k) {  // L Y = B
-    const BandBlocks::Column c = blocks.column(k, corner);
+    const BandBlocks::Column c = blocks.column(k);
     double* y = b + c.first;
     dtrsm_("L", "L", "N", "N", &c.size, &columns, &one, c.diagonal, &ld, y, &n);
     if (c.rectangle_rows > 0)
       dgemm_("N", "N", &c.rectangle_rows, &columns, &c.size, &minus_one, c.rectangle, &ld, y, &n,
              &one, y + c.size, &n);
     if (c.corner_rows > 0) {
+      blocks.copy_corner(c, corner);
       const int width = c.size - 1;
       dgemm_("N", "N", &c.corner_rows, &columns, &width, &minus_one, corner.data(), &c.corner_rows,
              y + 1, &n, &one, y + ld + 1, &n);
     }
   }
   for (int k = blocks.count() - 1; k >= 0; --k) {  // Lᵀ X = Y
-    const BandBlocks::Column c = blocks.column(k, corner);
+    const BandBlocks::Column c = blocks.column(k);
     double* x = b + c.first;
     if (c.rectangle_rows > 0)
       dgemm_("T", "N", &c.size, &columns, &c.rectangle_rows, &minus_one, c.rectangle, &ld,
              x + c.size, &n, &one, x, &n);
     if (c.corner_rows > 0) {
+      blocks.copy_corner(c, corner);
       const int width = c.size - 1;
       dgemm_("T", "N", &width, &columns, &c.corner_rows, &minus_one, corner.data(), &c.corner_rows,
              x + ld + 1, &n, &one, x + 1, &n);
