@@ -221,8 +221,17 @@ BENCHMARK_CAPTURE(piece, solve14_cholmod, Piece::Solve, SparseCholesky::Backend:
     ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
-// One right-hand side: a Newton or chord step.
+// One right-hand side (a Newton or chord step), and two and four: where the band's blocked
+// many-column solve starts to pay.
 BENCHMARK_CAPTURE(piece, solve1_auto, Piece::Solve, std::nullopt, 1)
+    ->Arg(4)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, solve2_auto, Piece::Solve, std::nullopt, 2)
+    ->Arg(4)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, solve4_auto, Piece::Solve, std::nullopt, 4)
     ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);

@@ -38,7 +38,7 @@ struct Case {
 };
 
 // Sizes and bandwidths around the solve's blocking (blocks of 32 columns, the blocked solve
-// from 32 sub-diagonals and 2 right-hand sides on, LAPACK's dpbtrs below): diagonal,
+// from 32 sub-diagonals and 3 right-hand sides on, LAPACK's dpbtrs below): diagonal,
 // tridiagonal, dense (bandwidth n − 1) with one block and with several, bands just below, at
 // and above one block and two, sizes not a multiple of a block, ill-conditioned ones.
 const Case kCases[] = {{1, 0},     {9, 0},

@@ -244,10 +244,11 @@ Eigen::MatrixXd BandCholesky::solve(const Eigen::MatrixXd& rhs) const {
   Eigen::MatrixXd permuted(size_, columns);
   for (int k = 0; k < columns; ++k)
     for (int i = 0; i < size_; ++i) permuted(new_index_[i], k) = rhs(i, k);
-  // The blocked solve from full blocks on and for two columns or more; one column is as fast
-  // or faster with dpbtrs (piece/solve1_auto in bench/statics_bench.cpp).
+  // The blocked solve from full blocks on and from three columns on: one or two columns are
+  // as fast or faster with dpbtrs (piece/solve{1,2,4}_auto in bench/statics_bench.cpp).
   constexpr int kBlock = 32;  // columns of L per block, as in dpbtrf
-  if (bandwidth_ >= kBlock && columns >= 2) {
+  constexpr int kBlockedFromColumns = 3;
+  if (bandwidth_ >= kBlock && columns >= kBlockedFromColumns) {
     blocked_band_solve(BandBlocks(band_.data(), size_, bandwidth_, kBlock), size_, permuted.data(),
                        columns);
   } else if (size_ > 0 && columns > 0) {
