@@ -213,33 +213,19 @@ BENCHMARK_CAPTURE(piece, assemble_and_factor_cholmod, Piece::Factorize,
                   SparseCholesky::Backend::CholmodSupernodal)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, solve14_auto, Piece::Solve, std::nullopt)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, solve14_cholmod, Piece::Solve, SparseCholesky::Backend::CholmodSupernodal)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
+// The default bar and the 12k one, in milliseconds.
+void both_bars(benchmark::internal::Benchmark* b) {
+  b->Arg(4)->Arg(8)->Unit(benchmark::kMillisecond);
+}
+const auto kCholmod = SparseCholesky::Backend::CholmodSupernodal;
+BENCHMARK_CAPTURE(piece, solve14_auto, Piece::Solve, std::nullopt)->Apply(both_bars);
+BENCHMARK_CAPTURE(piece, solve14_cholmod, Piece::Solve, kCholmod)->Apply(both_bars);
 // One right-hand side (a Newton or chord step), and two and four: where the band's blocked
 // many-column solve starts to pay.
-BENCHMARK_CAPTURE(piece, solve1_auto, Piece::Solve, std::nullopt, 1)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, solve2_auto, Piece::Solve, std::nullopt, 2)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, solve4_auto, Piece::Solve, std::nullopt, 4)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, solve1_cholmod, Piece::Solve, SparseCholesky::Backend::CholmodSupernodal,
-                  1)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, solve1_auto, Piece::Solve, std::nullopt, 1)->Apply(both_bars);
+BENCHMARK_CAPTURE(piece, solve2_auto, Piece::Solve, std::nullopt, 2)->Apply(both_bars);
+BENCHMARK_CAPTURE(piece, solve4_auto, Piece::Solve, std::nullopt, 4)->Apply(both_bars);
+BENCHMARK_CAPTURE(piece, solve1_cholmod, Piece::Solve, kCholmod, 1)->Apply(both_bars);
 
 // The band factorization alone (no assembly), with its flop rate: BandCholesky::flops() per
 // CPU second of the calling thread, the share of one core's peak that dpbtrf reaches (one
@@ -262,7 +248,7 @@ void BM_BandFactorize(benchmark::State& state) {
   state.counters["flops"] =
       benchmark::Counter(band.flops(), benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_BandFactorize)->Arg(4)->Arg(8)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BandFactorize)->Apply(both_bars);
 
 }  // namespace
 }  // namespace shapectl
