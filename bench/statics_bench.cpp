@@ -5,6 +5,7 @@
 #include <sys/resource.h>
 
 #include <shapectl/mesh/box_mesh.hpp>
+#include <shapectl/sim/band_cholesky.hpp>
 #include <shapectl/sim/object_statics.hpp>
 
 namespace shapectl {
@@ -166,9 +167,11 @@ BENCHMARK_CAPTURE(factorize, solve14_cholmod, SparseCholesky::Backend::CholmodSu
 
 // The pieces of one optimizer iteration on a refined bar (12,288 tets: the 12k size),
 // at its equilibrium: energy, gradient, Hessian assembly, numeric factorization, a solve with
-// 14 right-hand sides (dx̂/dθ for two 7-joint arms). Which piece dominates decides what to cut.
-enum class Piece { Energy, Gradient, Hessian, Factorize, Solve14 };
-void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::Backend> backend) {
+// 14 right-hand sides (dx̂/dθ for two 7-joint arms; or `rhs_columns`). Which piece dominates
+// decides what to cut. Arg(n): a bar of 4n × n × n cells (4: the default bar, 8: 12k tets).
+enum class Piece { Energy, Gradient, Hessian, Factorize, Solve };
+void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::Backend> backend,
+           int rhs_columns = 14) {
   const int n = static_cast<int>(state.range(0));
   Scene scene = clamped_bar({4 * n, n, n});
   scene.statics.backend = backend;
@@ -179,14 +182,14 @@ void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::B
   const EnergyTerms terms = statics.terms();
   const StaticsSolver& solver = statics.solver();
   if (!solver.factor(terms, ws, x)) state.SkipWithError("not positive definite");
-  const Eigen::MatrixXd rhs = Eigen::MatrixXd::Ones(x.size(), 14);
+  const Eigen::MatrixXd rhs = Eigen::MatrixXd::Ones(x.size(), rhs_columns);
   for (auto _ : state) {
     switch (which) {
       case Piece::Energy: benchmark::DoNotOptimize(solver.energy(terms, x)); break;
       case Piece::Gradient: benchmark::DoNotOptimize(solver.gradient(terms, x)); break;
       case Piece::Hessian: benchmark::DoNotOptimize(solver.hessian(terms, x)); break;
       case Piece::Factorize: benchmark::DoNotOptimize(solver.factor(terms, ws, x)); break;
-      case Piece::Solve14: benchmark::DoNotOptimize(solver.solve_with_factor(ws, rhs)); break;
+      case Piece::Solve: benchmark::DoNotOptimize(solver.solve_with_factor(ws, rhs)); break;
     }
   }
   state.counters["tets"] = statics.mesh().tet_count();
@@ -210,13 +213,42 @@ BENCHMARK_CAPTURE(piece, assemble_and_factor_cholmod, Piece::Factorize,
                   SparseCholesky::Backend::CholmodSupernodal)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, solve14_auto, Piece::Solve14, std::nullopt)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, solve14_cholmod, Piece::Solve14,
-                  SparseCholesky::Backend::CholmodSupernodal)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
+// The default bar and the 12k one, in milliseconds.
+void both_bars(benchmark::internal::Benchmark* b) {
+  b->Arg(4)->Arg(8)->Unit(benchmark::kMillisecond);
+}
+const auto kCholmod = SparseCholesky::Backend::CholmodSupernodal;
+BENCHMARK_CAPTURE(piece, solve14_auto, Piece::Solve, std::nullopt)->Apply(both_bars);
+BENCHMARK_CAPTURE(piece, solve14_cholmod, Piece::Solve, kCholmod)->Apply(both_bars);
+// One right-hand side (a Newton or chord step), and two and four: where the band's blocked
+// many-column solve starts to pay.
+BENCHMARK_CAPTURE(piece, solve1_auto, Piece::Solve, std::nullopt, 1)->Apply(both_bars);
+BENCHMARK_CAPTURE(piece, solve2_auto, Piece::Solve, std::nullopt, 2)->Apply(both_bars);
+BENCHMARK_CAPTURE(piece, solve4_auto, Piece::Solve, std::nullopt, 4)->Apply(both_bars);
+BENCHMARK_CAPTURE(piece, solve1_cholmod, Piece::Solve, kCholmod, 1)->Apply(both_bars);
+
+// The band factorization alone (no assembly), with its flop rate: BandCholesky::flops() per
+// CPU second of the calling thread, the share of one core's peak that dpbtrf reaches (one
+// thread below 256 sub-diagonals; from there OpenBLAS's threads make the rate an overestimate).
+void BM_BandFactorize(benchmark::State& state) {
+  const int n = static_cast<int>(state.range(0));
+  const Scene scene = clamped_bar({4 * n, n, n});
+  ObjectStatics statics(scene);
+  Positions x = scene.world_rest_positions();
+  if (!statics.solve(x).converged()) state.SkipWithError("statics failed");
+  const SparseMatrix H = statics.hessian(x);
+  SparseCholesky cholesky(SparseCholesky::Backend::Band);  // sets OpenBLAS's threads as in use
+  cholesky.analyze(H);
+  if (!cholesky.factorize(H)) state.SkipWithError("not positive definite");
+  for (auto _ : state) benchmark::DoNotOptimize(cholesky.factorize(H));
+  BandCholesky band;  // the same ordering, for its size and flop count
+  band.analyze(H);
+  state.counters["bandwidth"] = band.bandwidth();
+  state.counters["band_MB"] = band.storage_bytes() / 1e6;
+  state.counters["flops"] =
+      benchmark::Counter(band.flops(), benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_BandFactorize)->Apply(both_bars);
 
 }  // namespace
 }  // namespace shapectl

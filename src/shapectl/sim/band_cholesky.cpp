@@ -3,10 +3,16 @@
 #include <algorithm>
 #include <cmath>
 
-extern "C" {  // LAPACK (OpenBLAS)
+extern "C" {  // LAPACK and BLAS (OpenBLAS)
 void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);
 void dpbtrs_(const char* uplo, const int* n, const int* kd, const int* nrhs, const double* ab,
              const int* ldab, double* b, const int* ldb, int* info);
+void dtrsm_(const char* side, const char* uplo, const char* trans, const char* diag, const int* m,
+            const int* n, const double* alpha, const double* a, const int* lda, double* b,
+            const int* ldb);
+void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k,
+            const double* alpha, const double* a, const int* lda, const double* b, const int* ldb,
+            const double* beta, double* c, const int* ldc);
 }
 
 namespace shapectl {
@@ -94,6 +100,95 @@ std::vector<int> reverse_cuthill_mckee(const SparseMatrix& lower) {
   return order;
 }
 
+namespace {
+// Level-3 solve with the band factor, block column by block column. In LAPACK's lower band
+// storage (ldab = kd + 1) L(r, c) sits at ab[r + c·kd]: a dense column-major matrix with
+// leading dimension kd wherever the band covers the block (c ≤ r ≤ c + kd). A block column
+// of `size` ≤ kd columns starting at j then splits into
+//   the diagonal block    rows j .. j+size-1          (lower triangular, dtrsm),
+//   a rectangle           rows j+size .. j+kd         (inside the band, dgemm in place),
+//   a corner              rows j+kd+1 .. j+size-1+kd  (upper triangular: its lower part lies
+//                         outside the band, so it is copied out with zeros there).
+// Each block of L is read once per sweep for all right-hand sides, where dpbtrs streams the
+// whole band twice per right-hand side (level-2 dtbsv).
+class BandBlocks {
+ public:
+  BandBlocks(const double* ab, int n, int kd, int block) : ab_(ab), n_(n), kd_(kd), block_(block) {}
+  int count() const { return (n_ + block_ - 1) / block_; }
+
+  // Block column k: its diagonal block and rectangle in place, the corner's extent.
+  struct Column {
+    int first = 0, size = 0;
+    const double* diagonal = nullptr;
+    const double* rectangle = nullptr;
+    int rectangle_rows = 0;  // from row first + size
+    int corner_rows = 0;     // from row first + kd + 1, columns first + 1 .. first + size - 1
+  };
+  Column column(int k) const {
+    Column c;
+    c.first = k * block_;
+    c.size = std::min(block_, n_ - c.first);
+    c.diagonal = at(c.first, c.first);
+    c.rectangle = at(c.first + c.size, c.first);
+    c.rectangle_rows = std::min(c.first + kd_, n_ - 1) - (c.first + c.size) + 1;
+    c.corner_rows = std::min(c.size - 1, n_ - 1 - c.first - kd_);
+    return c;
+  }
+  // The corner, corner_rows × (size − 1), zero below its diagonal. Copied after the rectangle
+  // was read: it ends the same columns of the band, so it is in cache by then.
+  void copy_corner(const Column& c, std::vector<double>& corner) const {
+    corner.assign(static_cast<std::size_t>(c.corner_rows) * (c.size - 1), 0.0);
+    for (int col = 0; col < c.size - 1; ++col)
+      for (int i = 0; i < c.corner_rows && i <= col; ++i)
+        corner[i + static_cast<std::size_t>(col) * c.corner_rows] =
+            *at(c.first + kd_ + 1 + i, c.first + 1 + col);
+  }
+  int leading() const { return kd_; }
+
+ private:
+  const double* at(int row, int col) const {
+    return ab_ + row + static_cast<std::size_t>(col) * kd_;
+  }
+  const double* ab_;
+  int n_, kd_, block_;
+};
+
+// Solves L Lᵀ X = B in place; B is n × columns, column-major.
+void blocked_band_solve(const BandBlocks& blocks, int n, double* b, int columns) {
+  const double one = 1, minus_one = -1;
+  const int ld = blocks.leading();
+  std::vector<double> corner;
+  for (int k = 0; k < blocks.count(); ++k) {  // L Y = B
+    const BandBlocks::Column c = blocks.column(k);
+    double* y = b + c.first;
+    dtrsm_("L", "L", "N", "N", &c.size, &columns, &one, c.diagonal, &ld, y, &n);
+    if (c.rectangle_rows > 0)
+      dgemm_("N", "N", &c.rectangle_rows, &columns, &c.size, &minus_one, c.rectangle, &ld, y, &n,
+             &one, y + c.size, &n);
+    if (c.corner_rows > 0) {
+      blocks.copy_corner(c, corner);
+      const int width = c.size - 1;
+      dgemm_("N", "N", &c.corner_rows, &columns, &width, &minus_one, corner.data(), &c.corner_rows,
+             y + 1, &n, &one, y + ld + 1, &n);
+    }
+  }
+  for (int k = blocks.count() - 1; k >= 0; --k) {  // Lᵀ X = Y
+    const BandBlocks::Column c = blocks.column(k);
+    double* x = b + c.first;
+    if (c.rectangle_rows > 0)
+      dgemm_("T", "N", &c.size, &columns, &c.rectangle_rows, &minus_one, c.rectangle, &ld,
+             x + c.size, &n, &one, x, &n);
+    if (c.corner_rows > 0) {
+      blocks.copy_corner(c, corner);
+      const int width = c.size - 1;
+      dgemm_("T", "N", &width, &columns, &c.corner_rows, &minus_one, corner.data(), &c.corner_rows,
+             x + ld + 1, &n, &one, x + 1, &n);
+    }
+    dtrsm_("L", "L", "T", "N", &c.size, &columns, &one, c.diagonal, &ld, x, &n);
+  }
+}
+}  // namespace
+
 void BandCholesky::analyze(const SparseMatrix& lower) {
   size_ = static_cast<int>(lower.rows());
   const std::vector<int> order = reverse_cuthill_mckee(lower);
@@ -144,13 +239,27 @@ bool BandCholesky::factorize(const SparseMatrix& lower) {
 
 Eigen::MatrixXd BandCholesky::solve(const Eigen::MatrixXd& rhs) const {
   const int columns = static_cast<int>(rhs.cols());
+  // Column by column, contiguously: along a row of a tall column-major matrix consecutive
+  // elements are ~64 kB apart at 12k tets.
   Eigen::MatrixXd permuted(size_, columns);
-  for (int i = 0; i < size_; ++i) permuted.row(new_index_[i]) = rhs.row(i);
-  const int rows = bandwidth_ + 1;
-  int info = 0;
-  dpbtrs_("L", &size_, &bandwidth_, &columns, band_.data(), &rows, permuted.data(), &size_, &info);
+  for (int k = 0; k < columns; ++k)
+    for (int i = 0; i < size_; ++i) permuted(new_index_[i], k) = rhs(i, k);
+  // The blocked solve from full blocks on and from three columns on: one or two columns are
+  // as fast or faster with dpbtrs (piece/solve{1,2,4}_auto in bench/statics_bench.cpp).
+  constexpr int kBlock = 32;  // columns of L per block, as in dpbtrf
+  constexpr int kBlockedFromColumns = 3;
+  if (bandwidth_ >= kBlock && columns >= kBlockedFromColumns) {
+    blocked_band_solve(BandBlocks(band_.data(), size_, bandwidth_, kBlock), size_, permuted.data(),
+                       columns);
+  } else if (size_ > 0 && columns > 0) {
+    const int rows = bandwidth_ + 1;
+    int info = 0;
+    dpbtrs_("L", &size_, &bandwidth_, &columns, band_.data(), &rows, permuted.data(), &size_,
+            &info);
+  }
   Eigen::MatrixXd result(size_, columns);
-  for (int i = 0; i < size_; ++i) result.row(i) = permuted.row(new_index_[i]);
+  for (int k = 0; k < columns; ++k)
+    for (int i = 0; i < size_; ++i) result(i, k) = permuted(new_index_[i], k);
   return result;
 }
 

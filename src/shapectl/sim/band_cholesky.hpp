@@ -27,6 +27,8 @@ class BandCholesky {
   // Numeric factorization; false if the matrix is not (numerically) positive definite.
   // The matrix must have the analyzed pattern.
   bool factorize(const SparseMatrix& lower);
+  // Solves with the factor. Many right-hand sides go through a blocked level-3 substitution
+  // that reads the band once per sweep for all of them; one or two go through LAPACK's dpbtrs.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
 
  private:
