@@ -7,7 +7,8 @@
 // rate, the median / p90 / max interval between state messages, how many of them carried a new
 // optimizer iterate, how soon a change shows in the states, the time from a change to "reached"
 // / "best effort", and the server's CPU. With --browser a headless Chromium page watches the
-// same session: its state handling and requestAnimationFrame rates.
+// same session: its state handling and requestAnimationFrame rates. Last, the longest pause of
+// the states when the scene is switched between the given (bundled) scenes.
 // A benchmark (docs/benchmarks.md), not a test: it asserts nothing and is not in CTest.
 import { readFileSync, readdirSync } from 'node:fs';
 import path from 'node:path';
@@ -234,6 +235,30 @@ async function measure(scene, options) {
   }
 }
 
+// The one pause the stream is known to have: `load_scene` builds the new scene on the server's
+// thread. Switches between the given scenes (they must be bundled ones, scenes/*.json) and back,
+// and measures the longest gap between states from each switch until 3 s after it.
+async function measureSwitches(scenes) {
+  const names = scenes.filter((f) => path.dirname(f) === path.join(sourceDir, 'scenes')).map((f) => path.basename(f));
+  if (names.length < 2) return;
+  const server = await startServer([path.join(sourceDir, 'scenes', names[0])]);
+  const recorder = await connectRecorder(server.port);
+  try {
+    await waitUntil(() => recorder.states.length, 'a state');
+    let id = 1;
+    for (const name of [...names.slice(1), names[0]]) {
+      const at = performance.now();
+      recorder.ws.sendJson({ type: Command.LoadScene, id: id++, scene: name });
+      await sleepUntil(at + 3000);
+      const times = [at, ...recorder.states.filter((s) => s.at > at).map((s) => s.at)];
+      console.log(`switch to ${name}: longest gap between states ${ms(intervals(times).at(-1))} ms`);
+    }
+  } finally {
+    recorder.ws.close();
+    await server.stop();
+  }
+}
+
 function print(r) {
   const late = r.all.filter((g) => g > 2 * r.period_ms).length;
   const stop = (s) => (s ? `${(s.ms / 1000).toFixed(2)} s (${s.status}, mean error ${(1000 * s.error).toFixed(2)} mm)` : 'not stopped');
@@ -262,3 +287,4 @@ try {
 }
 console.log(`gui_rate: ${options.seconds} s per scene, --rate ${options.rate}, --jump ${options.jump}${options.browser ? ', with a headless page' : ''}; ${new Date().toISOString()}`);
 for (const scene of options.scenes) print(await measure(scene, options));
+await measureSwitches(options.scenes);
