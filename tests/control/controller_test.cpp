@@ -57,6 +57,24 @@ TEST(Controller, BadRequestsThrowAndChangeNothing) {
   EXPECT_EQ(controller.snapshot()->sequence, before->sequence);  // nothing was applied
 }
 
+// On a fine mesh one optimizer step can take seconds: the GUI must see the new targets and
+// "optimizing" at once, not after that step. So a request is published when applied, before the
+// step, and the step's result after it: two publications.
+TEST(Controller, AnAppliedRequestIsPublishedBeforeTheStepThatFollowsIt) {
+  Controller controller(test::two_arm_scene());
+  const auto before = controller.snapshot();
+  const int node = 5;
+  controller.set_targets({{node}, {before->positions.segment<3>(3 * node) + Vec3(0, 0, 0.01)}});
+  controller.step_once();
+  const auto after = controller.snapshot();
+  EXPECT_EQ(after->sequence, before->sequence + 2);
+  EXPECT_EQ(after->iterations, before->iterations + 1);
+  EXPECT_EQ(after->targets.nodes, std::vector<int>{node});
+  // Without a request, a step publishes once at most (none when it had stopped).
+  controller.step_once();
+  EXPECT_LE(controller.snapshot()->sequence, after->sequence + 1);
+}
+
 TEST(Controller, PauseAndJogMoveTheRobotWithoutTheOptimizer) {
   Controller controller(test::two_arm_scene());
   controller.set_paused(true);

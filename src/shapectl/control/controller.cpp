@@ -337,6 +337,9 @@ void Controller::State::iterate() {
   const bool had_requests = !in.empty();
   if (had_requests) apply(std::move(in));
   const bool work = !paused && !objective->targets().empty() && !idle;
+  // Show the applied request (targets, "optimizing", the error against them) before the step:
+  // one step of a 12k-tet object can take seconds, and the GUI would show the old state till then.
+  if (work && had_requests) publish();
   if (work) {
     failed = false;
     try {
