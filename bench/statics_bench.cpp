@@ -198,12 +198,14 @@ BENCHMARK_CAPTURE(piece, gradient, Piece::Gradient, std::nullopt)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, hessian, Piece::Hessian, std::nullopt)
+    ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, assemble_and_factor_auto, Piece::Factorize, std::nullopt)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, assemble_and_factor_band, Piece::Factorize, SparseCholesky::Backend::Band)
+    ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, assemble_and_factor_cholmod, Piece::Factorize,
