@@ -46,14 +46,14 @@ HessianScatter::HessianScatter(int dof_count, const std::vector<char>& fixed_dof
                                const std::vector<ElementNodes>& elements, SparseMatrix& pattern) {
   const int node_count = dof_count / 3;
   int first = 0;
-  block_offsets_.push_back(0);
+  entry_offsets_.push_back(0);
   for (const ElementNodes& term_elements : elements) {
     Term term;
     term.first_element = first;
     first += static_cast<int>(term_elements.size());
     for (std::size_t e = 0; e < term_elements.size(); ++e) {
       const int dofs = 3 * term_elements.node_count(e);
-      block_offsets_.push_back(block_offsets_.back() + dofs * dofs);
+      block_sizes_.push_back(dofs * dofs);
     }
     // Counting sort by colour keeps element order within a colour.
     const std::vector<int> colour = greedy_colours(term_elements, node_count);
@@ -131,7 +131,10 @@ void HessianScatter::build_pattern(int dof_count, const std::vector<char>& fixed
 
   // Each block entry (row 3i + r, column 3j + c) with i ≥ j lands in column 3j + c; where in
   // it is read from `place`, filled column by column for the three columns of node j.
-  slots_.assign(block_offsets_.back(), -1);
+  std::vector<int> block_offsets(block_sizes_.size() + 1, 0);
+  for (std::size_t g = 0; g < block_sizes_.size(); ++g)
+    block_offsets[g + 1] = block_offsets[g] + block_sizes_[g];
+  std::vector<int> slots(block_offsets.back(), -1);
   std::vector<int> place(3 * static_cast<std::size_t>(dof_count), -1);
   for (int j = 0; j < node_count; ++j) {
     for (int c = 0; c < 3; ++c)
@@ -141,7 +144,7 @@ void HessianScatter::build_pattern(int dof_count, const std::vector<char>& fixed
       const ElementNodes& term_elements = elements[t];
       const int* nodes = term_elements.begin(e);
       const int dofs = 3 * term_elements.node_count(e);
-      int* slot = slots_.data() + block_offsets_[terms_[t].first_element + e];
+      int* slot = slots.data() + block_offsets[terms_[t].first_element + e];
       for (int a = 0; a < term_elements.node_count(e); ++a) {
         if (nodes[a] < j) continue;
         for (int c = 0; c < 3; ++c)
@@ -152,6 +155,11 @@ void HessianScatter::build_pattern(int dof_count, const std::vector<char>& fixed
           }
       }
     }
+  }
+  for (std::size_t g = 0; g < block_sizes_.size(); ++g) {
+    for (int q = 0; q < block_sizes_[g]; ++q)
+      if (slots[block_offsets[g] + q] >= 0) entries_.push_back({q, slots[block_offsets[g] + q]});
+    entry_offsets_.push_back(static_cast<int>(entries_.size()));
   }
   for (int d = 0; d < dof_count; ++d)
     if (fixed_dof[d]) fixed_diagonal_slots_.push_back(outer[d]);
@@ -168,12 +176,11 @@ void HessianScatter::add_blocks(std::size_t term_index, const ElementKernel& ker
                         for (int k = range.begin(); k != range.end(); ++k) {
                           const int e = term.by_colour[k];
                           const int g = term.first_element + e;
-                          const int size = block_offsets_[g + 1] - block_offsets_[g];
+                          const int size = block_sizes_[g];
                           block.assign(size, std::numeric_limits<double>::quiet_NaN());
                           kernel(e, block.data());
-                          const int* slot = slots_.data() + block_offsets_[g];
-                          for (int q = 0; q < size; ++q)
-                            if (slot[q] >= 0) values[slot[q]] += block[q];
+                          for (int i = entry_offsets_[g]; i < entry_offsets_[g + 1]; ++i)
+                            values[entries_[i].slot] += block[entries_[i].entry];
                         }
                       });
 }

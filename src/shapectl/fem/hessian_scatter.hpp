@@ -37,8 +37,14 @@ class HessianScatter {
   void build_pattern(int dof_count, const std::vector<char>& fixed_dof,
                      const std::vector<ElementNodes>& elements, SparseMatrix& pattern);
   std::vector<Term> terms_;
-  std::vector<int> block_offsets_;  // global element g: slots_[block_offsets_[g] …], (3k)² each
-  std::vector<int> slots_;          // value index per block entry (column-major), −1: dropped
+  // Where the kept entries of an element's block go: value index `slot` gets block[entry].
+  // Only entries that land (lower triangle, free dofs) are listed: no test in the hot loop.
+  struct Entry {
+    int entry, slot;
+  };
+  std::vector<int> block_sizes_;    // global element g: (3k)²
+  std::vector<int> entry_offsets_;  // global element g: entries_[entry_offsets_[g] …]
+  std::vector<Entry> entries_;
   std::vector<int> fixed_diagonal_slots_;
 };
 
