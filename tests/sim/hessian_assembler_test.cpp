@@ -28,6 +28,9 @@ struct Problem {
       if (object.mesh().rest_positions()[i].y() > 0.0149)
         for (int d = 0; d < 3; ++d) fixed_dof[3 * i + d] = 1;
   }
+  GripEnergy grip_at(const Eigen::VectorXd& joints) const {
+    return GripEnergy(object.grips(), forward_kinematics(object.robot(), joints));
+  }
   Positions deformed(std::mt19937& rng) const {
     return test::perturbed(object.reference_positions(), 0.001, rng);
   }
@@ -72,8 +75,7 @@ TEST(HessianAssembler, EqualsTheTripletAssemblyWithFixedNodesAndGripSprings) {
   Problem p;
   std::mt19937 rng(7);
   const Positions x = p.deformed(rng);
-  const GripEnergy grip(p.object.grips(),
-                        forward_kinematics(p.object.robot(), p.object.reference_joints()));
+  const GripEnergy grip = p.grip_at(p.object.reference_joints());
   ASSERT_FALSE(p.object.grips().nodes().empty());
   const std::vector<const EnergyTerm*> terms{&p.elastic, &p.gravity, &grip};
   HessianAssembler assembler(x.size(), p.fixed_dof);
@@ -97,8 +99,7 @@ TEST(HessianAssembler, KeepsItsPatternForTheSameElementsAndRebuildsItForNewOnes)
   Problem p;
   std::mt19937 rng(3);
   const Positions x = p.deformed(rng);
-  const GripEnergy at_reference(p.object.grips(),
-                                forward_kinematics(p.object.robot(), p.object.reference_joints()));
+  const GripEnergy at_reference = p.grip_at(p.object.reference_joints());
   HessianAssembler assembler(x.size(), p.fixed_dof);
   assembler.assemble({&p.elastic, &at_reference}, x, false);
   EXPECT_TRUE(assembler.pattern_changed());
@@ -106,7 +107,7 @@ TEST(HessianAssembler, KeepsItsPatternForTheSameElementsAndRebuildsItForNewOnes)
   // Other joints, other positions: the same elements, so the same pattern, values of x2.
   Eigen::VectorXd joints = p.object.reference_joints();
   joints[1] += 0.1;
-  const GripEnergy moved(p.object.grips(), forward_kinematics(p.object.robot(), joints));
+  const GripEnergy moved = p.grip_at(joints);
   const Positions x2 = p.deformed(rng);
   const SparseMatrix& H = assembler.assemble({&p.elastic, &moved}, x2, false);
   EXPECT_FALSE(assembler.pattern_changed());

@@ -66,15 +66,15 @@ double StaticsSolver::max_force(const Eigen::VectorXd& g) const {
 
 namespace {
 // Every Hessian the solver uses (Newton, Krylov, hessian()) is assembled here.
-const SparseMatrix& assemble_hessian(const EnergyTerms& terms, StaticsWorkspace& ws,
+const SparseMatrix& assemble_hessian(const EnergyTerms& terms, HessianAssembler& assembler,
                                      const Positions& x, bool projected) {
-  return ws.assembler.assemble(terms, x, projected);
+  return assembler.assemble(terms, x, projected);
 }
 }  // namespace
 
 bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
                               bool projected) const {
-  const SparseMatrix& H = assemble_hessian(terms, ws, x, projected);
+  const SparseMatrix& H = assemble_hessian(terms, ws.assembler, x, projected);
   if (!ws.analyzed || ws.assembler.pattern_changed()) {
     ws.cholesky.analyze(H);
     ws.analyzed = true;
@@ -92,8 +92,8 @@ bool StaticsSolver::factor(const EnergyTerms& terms, StaticsWorkspace& ws,
 }
 
 SparseMatrix StaticsSolver::hessian(const EnergyTerms& terms, const Positions& x) const {
-  StaticsWorkspace ws = make_workspace();
-  return assemble_hessian(terms, ws, x, false);
+  HessianAssembler assembler(3 * node_count_, fixed_dof_);
+  return assemble_hessian(terms, assembler, x, false);
 }
 
 double StaticsSolver::factor_distance(const StaticsWorkspace& ws, const Positions& x) const {
@@ -178,7 +178,7 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
   // nearby state: H is close to it, so few products reach the tolerance. Assembling H costs a
   // fraction of factoring it on large meshes. Fixed dofs: H has identity rows there and g zeros,
   // so dx stays zero on them.
-  const SparseMatrix& H = assemble_hessian(terms, ws, x, false);
+  const SparseMatrix& H = assemble_hessian(terms, ws.assembler, x, false);
   auto precondition = [&](const Eigen::VectorXd& r) {
     std::lock_guard lock(*chord.solve_mutex);
     return Eigen::VectorXd(chord.cholesky.solve(r));
