@@ -169,7 +169,9 @@ BENCHMARK_CAPTURE(factorize, solve14_cholmod, SparseCholesky::Backend::CholmodSu
 // at its equilibrium: energy, gradient, Hessian assembly, numeric factorization, a solve with
 // 14 right-hand sides (dx̂/dθ for two 7-joint arms; or `rhs_columns`). Which piece dominates
 // decides what to cut. Arg(n): a bar of 4n × n × n cells (4: the default bar, 8: 12k tets).
-enum class Piece { Energy, Gradient, Hessian, Factorize, Solve };
+// Assemble: the workspace's assembler with its pattern built (what every Newton and Krylov step
+// pays); FactorOnly: the numeric factorization of the matrix already assembled.
+enum class Piece { Energy, Gradient, Hessian, Assemble, FactorOnly, Factorize, Solve };
 void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::Backend> backend,
            int rhs_columns = 14) {
   const int n = static_cast<int>(state.range(0));
@@ -188,6 +190,12 @@ void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::B
       case Piece::Energy: benchmark::DoNotOptimize(solver.energy(terms, x)); break;
       case Piece::Gradient: benchmark::DoNotOptimize(solver.gradient(terms, x)); break;
       case Piece::Hessian: benchmark::DoNotOptimize(solver.hessian(terms, x)); break;
+      case Piece::Assemble:
+        benchmark::DoNotOptimize(ws.assembler.assemble(terms, x, false).valuePtr());
+        break;
+      case Piece::FactorOnly:
+        benchmark::DoNotOptimize(ws.cholesky.factorize(ws.assembler.matrix()));
+        break;
       case Piece::Factorize: benchmark::DoNotOptimize(solver.factor(terms, ws, x)); break;
       case Piece::Solve: benchmark::DoNotOptimize(solver.solve_with_factor(ws, rhs)); break;
     }
@@ -201,12 +209,22 @@ BENCHMARK_CAPTURE(piece, gradient, Piece::Gradient, std::nullopt)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, hessian, Piece::Hessian, std::nullopt)
+    ->Arg(4)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, assemble, Piece::Assemble, std::nullopt)
+    ->Arg(4)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, factor_only_band, Piece::FactorOnly, SparseCholesky::Backend::Band)
+    ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, assemble_and_factor_auto, Piece::Factorize, std::nullopt)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, assemble_and_factor_band, Piece::Factorize, SparseCholesky::Backend::Band)
+    ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, assemble_and_factor_cholmod, Piece::Factorize,

@@ -114,9 +114,20 @@ class CubicTerm final : public EnergyTerm {
     gradient.array() += 2 * x.array() + 3 * x.array().square();
     if (fault_ == Fault::Gradient) gradient[1] += 0.1;  // a constant: differences of it stay right
   }
-  void add_hessian(const Positions& x, Triplets& hessian, bool) const override {
-    for (int i = 0; i < x.size(); ++i)
-      hessian.emplace_back(i, i, 2 + 6 * x[i] + (fault_ == Fault::Hessian && i == 2 ? 0.1 : 0.0));
+  // One element per node of energy_point()'s two: a diagonal 3×3 block.
+  void hessian_elements(ElementNodes& elements) const override {
+    elements.add({0});
+    elements.add({1});
+  }
+  void add_hessian(const Positions& x, ElementHessianSink& sink, bool) const override {
+    sink.add_blocks([&](std::size_t node, double* block) {
+      Eigen::Map<Mat3> H(block);
+      H.setZero();
+      for (int d = 0; d < 3; ++d) {
+        const int i = 3 * static_cast<int>(node) + d;
+        H(d, d) = 2 + 6 * x[i] + (fault_ == Fault::Hessian && i == 2 ? 0.1 : 0.0);
+      }
+    });
   }
 
  private:
@@ -133,7 +144,8 @@ class LinearTerm final : public EnergyTerm {
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override {
     gradient += Eigen::VectorXd::LinSpaced(x.size(), 1, static_cast<double>(x.size()));
   }
-  void add_hessian(const Positions&, Triplets&, bool) const override {}
+  void hessian_elements(ElementNodes&) const override {}
+  void add_hessian(const Positions&, ElementHessianSink&, bool) const override {}
 };
 
 Positions energy_point() {

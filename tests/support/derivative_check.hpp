@@ -95,8 +95,7 @@ inline Eigen::VectorXd energy_gradient(const EnergyTerm& term, const Positions& 
 
 inline Eigen::MatrixXd dense_hessian(const EnergyTerm& term, const Positions& x,
                                      bool project = false) {
-  Triplets t;
-  term.add_hessian(x, t, project);
+  const Triplets t = term.hessian_triplets(x, project);
   SparseMatrix H(x.size(), x.size());
   H.setFromTriplets(t.begin(), t.end());
   return Eigen::MatrixXd(H);

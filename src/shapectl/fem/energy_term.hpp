@@ -2,6 +2,7 @@
 // One additive part of the total energy E(x) of the object.
 #include <string_view>
 
+#include <shapectl/fem/element_hessians.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {
@@ -14,10 +15,18 @@ class EnergyTerm {
   virtual double value(const Positions& x) const = 0;
   // Adds ∂E/∂x to `gradient` (size 3n).
   virtual void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const = 0;
-  // Appends ∂²E/∂x² as triplets, the same count in the same order on every call, so an
-  // assembler can cache where each lands. `project_psd` makes each element block positive
-  // semi-definite (the fallback when the true Hessian cannot be factorized).
-  virtual void add_hessian(const Positions& x, Triplets& hessian, bool project_psd) const = 0;
+  // Appends the nodes of each element whose Hessian block add_hessian gives: the same elements
+  // in the same order on every call, so an assembler can cache where each block lands.
+  virtual void hessian_elements(ElementNodes& elements) const = 0;
+  // ∂²E/∂x² as one block per element (hessian_elements order) through sink.add_blocks, called
+  // once. `project_psd` makes each block positive semi-definite (the fallback when the true
+  // Hessian cannot be factorized).
+  virtual void add_hessian(const Positions& x, ElementHessianSink& sink,
+                           bool project_psd) const = 0;
+
+  // The same Hessian as triplets (every entry of every block, both triangles); for tests and
+  // tools that want a plain sparse matrix.
+  Triplets hessian_triplets(const Positions& x, bool project_psd) const;
 };
 
 }  // namespace shapectl

@@ -19,7 +19,9 @@ class Gravity : public EnergyTerm {
   void add_gradient(const Positions&, Eigen::VectorXd& gradient) const override {
     gradient += gradient_;
   }
-  void add_hessian(const Positions&, Triplets&, bool) const override {}
+  // Linear in x: no Hessian, no elements.
+  void hessian_elements(ElementNodes&) const override {}
+  void add_hessian(const Positions&, ElementHessianSink&, bool) const override {}
   // Total weight of the object, N.
   double weight() const { return weight_; }
 

@@ -124,26 +124,19 @@ void NeoHookean::add_gradient(const Positions& x, Eigen::VectorXd& gradient) con
       gradient.segment<3>(3 * tets[e].nodes[a]) += per_tet[e].segment<3>(3 * a);
 }
 
-void NeoHookean::add_hessian(const Positions& x, Triplets& hessian, bool project_psd) const {
+void NeoHookean::hessian_elements(ElementNodes& elements) const {
+  for (const auto& t : mesh_.tets()) elements.add({t.nodes[0], t.nodes[1], t.nodes[2], t.nodes[3]});
+}
+
+void NeoHookean::add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const {
   const auto& tets = mesh_.tets();
-  const std::size_t offset = hessian.size();
-  hessian.resize(offset + 144 * tets.size());
-  tbb::parallel_for(
-      tbb::blocked_range<std::size_t>(0, tets.size(), kGrain),
-      [&](const tbb::blocked_range<std::size_t>& r) {
-        Mat12 H;
-        for (std::size_t e = r.begin(); e != r.end(); ++e) {
-          const auto& t = tets[e];
-          H.setConstant(std::numeric_limits<double>::quiet_NaN());
-          neo_hookean_tet(t, material_, gather(x, t), nullptr, &H, project_psd);
-          auto* out = &hessian[offset + 144 * e];
-          for (int a = 0; a < 4; ++a)
-            for (int i = 0; i < 3; ++i)
-              for (int b = 0; b < 4; ++b)
-                for (int j = 0; j < 3; ++j)
-                  *out++ = {3 * t.nodes[a] + i, 3 * t.nodes[b] + j, H(3 * a + i, 3 * b + j)};
-        }
-      });
+  sink.add_blocks([&](std::size_t e, double* block) {
+    Mat12 H;
+    // An inverted tet leaves its block NaN, so the factorization fails.
+    if (std::isfinite(
+            neo_hookean_tet(tets[e], material_, gather(x, tets[e]), nullptr, &H, project_psd)))
+      Eigen::Map<Mat12>{block} = H;
+  });
 }
 
 }  // namespace shapectl

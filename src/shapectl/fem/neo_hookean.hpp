@@ -20,7 +20,8 @@ class NeoHookean : public EnergyTerm {
   std::string_view name() const override { return "neo_hookean"; }
   double value(const Positions& x) const override;
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
-  void add_hessian(const Positions& x, Triplets& hessian, bool project_psd) const override;
+  void hessian_elements(ElementNodes& elements) const override;
+  void add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const override;
 
  private:
   const TetMesh& mesh_;

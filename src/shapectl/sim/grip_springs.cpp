@@ -63,10 +63,14 @@ void GripEnergy::add_gradient(const Positions& x, Eigen::VectorXd& gradient) con
   }
 }
 
-void GripEnergy::add_hessian(const Positions&, Triplets& hessian, bool) const {
-  for (const auto& g : springs_->nodes())
-    for (int d = 0; d < 3; ++d)
-      hessian.emplace_back(3 * g.node + d, 3 * g.node + d, springs_->stiffness());
+void GripEnergy::hessian_elements(ElementNodes& elements) const {
+  for (const auto& g : springs_->nodes()) elements.add({g.node});
+}
+
+void GripEnergy::add_hessian(const Positions&, ElementHessianSink& sink, bool) const {
+  const double k = springs_->stiffness();
+  sink.add_blocks(
+      [k](std::size_t, double* block) { Eigen::Map<Mat3>{block} = k * Mat3::Identity(); });
 }
 
 }  // namespace shapectl

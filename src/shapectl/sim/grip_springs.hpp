@@ -54,7 +54,9 @@ class GripEnergy : public EnergyTerm {
   std::string_view name() const override { return "grip"; }
   double value(const Positions& x) const override;
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
-  void add_hessian(const Positions& x, Triplets& hessian, bool project_psd) const override;
+  // One element per gripped node: K·I₃.
+  void hessian_elements(ElementNodes& elements) const override;
+  void add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const override;
   const std::vector<Vec3>& anchors() const { return anchors_; }
 
  private:

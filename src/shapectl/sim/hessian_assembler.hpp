@@ -1,31 +1,36 @@
 #pragma once
-// Sums Hessian triplets into a sparse matrix whose pattern is built once: the first call finds
-// where each triplet lands, later calls (same triplets in the same order) only add values.
-// Keeps the lower triangle (what the Cholesky solvers read). Fixed degrees of freedom are
-// eliminated: their rows and columns are dropped and their diagonal is 1.
+// Sums the energy terms' Hessians into a sparse matrix whose pattern is built once: the first
+// call learns each term's elements and where each entry of their blocks lands (HessianScatter);
+// later calls, with the same elements, only compute the blocks (on all cores) and add them into
+// the matrix values. Keeps the lower triangle (what the Cholesky solvers read). Fixed degrees
+// of freedom are eliminated: their rows and columns are dropped and their diagonal is 1.
+#include <optional>
 #include <vector>
 
-#include <shapectl/types.hpp>
+#include <shapectl/fem/energy_term.hpp>
+#include <shapectl/fem/hessian_scatter.hpp>
 
 namespace shapectl {
 
 class HessianAssembler {
  public:
   HessianAssembler(int dof_count, std::vector<char> fixed_dof);
-  // Returns the assembled matrix; `pattern_changed()` tells if the sparsity pattern is new.
-  const SparseMatrix& assemble(const Triplets& triplets);
+  // ∂²E/∂x² of the sum of `terms` at x (size dof_count); `project_psd` makes each element block
+  // positive semi-definite. `pattern_changed()` then tells if the sparsity pattern is new.
+  const SparseMatrix& assemble(const std::vector<const EnergyTerm*>& terms, const Positions& x,
+                               bool project_psd);
   bool pattern_changed() const { return pattern_changed_; }
   // The matrix the last assemble() returned.
   const SparseMatrix& matrix() const { return matrix_; }
   const std::vector<char>& fixed_dof() const { return fixed_dof_; }
 
  private:
-  void build_pattern(const Triplets& triplets);
   int dof_count_;
   std::vector<char> fixed_dof_;
   SparseMatrix matrix_;
-  std::vector<int> slot_;           // value index for each triplet, −1 if dropped
-  std::vector<int> diagonal_slot_;  // value index of each diagonal entry
+  std::vector<ElementNodes> elements_;  // each term's elements the scatter map was built for
+  std::vector<ElementNodes> asked_;     // this call's, compared with elements_
+  std::optional<HessianScatter> scatter_;
   bool pattern_changed_ = false;
 };
 

@@ -66,11 +66,17 @@ double StaticsSolver::max_force(const Eigen::VectorXd& g) const {
   return std::isfinite(m) ? m : std::numeric_limits<double>::infinity();
 }
 
+namespace {
+// Every Hessian the solver uses (Newton, Krylov, hessian()) is assembled here.
+const SparseMatrix& assemble_hessian(const EnergyTerms& terms, HessianAssembler& assembler,
+                                     const Positions& x, bool projected) {
+  return assembler.assemble(terms, x, projected);
+}
+}  // namespace
+
 bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
                               bool projected) const {
-  ws.triplets.clear();
-  for (const auto* t : terms) t->add_hessian(x, ws.triplets, projected);
-  const SparseMatrix& H = ws.assembler.assemble(ws.triplets);
+  const SparseMatrix& H = assemble_hessian(terms, ws.assembler, x, projected);
   if (!ws.analyzed || ws.assembler.pattern_changed()) {
     ws.cholesky.analyze(H);
     ws.analyzed = true;
@@ -88,10 +94,8 @@ bool StaticsSolver::factor(const EnergyTerms& terms, StaticsWorkspace& ws,
 }
 
 SparseMatrix StaticsSolver::hessian(const EnergyTerms& terms, const Positions& x) const {
-  Triplets triplets;
-  for (const auto* t : terms) t->add_hessian(x, triplets, false);
   HessianAssembler assembler(3 * node_count_, fixed_dof_);
-  return assembler.assemble(triplets);
+  return assemble_hessian(terms, assembler, x, false);
 }
 
 double StaticsSolver::factor_distance(const StaticsWorkspace& ws, const Positions& x) const {
@@ -185,9 +189,7 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
   // nearby state: H is close to it, so few products reach the tolerance. Assembling H costs a
   // fraction of factoring it on large meshes. Fixed dofs: H has identity rows there and g zeros,
   // so dx stays zero on them.
-  ws.triplets.clear();
-  for (const auto* t : terms) t->add_hessian(x, ws.triplets, false);
-  const SparseMatrix& H = ws.assembler.assemble(ws.triplets);
+  const SparseMatrix& H = assemble_hessian(terms, ws.assembler, x, false);
   const Mat3 R = chord_rotation(chord, x);
   auto precondition = [&](const Eigen::VectorXd& r) { return solve_rotated(chord, R, r); };
   Eigen::VectorXd dx = Eigen::VectorXd::Zero(g.size());

@@ -91,7 +91,6 @@ struct StaticsWorkspace {
 
   HessianAssembler assembler;
   SparseCholesky cholesky;
-  Triplets triplets;
   bool analyzed = false;
   // The factor is of the true Hessian at `factor_x` (else it is unusable).
   bool has_factor = false;
@@ -118,7 +117,7 @@ StaticsTotals statics_totals();
 // it. Const and shareable across threads; everything that changes lives in the caller's
 // StaticsWorkspace and positions. The energy terms are passed per call (they may depend on the
 // robot's configuration); they must describe the same problem each time (same Hessian
-// triplets).
+// elements).
 class StaticsSolver {
  public:
   // fixed_node[i]: node i keeps the position it has in x (Dirichlet). Sizes: n nodes, 3n unknowns.
