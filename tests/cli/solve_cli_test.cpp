@@ -172,6 +172,24 @@ TEST(SolveCli, MaxSecondsReachesIntoTheStaticsAtTheStart) {
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
+TEST(SolveCli, ARunCutShortByItsLimitSaysSoInsteadOfALocalMinimum) {
+  // One iteration cannot bring node 0 ten centimetres up: best effort, and the reason is the
+  // iteration limit, not "a local minimum".
+  TempDir dir;
+  const auto targets =
+      dir.write("t.json", R"({"targets": [{"node": 0, "position": [0.25, 0.05, 0.35]}]})");
+  const auto out = dir.path() / "r.json";
+  const nlohmann::json r = run_json({"solve", kBar, "--targets", targets.string(), "--out",
+                                     out.string(), "--max-iterations", "1"},
+                                    out);
+  EXPECT_EQ(r["termination"], "iteration limit");
+  EXPECT_EQ(r["status"], "best effort");
+  const std::string why = r["status_reason"];
+  EXPECT_TRUE(r["unreachable"].empty());
+  EXPECT_EQ(why.find("local minimum"), std::string::npos) << why;
+  EXPECT_NE(why.find("stopped by the iteration limit"), std::string::npos) << why;
+}
+
 TEST(SolveCli, CentreLineOnAnObjectThatIsNotBarLikeIsBadInput) {
   TempDir dir;
   const auto file = dir.write("line.json", R"({"centerline": [[0.3, 0, 0.3], [0.4, 0, 0.3]]})");
