@@ -106,14 +106,7 @@ void run_solve(const SolveArgs& args) {
   out["tolerance"] = args.tolerance;
   ShortfallReport shortfall;
   if (status == ControllerStatus::BestEffort)
-    shortfall = find_shortfalls(objective, best, out_of_time);
-  // A run cut short by its limits is no local minimum: say which limit ended it.
-  const bool limited = result.termination == Termination::IterationLimit ||
-                       result.termination == Termination::TimeLimit;
-  if (limited && shortfall.reasons.empty())
-    shortfall.detail = std::string("stopped by the ") + to_string(result.termination) +
-                       " before the tolerance; no joint limit, collision, reach or buckling "
-                       "found in the way";
+    shortfall = find_run_shortfalls(objective, best, result.termination, out_of_time);
   out["unreachable"] = shortfall_names(shortfall.reasons);
   out["status_reason"] = shortfall.detail;
   out["iterations"] = result.iterations;

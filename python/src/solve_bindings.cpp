@@ -97,7 +97,7 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
   out.status = to_string(status);
   out.tolerance = tolerance;
   if (status == ControllerStatus::BestEffort) {
-    const ShortfallReport shortfall = find_shortfalls(objective, best);
+    const ShortfallReport shortfall = find_run_shortfalls(objective, best, result.termination);
     out.unreachable = shortfall_names(shortfall.reasons);
     out.status_reason = shortfall.detail;
   }

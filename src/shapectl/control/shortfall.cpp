@@ -163,4 +163,16 @@ ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluat
   return report;
 }
 
+ShortfallReport find_run_shortfalls(const ReducedObjective& objective, const Evaluation& best,
+                                    Termination termination, const StopRequest& stop) {
+  ShortfallReport report = find_shortfalls(objective, best, stop);
+  const bool limited =
+      termination == Termination::IterationLimit || termination == Termination::TimeLimit;
+  if (limited && report.reasons.empty())
+    report.detail = std::string("stopped by the ") + to_string(termination) +
+                    " before the tolerance; no joint limit, collision, reach or buckling found "
+                    "in the way";
+  return report;
+}
+
 }  // namespace shapectl

@@ -18,6 +18,7 @@
 #include <string_view>
 #include <vector>
 
+#include <shapectl/control/optimize.hpp>
 #include <shapectl/control/reduced_objective.hpp>
 
 namespace shapectl {
@@ -37,5 +38,9 @@ struct ShortfallReport {
 // time budget) may cut the buckling probe's statics short: buckling is then not reported.
 ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluation& at,
                                 const StopRequest& stop = {});
+// The same for the best state of a run that ended with `termination`: a run its iteration or
+// time limit cut short, with no reason found, is said to be that, not a local minimum.
+ShortfallReport find_run_shortfalls(const ReducedObjective& objective, const Evaluation& best,
+                                    Termination termination, const StopRequest& stop = {});
 
 }  // namespace shapectl
