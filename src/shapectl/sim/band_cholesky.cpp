@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <shapectl/sim/band_factor.hpp>
+
 extern "C" {  // LAPACK and BLAS (OpenBLAS)
 void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);
 void dpbtrs_(const char* uplo, const int* n, const int* kd, const int* nrhs, const double* ab,
@@ -218,14 +220,27 @@ double BandCholesky::flops() const {
   return f;
 }
 
+namespace {
+constexpr int kOwnFactorFrom = 128;  // sub-diagonals
+constexpr int kOwnFactorBlock = 32;  // columns per block column
+}  // namespace
+
 bool BandCholesky::factorize(const SparseMatrix& lower) {
   band_.assign(static_cast<std::size_t>(bandwidth_ + 1) * size_, 0.0);
   const double* values = lower.valuePtr();
   for (std::size_t k = 0; k < slot_.size(); ++k) band_[slot_[k]] += values[k];
   const int rows = bandwidth_ + 1;
-  int info = 0;
-  dpbtrf_("L", &size_, &bandwidth_, band_.data(), &rows, &info);
-  if (info != 0) return false;
+  // Narrow bands: LAPACK's dpbtrf (one thread; its rank-32 updates are as fast as ours there).
+  // Wider ones: our blocked factorization, its trailing updates split over two threads with a
+  // look-ahead (band_factor.hpp). Crossover and block measured, docs/benchmarks.md.
+  if (bandwidth_ >= kOwnFactorFrom) {
+    if (!factor_band(band_.data(), size_, bandwidth_, kOwnFactorBlock, /*two_threads=*/true))
+      return false;
+  } else {
+    int info = 0;
+    dpbtrf_("L", &size_, &bandwidth_, band_.data(), &rows, &info);
+    if (info != 0) return false;
+  }
   // As for LDLᵀ: a pivot (L_jj²) tiny next to the largest means singular in double precision.
   double smallest = INFINITY, largest = 0;
   for (int j = 0; j < size_; ++j) {

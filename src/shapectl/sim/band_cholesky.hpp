@@ -1,7 +1,8 @@
 #pragma once
 // Cholesky factorization of a sparse SPD matrix as a dense band: the unknowns are renumbered
 // by reverse Cuthill–McKee, which makes the band of an elongated mesh (a bar, a frame) narrow,
-// and LAPACK's blocked band Cholesky (dpbtrf, BLAS-3) factors it. On such meshes this runs
+// and a blocked band Cholesky (BLAS-3) factors it: LAPACK's dpbtrf for narrow bands, our own
+// two-thread one for wide bands (band_factor.hpp). On such meshes this runs
 // several times faster than a simplicial sparse factorization of the same matrix, although
 // it does more flops: dense kernels use the vector units, scattered sparse updates do not.
 #include <vector>

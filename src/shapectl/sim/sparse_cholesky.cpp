@@ -88,11 +88,16 @@ void SparseCholesky::analyze(const SparseMatrix& lower) {
 }
 
 bool SparseCholesky::factorize(const SparseMatrix& lower) {
-  constexpr int kThreadedBandFrom = 256;  // sub-diagonals; measured crossover on 2 cores
+  constexpr int kThreadedBandFrom = 256;  // sub-diagonals; measured crossover on 2 cores (solve)
   switch (backend_) {
-    case Backend::Band:
+    case Backend::Band: {
+      // The band factorization runs its own two threads over single-threaded BLAS calls
+      // (band_factor.hpp); the solves keep OpenBLAS's threads on wide bands.
+      use_blas_threads(false);
+      const bool positive_definite = impl_->band.factorize(lower);
       use_blas_threads(impl_->band.bandwidth() >= kThreadedBandFrom);
-      return impl_->band.factorize(lower);
+      return positive_definite;
+    }
     case Backend::CholmodSupernodal:
       use_blas_threads(true);
       impl_->cholmod.factorize(lower);
