@@ -248,8 +248,9 @@ BENCHMARK_CAPTURE(piece, solve4_auto, Piece::Solve, std::nullopt, 4)->Apply(both
 BENCHMARK_CAPTURE(piece, solve1_cholmod, Piece::Solve, kCholmod, 1)->Apply(both_bars);
 
 // The band factorization alone (no assembly), with its flop rate: BandCholesky::flops() per
-// CPU second of the calling thread, the share of one core's peak that dpbtrf reaches (one
-// thread below 256 sub-diagonals; from there OpenBLAS's threads make the rate an overestimate).
+// CPU second of the calling thread, the share of one core's peak that dpbtrf reaches below 192
+// sub-diagonals; from there the factorization's second thread makes the rate an overestimate
+// (compare wall times).
 void BM_BandFactorize(benchmark::State& state) {
   const int n = static_cast<int>(state.range(0));
   const Scene scene = clamped_bar({4 * n, n, n});

@@ -47,7 +47,7 @@ struct Case {
 // from 32 sub-diagonals and 3 right-hand sides on, LAPACK's dpbtrs below): diagonal,
 // tridiagonal, dense (bandwidth n − 1) with one block and with several, bands just below, at
 // and above one block and two, sizes not a multiple of a block, ill-conditioned ones; and
-// from 128 sub-diagonals on the blocked two-thread factorization (band_factor.hpp).
+// from 192 sub-diagonals on the blocked two-thread factorization (band_factor.hpp).
 const Case kCases[] = {{1, 0},
                        {9, 0},
                        {9, 1},

@@ -221,7 +221,7 @@ double BandCholesky::flops() const {
 }
 
 namespace {
-constexpr int kOwnFactorFrom = 128;  // sub-diagonals
+constexpr int kOwnFactorFrom = 192;  // sub-diagonals
 constexpr int kOwnFactorBlock = 32;  // columns per block column
 }  // namespace
 

@@ -1,6 +1,6 @@
 #include <shapectl/sim/band_factor.hpp>
 
-#include <tbb/parallel_invoke.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cmath>
@@ -101,12 +101,20 @@ int lookahead_split(const BlockColumn& b, const BlockColumn& next) {
   const double s = b.rows - std::sqrt(0.5 * b.rows * b.rows + next_flops / (2.0 * b.size));
   return std::clamp(static_cast<int>(std::lround(s)), std::min(next.size, b.rows), b.rows);
 }
+
+// The column c_p of a rows × rows triangle such that columns [from, c_p) hold p/pieces of the
+// entries of columns [from, rows): (rows − c_p)² = (rows − from)² (1 − p/pieces).
+int equal_flops_column(int rows, int from, int p, int pieces) {
+  if (p >= pieces) return rows;
+  const double c = rows - (rows - from) * std::sqrt(1.0 - static_cast<double>(p) / pieces);
+  return std::clamp(static_cast<int>(std::lround(c)), from, rows);
+}
 }  // namespace
 
 // Right-looking like LAPACK's dpbtrf, with a look-ahead of one block column: the trailing
-// update of block column k is split by columns; the part holding block column k + 1 goes first
-// on one thread, which then factors that block column while the other thread finishes the
-// rest. One synchronisation per block column; with one thread the same steps run in turn.
+// update of block column k is split by columns; the calling thread updates the part holding
+// block column k + 1 and then factors that block column while another thread updates the
+// rest. One synchronisation per block column. With one thread, the whole update in one go.
 bool factor_band(double* ab, int n, int kd, int block, bool two_threads) {
   const BandView band{ab, n, kd};
   const int nb = std::clamp(block, 1, std::max(kd, 1));
@@ -118,16 +126,23 @@ bool factor_band(double* ab, int n, int kd, int block, bool two_threads) {
     const BlockColumn next(band, b.first + b.size, nb);
     const int split = lookahead_split(b, next);
     bool next_ok = true;
-    const auto first_part = [&] {
+    if (two_threads) {
+      // The rest in a few pieces of equal flops: a piece another thread took and then could not
+      // run (preempted on a busy machine) holds this thread up for less; pieces nobody took,
+      // this thread runs itself in wait().
+      constexpr int kPieces = 4;
+      tbb::task_group rest;
+      for (int p = 0; p < kPieces; ++p) {
+        const int from = equal_flops_column(b.rows, split, p, kPieces);
+        const int to = equal_flops_column(b.rows, split, p + 1, kPieces);
+        rest.run([&, from, to] { update_trailing_columns(band, b, panel, from, to); });
+      }
       update_trailing_columns(band, b, panel, 0, split);
       next_ok = factor_block_column(band, next, next_panel);
-    };
-    const auto second_part = [&] { update_trailing_columns(band, b, panel, split, b.rows); };
-    if (two_threads) {
-      tbb::parallel_invoke(first_part, second_part);
+      rest.wait();
     } else {
-      first_part();
-      second_part();
+      update_trailing_columns(band, b, panel, 0, b.rows);
+      next_ok = factor_block_column(band, next, next_panel);
     }
     if (!next_ok) return false;
     b = next;
