@@ -167,7 +167,8 @@ BENCHMARK_CAPTURE(factorize, solve14_cholmod, SparseCholesky::Backend::CholmodSu
 
 // The pieces of one optimizer iteration on a refined bar (12,288 tets: the 12k size),
 // at its equilibrium: energy, gradient, Hessian assembly, numeric factorization, a solve with
-// 14 right-hand sides (dx̂/dθ for two 7-joint arms; or `rhs_columns`). Which piece dominates
+// 14 right-hand sides (dx̂/dθ for two 7-joint arms; or `rhs_columns`). EnergyAndGradient: the
+// terms' fused value_and_add_gradient (one pass where a term has one). Which piece dominates
 // decides what to cut. Arg(n): a bar of 4n × n × n cells (4: the default bar, 8: 12k tets).
 // Assemble: the workspace's assembler with its pattern built (what every Newton and Krylov step
 // pays); FactorOnly: the numeric factorization of the matrix already assembled.
@@ -179,7 +180,16 @@ void both_bars(benchmark::internal::Benchmark* b) {
 void four_bars(benchmark::internal::Benchmark* b) {
   b->Arg(4)->Arg(8)->Arg(10)->Arg(13)->Unit(benchmark::kMillisecond);
 }
-enum class Piece { Energy, Gradient, Hessian, Assemble, FactorOnly, Factorize, Solve };
+enum class Piece {
+  Energy,
+  Gradient,
+  EnergyAndGradient,
+  Hessian,
+  Assemble,
+  FactorOnly,
+  Factorize,
+  Solve
+};
 void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::Backend> backend,
            int rhs_columns = 14) {
   const int n = static_cast<int>(state.range(0));
@@ -197,6 +207,14 @@ void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::B
     switch (which) {
       case Piece::Energy: benchmark::DoNotOptimize(solver.energy(terms, x)); break;
       case Piece::Gradient: benchmark::DoNotOptimize(solver.gradient(terms, x)); break;
+      case Piece::EnergyAndGradient: {
+        Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+        double e = 0;
+        for (const EnergyTerm* t : terms) e += t->value_and_add_gradient(x, g);
+        benchmark::DoNotOptimize(e);
+        benchmark::DoNotOptimize(g.data());
+        break;
+      }
       case Piece::Hessian: benchmark::DoNotOptimize(solver.hessian(terms, x)); break;
       case Piece::Assemble:
         benchmark::DoNotOptimize(ws.assembler.assemble(terms, x, false).valuePtr());
@@ -211,9 +229,15 @@ void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::B
   state.counters["tets"] = statics.mesh().tet_count();
 }
 BENCHMARK_CAPTURE(piece, energy, Piece::Energy, std::nullopt)
+    ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, gradient, Piece::Gradient, std::nullopt)
+    ->Arg(4)
+    ->Arg(8)
+    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, energy_and_gradient, Piece::EnergyAndGradient, std::nullopt)
+    ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(piece, hessian, Piece::Hessian, std::nullopt)

@@ -100,8 +100,9 @@ TEST(DerivativeCheck, MismatchedSizesAndNotANumberFail) {
   EXPECT_FALSE(test::derivative_matches(Eigen::MatrixXd::Ones(2, 3), not_a_number(), 1e-6, "f"));
 }
 
-// E(x) = Σ xᵢ² + xᵢ³: gradient 2xᵢ + 3xᵢ², Hessian diagonal 2 + 6xᵢ. A fault breaks one of them.
-enum class Fault { None, Gradient, Hessian };
+// E(x) = Σ xᵢ² + xᵢ³: gradient 2xᵢ + 3xᵢ², Hessian diagonal 2 + 6xᵢ. A fault breaks one of them,
+// or makes the fused value and gradient differ from the separate ones.
+enum class Fault { None, Gradient, Hessian, FusedValue, FusedGradient };
 
 class CubicTerm final : public EnergyTerm {
  public:
@@ -113,6 +114,11 @@ class CubicTerm final : public EnergyTerm {
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override {
     gradient.array() += 2 * x.array() + 3 * x.array().square();
     if (fault_ == Fault::Gradient) gradient[1] += 0.1;  // a constant: differences of it stay right
+  }
+  double value_and_add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override {
+    const double e = EnergyTerm::value_and_add_gradient(x, gradient);
+    if (fault_ == Fault::FusedGradient) gradient[4] *= 1 + 1e-15;  // one rounding apart
+    return fault_ == Fault::FusedValue ? e * (1 + 1e-15) : e;
   }
   // One element per node of energy_point()'s two: a diagonal 3×3 block.
   void hessian_elements(ElementNodes& elements) const override {
@@ -163,6 +169,12 @@ TEST(DerivativeCheck, EnergyTermCheckPassesRightDerivativesAndFailsEachWrongOne)
   EXPECT_NONFATAL_FAILURE(test::expect_derivatives_match(CubicTerm(Fault::Hessian), energy_point(),
                                                          1e-6),
                           "cubic Hessian: relative error");
+  EXPECT_NONFATAL_FAILURE(test::expect_derivatives_match(CubicTerm(Fault::FusedValue),
+                                                         energy_point(), 1e-6),
+                          "cubic fused energy differs");
+  EXPECT_NONFATAL_FAILURE(test::expect_derivatives_match(CubicTerm(Fault::FusedGradient),
+                                                         energy_point(), 1e-6),
+                          "cubic fused gradient differs");
 }
 
 TEST(DerivativeCheck, EnergyTermWithAZeroHessianFailsTheHessianCheck) {

@@ -6,6 +6,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <tbb/task_arena.h>
 
 #include <shapectl/mesh/box_mesh.hpp>
 
@@ -105,6 +106,59 @@ TEST(NeoHookean, InvertedElementHasInfiniteEnergy) {
   mirror(2, 2) = -1;
   EXPECT_TRUE(std::isinf(term.value(affine(mesh, mirror, Vec3::Zero()))));
   EXPECT_TRUE(std::isinf(term.value(affine(mesh, Mat3::Zero(), Vec3::Zero()))));
+}
+
+TEST(NeoHookean, InvertedElementMakesTheFusedGradientNaNLikeTheSeparateOne) {
+  const TetMesh mesh = make_box_mesh({0.1, 0.02, 0.02}, {4, 1, 1});
+  const NeoHookean term(mesh, kFoam);
+  Positions x = mesh.rest_vector();
+  const int node = mesh.tets()[0].nodes[0];
+  // Push one corner through the opposite face.
+  x.segment<3>(3 * node) =
+      3 * x.segment<3>(3 * mesh.tets()[0].nodes[1]) - 2 * x.segment<3>(3 * node);
+  Eigen::VectorXd separate = Eigen::VectorXd::Zero(x.size()), fused = separate;
+  term.add_gradient(x, separate);
+  EXPECT_TRUE(std::isinf(term.value_and_add_gradient(x, fused)));
+  EXPECT_TRUE(std::isnan(fused[3 * node]));
+  EXPECT_TRUE((fused.array().isNaN() == separate.array().isNaN()).all());
+  EXPECT_TRUE(fused.array().isNaN().any() && !fused.array().isNaN().all());
+}
+
+TEST(NeoHookean, EnergyAndGradientAreTheSameBitsOnOneThreadAndOnMany) {
+  // Enough tets and nodes for many parallel chunks; a perturbed state so every entry is nonzero.
+  const TetMesh mesh = make_box_mesh({0.32, 0.08, 0.08}, {16, 4, 4});
+  const NeoHookean term(mesh, kFoam);
+  std::mt19937 rng(11);
+  const Positions x = test::perturbed(mesh.rest_vector(), 0.002, rng);
+  struct Result {
+    double energy = 0, fused_energy = 0;
+    Eigen::VectorXd gradient, fused_gradient;
+  };
+  const auto evaluate = [&](int threads) {
+    Result r;
+    r.gradient = r.fused_gradient = Eigen::VectorXd::Zero(x.size());
+    tbb::task_arena(threads).execute([&] {
+      r.energy = term.value(x);
+      term.add_gradient(x, r.gradient);
+      r.fused_energy = term.value_and_add_gradient(x, r.fused_gradient);
+    });
+    return r;
+  };
+  const Result one = evaluate(1);
+  ASSERT_GT(one.energy, 0);
+  ASSERT_GT(one.gradient.cwiseAbs().minCoeff(), 0);
+  EXPECT_EQ(one.fused_energy, one.energy);
+  EXPECT_TRUE((one.fused_gradient.array() == one.gradient.array()).all());
+  for (const int threads : {2, 4}) {
+    for (int run = 0; run < 3; ++run) {
+      const Result many = evaluate(threads);
+      EXPECT_EQ(many.energy, one.energy) << threads << " threads";
+      EXPECT_EQ(many.fused_energy, one.energy) << threads << " threads";
+      EXPECT_TRUE((many.gradient.array() == one.gradient.array()).all()) << threads << " threads";
+      EXPECT_TRUE((many.fused_gradient.array() == one.gradient.array()).all())
+          << threads << " threads";
+    }
+  }
 }
 
 TEST(NeoHookean, ProjectedHessianIsPositiveSemidefiniteAndTrueOneIsNot) {

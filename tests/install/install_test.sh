@@ -26,7 +26,7 @@ scene="$data/scenes/yumi_bar.json"
 read -r cli_iterations cli_energy < <(python3 -c '
 import json, sys
 r = json.load(open(sys.argv[1]))
-print(r["iterations"], repr(r["energy"]))' "$work/statics.json")
+print(r["iterations"], "%.17g" % r["energy"])' "$work/statics.json")  # the consumer's printf format
 expected="nodes 425
 converged 1
 iterations $cli_iterations

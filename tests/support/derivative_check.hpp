@@ -120,9 +120,25 @@ inline void expect_hessian_matches(const EnergyTerm& term, const Positions& x, d
                                  std::string(term.name()) + " Hessian"));
 }
 
+// The fused value_and_add_gradient against value and add_gradient: the same energy and the same
+// gradient bit for bit, added onto what `gradient` held (a seeded random start). With
+// add_gradient checked against central differences, so is the fused gradient.
+inline void expect_fused_matches_separate(const EnergyTerm& term, const Positions& x) {
+  std::mt19937 rng(7);
+  const Eigen::VectorXd start = perturbed(Eigen::VectorXd::Zero(x.size()), 1.0, rng);
+  Eigen::VectorXd separate = start, fused = start;
+  term.add_gradient(x, separate);
+  const double energy = term.value_and_add_gradient(x, fused);
+  EXPECT_EQ(energy, term.value(x)) << term.name() << " fused energy differs from value";
+  EXPECT_TRUE((fused.array() == separate.array()).all())
+      << term.name() << " fused gradient differs from add_gradient by up to "
+      << (fused - separate).cwiseAbs().maxCoeff();
+}
+
 inline void expect_derivatives_match(const EnergyTerm& term, const Positions& x, double tolerance,
                                      double h = 1e-6) {
   expect_gradient_matches(term, x, tolerance, h);
+  expect_fused_matches_separate(term, x);
   expect_hessian_matches(term, x, tolerance, h);
 }
 

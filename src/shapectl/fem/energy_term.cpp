@@ -31,6 +31,11 @@ class TripletSink : public ElementHessianSink {
 
 }  // namespace
 
+double EnergyTerm::value_and_add_gradient(const Positions& x, Eigen::VectorXd& gradient) const {
+  add_gradient(x, gradient);
+  return value(x);
+}
+
 Triplets EnergyTerm::hessian_triplets(const Positions& x, bool project_psd) const {
   ElementNodes elements;
   hessian_elements(elements);

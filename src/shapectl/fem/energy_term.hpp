@@ -15,6 +15,10 @@ class EnergyTerm {
   virtual double value(const Positions& x) const = 0;
   // Adds ∂E/∂x to `gradient` (size 3n).
   virtual void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const = 0;
+  // value(x), and add_gradient(x, gradient), in one call: the same numbers bit for bit. A term
+  // overrides it where one pass over its elements can share the work (F, J, F⁻ᵀ per tet); the
+  // default calls the two.
+  virtual double value_and_add_gradient(const Positions& x, Eigen::VectorXd& gradient) const;
   // Appends the nodes of each element whose Hessian block add_hessian gives: the same elements
   // in the same order on every call, so an assembler can cache where each block lands.
   virtual void hessian_elements(ElementNodes& elements) const = 0;

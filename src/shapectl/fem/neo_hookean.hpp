@@ -2,6 +2,7 @@
 // Compressible neo-Hookean elasticity on linear tetrahedra (paper eq. 2):
 // Ψ(F) = μ/2 (tr(FᵀF) − 3) − μ ln J + κ/2 (ln J)², J = det F, energy = Σ rest volume · Ψ.
 #include <shapectl/fem/energy_term.hpp>
+#include <shapectl/fem/gradient_gather.hpp>
 #include <shapectl/fem/material.hpp>
 #include <shapectl/mesh/tet_mesh.hpp>
 
@@ -16,16 +17,21 @@ double neo_hookean_tet(const TetRest& rest, const Material& m, const Vec12& x,
 
 class NeoHookean : public EnergyTerm {
  public:
-  NeoHookean(const TetMesh& mesh, const Material& material) : mesh_(mesh), material_(material) {}
+  // The mesh must outlive this.
+  NeoHookean(const TetMesh& mesh, const Material& material);
   std::string_view name() const override { return "neo_hookean"; }
   double value(const Positions& x) const override;
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
+  double value_and_add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
   void hessian_elements(ElementNodes& elements) const override;
   void add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const override;
 
  private:
+  double tet_energy_and_gradient(const Positions& x, std::size_t e, double* corners) const;
+
   const TetMesh& mesh_;
   Material material_;
+  GradientGather gather_;  // the tets' corners, node by node
 };
 
 }  // namespace shapectl
