@@ -22,7 +22,7 @@
 // that step, and on with the energy test only, unless within watchdog_iterations iterations
 // the energy falls below that state's Armijo level; an equilibrium found above it, and any
 // failure or end of the solve during the watch, also go back. The convergence test is the
-// same; on every case measured (docs/benchmarks.md) so is the equilibrium, to < 1e-7 m.
+// same; on every case measured (docs/benchmarks.md) so is the equilibrium, to < 1e-6 m.
 #include <algorithm>
 #include <functional>
 #include <limits>
