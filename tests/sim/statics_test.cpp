@@ -264,6 +264,14 @@ StaticsSolver with_watchdog(const ObjectStatics& statics, int watchdog_iteration
   return StaticsSolver(statics.mesh().node_count(), statics.fixed_node(), options);
 }
 
+// Statics from rest with the watchdog after `watchdog_iterations` (0: off); x the answer.
+StaticsResult solve_from_rest(const ObjectStatics& statics, int watchdog_iterations, Positions& x) {
+  const StaticsSolver solver = with_watchdog(statics, watchdog_iterations);
+  StaticsWorkspace ws = solver.make_workspace();
+  x = statics.mesh().rest_vector();
+  return solver.solve(statics.terms(), ws, x);
+}
+
 // Largest distance between the nodes of two position vectors.
 double largest_distance(const Positions& a, const Positions& b) {
   return (a - b).reshaped(3, a.size() / 3).colwise().norm().maxCoeff();
@@ -274,11 +282,9 @@ TEST(Statics, WatchdogSavesIterationsOnASoftCantileverFromRest) {
   // solution) stretches it, and the energy test cut it to a fraction.
   const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, false);
   const ObjectStatics statics(scene);
-  const StaticsSolver on = with_watchdog(statics, 6), off = with_watchdog(statics, 0);
-  Positions x_on = scene.world_rest_positions(), x_off = x_on;
-  StaticsWorkspace ws_on = on.make_workspace(), ws_off = off.make_workspace();
-  const StaticsResult r_on = on.solve(statics.terms(), ws_on, x_on);
-  const StaticsResult r_off = off.solve(statics.terms(), ws_off, x_off);
+  Positions x_on, x_off;
+  const StaticsResult r_on = solve_from_rest(statics, 6, x_on);
+  const StaticsResult r_off = solve_from_rest(statics, 0, x_off);
   ASSERT_TRUE(r_on.converged()) << r_on.reason;
   ASSERT_TRUE(r_off.converged()) << r_off.reason;
   // 8 against 15 on this machine.
@@ -302,11 +308,9 @@ TEST(Statics, WatchdogGoesBackWhenTheEnergyDoesNotFallInTime) {
   // solve returns to the rest state and descends from there as without the watchdog.
   const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, false);
   const ObjectStatics statics(scene);
-  const StaticsSolver short_watch = with_watchdog(statics, 1), off = with_watchdog(statics, 0);
-  Positions x = scene.world_rest_positions(), x_off = x;
-  StaticsWorkspace ws = short_watch.make_workspace(), ws_off = off.make_workspace();
-  const StaticsResult r = short_watch.solve(statics.terms(), ws, x);
-  const StaticsResult r_off = off.solve(statics.terms(), ws_off, x_off);
+  Positions x, x_off;
+  const StaticsResult r = solve_from_rest(statics, 1, x);
+  const StaticsResult r_off = solve_from_rest(statics, 0, x_off);
   ASSERT_TRUE(r.converged()) << r.reason;
   ASSERT_TRUE(r_off.converged()) << r_off.reason;
   ASSERT_GE(r.log.size(), 2u);
