@@ -257,5 +257,98 @@ TEST(Statics, UnconvergedSolveIsNeverReportedConverged) {
   EXPECT_NE(r.reason.find("after 1 iterations"), std::string::npos) << r.reason;
 }
 
+// A solver for `statics`'s problem with the watchdog after `watchdog_iterations` (0: off).
+StaticsSolver with_watchdog(const ObjectStatics& statics, int watchdog_iterations) {
+  StaticsOptions options = statics.solver().options();
+  options.watchdog_iterations = watchdog_iterations;
+  return StaticsSolver(statics.mesh().node_count(), statics.fixed_node(), options);
+}
+
+// Statics from rest with the watchdog after `watchdog_iterations` (0: off); x the answer.
+StaticsResult solve_from_rest(const ObjectStatics& statics, int watchdog_iterations, Positions& x) {
+  const StaticsSolver solver = with_watchdog(statics, watchdog_iterations);
+  StaticsWorkspace ws = solver.make_workspace();
+  x = statics.mesh().rest_vector();
+  return solver.solve(statics.terms(), ws, x);
+}
+
+// Largest distance between the nodes of two position vectors.
+double largest_distance(const Positions& a, const Positions& b) {
+  return (a - b).reshaped(3, a.size() / 3).colwise().norm().maxCoeff();
+}
+
+TEST(Statics, WatchdogSavesIterationsOnASoftCantileverFromRest) {
+  // A foam cantilever sags a third of its length: from rest Newton's full step (the linear
+  // solution) stretches it, and the energy test cut it to a fraction.
+  const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, false);
+  const ObjectStatics statics(scene);
+  Positions x_on, x_off;
+  const StaticsResult r_on = solve_from_rest(statics, 6, x_on);
+  const StaticsResult r_off = solve_from_rest(statics, 0, x_off);
+  ASSERT_TRUE(r_on.converged()) << r_on.reason;
+  ASSERT_TRUE(r_off.converged()) << r_off.reason;
+  // 8 against 15 on this machine.
+  EXPECT_LE(r_on.iterations, 10);
+  EXPECT_LE(r_on.iterations + 4, r_off.iterations);
+  // The first step was the relaxed one: taken in full although it raised the energy; none
+  // was undone.
+  ASSERT_GE(r_on.log.size(), 2u);
+  EXPECT_TRUE(r_on.log[0].relaxed);
+  EXPECT_EQ(r_on.log[0].step_length, 1);
+  EXPECT_GT(r_on.log[1].energy, r_on.log[0].energy);
+  for (const auto& it : r_on.log) EXPECT_FALSE(it.went_back);
+  EXPECT_LT(r_on.energy, r_on.log[0].energy);
+  // The same equilibrium; the tip hangs centimetres low.
+  EXPECT_LT(largest_distance(x_on, x_off), 1e-6);
+  EXPECT_GT(largest_distance(x_on, scene.world_rest_positions()), 0.05);
+}
+
+TEST(Statics, WatchdogGoesBackWhenTheEnergyDoesNotFallInTime) {
+  // One iteration is too few for the cantilever to swing below its starting energy: the
+  // solve returns to the rest state and descends from there as without the watchdog.
+  const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, false);
+  const ObjectStatics statics(scene);
+  Positions x, x_off;
+  const StaticsResult r = solve_from_rest(statics, 1, x);
+  const StaticsResult r_off = solve_from_rest(statics, 0, x_off);
+  ASSERT_TRUE(r.converged()) << r.reason;
+  ASSERT_TRUE(r_off.converged()) << r_off.reason;
+  ASSERT_GE(r.log.size(), 2u);
+  EXPECT_TRUE(r.log[0].relaxed);
+  EXPECT_TRUE(r.log[1].went_back);
+  EXPECT_EQ(r.log[1].energy, r.log[0].energy);  // back at rest
+  EXPECT_EQ(r.iterations, r_off.iterations + 1);
+  EXPECT_LT(largest_distance(x, x_off), 1e-6);
+}
+
+TEST(Statics, WatchdogEndingUnconvergedReturnsTheStateBeforeItsStep) {
+  // Stopped by the iteration limit during the watch: the state before the relaxed step (here
+  // rest), not the stretched one, with its residual.
+  const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, false);
+  const ObjectStatics statics(scene);
+  Positions x = scene.world_rest_positions();
+  StaticsWorkspace ws = statics.make_workspace();
+  const StaticsResult r = statics.solver().solve(statics.terms(), ws, x, 2);
+  EXPECT_EQ(r.status, StaticsStatus::NotConverged);
+  ASSERT_FALSE(r.log.empty());
+  EXPECT_TRUE(r.log[0].relaxed);
+  EXPECT_EQ(x, scene.world_rest_positions());
+  EXPECT_EQ(r.residual, r.log[0].residual);
+  EXPECT_EQ(r.energy, r.log[0].energy);
+}
+
+TEST(Statics, WarmSolvesWithANearbyFactorNeverRelax) {
+  // The optimizer's warm solves (a chord source given) keep the energy test on every step.
+  const Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
+  const ObjectStatics statics(scene);
+  Positions x = scene.world_rest_positions();
+  StaticsWorkspace ws = statics.make_workspace();
+  ASSERT_TRUE(statics.solve(ws, x).converged());
+  move_right_clamp(statics, x, 2e-2);
+  const StaticsResult r = statics.solve(ws, x, nullptr, 0, &ws);
+  ASSERT_TRUE(r.converged()) << r.reason;
+  for (const auto& it : r.log) EXPECT_FALSE(it.relaxed || it.went_back);
+}
+
 }  // namespace
 }  // namespace shapectl

@@ -235,8 +235,9 @@ Eigen::VectorXd StaticsSolver::newton_direction(const EnergyTerms& terms, Static
 }
 
 bool StaticsSolver::line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x,
-                                Point& at, NewtonIterate& log) const {
-  // Backtracking (see the header). Inverted trial states have E = +inf.
+                                Point& at, NewtonIterate& log, bool relaxed) const {
+  // Backtracking (see the header). Inverted trial states have E = +inf. Relaxed (the
+  // watchdog's step): the first finite state is taken.
   const double slope = at.gradient.dot(dx);
   const double noise = energy_noise(at.energy);
   const double force_norm2 = at.gradient.squaredNorm();
@@ -245,7 +246,7 @@ bool StaticsSolver::line_search(const EnergyTerms& terms, const Eigen::VectorXd&
     Positions trial = x + alpha * dx;
     const double e_trial = energy(terms, trial);
     if (!std::isfinite(e_trial)) continue;
-    const bool armijo = e_trial <= at.energy + 1e-4 * alpha * slope;
+    const bool armijo = relaxed || e_trial <= at.energy + 1e-4 * alpha * slope;
     if (!armijo && e_trial > at.energy + noise) continue;
     Eigen::VectorXd g_trial = gradient(terms, trial);
     const double r_trial = max_force(g_trial);
@@ -259,6 +260,13 @@ bool StaticsSolver::line_search(const EnergyTerms& terms, const Eigen::VectorXd&
     return true;
   }
   return false;
+}
+
+bool StaticsSolver::lowers_enough(const Point& from, double slope, const Point& to) const {
+  // The line search's test at α = 1, with the gradient at hand.
+  if (to.energy <= from.energy + 1e-4 * slope) return true;
+  return to.energy <= from.energy + energy_noise(from.energy) &&
+         to.gradient.squaredNorm() <= (1 - 1e-4) * from.gradient.squaredNorm();
 }
 
 StaticsResult StaticsSolver::stopped(StaticsResult& result, const Point& at, int it) const {
@@ -296,7 +304,38 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
   // near buckling (seconds instead of milliseconds in `shapectl bench`), and Newton's last
   // step leaves a factorization the sensitivities can reuse.
   bool may_chord = chord && chord->has_factor && chord->factor_x.size() == x.size();
+  // The watchdog (see the header): a cold solve's first Newton step is taken in full while no
+  // element inverts, even where it raises the energy; the solve returns to the state before it
+  // (and to the descent rule, for good) unless the energy falls below that state's Armijo level
+  // within watchdog_iterations iterations.
+  struct Reference {
+    Positions x;
+    Point at;
+    double slope = 0;  // ∇E·dx of the relaxed step
+    int iteration = 0;
+  };
+  std::optional<Reference> watch;
+  bool may_relax = !chord && options_.watchdog_iterations > 0;
+  // A solve that ends unconverged during the watch returns the state before the relaxed step.
+  auto restore = [&] {
+    x = std::move(watch->x);
+    at = std::move(watch->at);
+    watch.reset();
+    result.residual = at.residual;
+    result.energy = at.energy;
+  };
+  auto go_back = [&](int it) {
+    restore();
+    result.log.push_back(
+        {.iteration = it, .residual = at.residual, .energy = at.energy, .went_back = true});
+  };
   for (int it = 0;; ++it) {
+    if (watch) {
+      if (lowers_enough(watch->at, watch->slope, at)) watch.reset();
+      else if (it - watch->iteration >= options_.watchdog_iterations || at.residual <= tolerance ||
+               !std::isfinite(at.residual))
+        go_back(it);  // not below the start in time, or an equilibrium above it
+    }
     result.iterations = it;
     result.residual = at.residual;
     result.energy = at.energy;
@@ -312,12 +351,16 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
       return result;
     }
     if (it == max_iterations) {
+      if (watch) restore();
       result.status = StaticsStatus::NotConverged;
       result.reason = "not converged: residual " + sci(at.residual) + " N after " +
                       std::to_string(it) + " iterations";
       return result;
     }
-    if (stop && stop()) return stopped(result, at, it);
+    if (stop && stop()) {
+      if (watch) restore();
+      return stopped(result, at, it);
+    }
     NewtonIterate log{.iteration = it, .residual = at.residual, .energy = at.energy};
     ++total_iterations;
     if (may_chord && options_.chord_steps && chord_step(terms, *chord, x, at, log)) {
@@ -328,7 +371,7 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     // takes full steps (a shorter one means the factor no longer fits: Newton factors anew).
     if (may_chord && options_.krylov_steps) {
       const Eigen::VectorXd dx = krylov_direction(terms, ws, *chord, x, at.gradient, log);
-      if (dx.size() > 0 && line_search(terms, dx, x, at, log)) {
+      if (dx.size() > 0 && line_search(terms, dx, x, at, log, false)) {
         may_chord = log.step_length == 1;
         result.log.push_back(log);
         continue;
@@ -338,19 +381,34 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     may_chord = false;
     const Eigen::VectorXd dx =
         newton_direction(terms, ws, x, at.gradient, log, result.factorizations, stop);
-    if (dx.size() == 0 && stop && stop()) return stopped(result, at, it);
+    if (dx.size() == 0 && stop && stop()) {
+      if (watch) restore();
+      return stopped(result, at, it);
+    }
+    if (dx.size() == 0 && watch) {
+      go_back(it);
+      continue;
+    }
     if (dx.size() == 0) {
       result.status = StaticsStatus::Singular;
       result.reason = singular_reason(ws);
       return result;
     }
     const double residual_before = at.residual;
-    if (!line_search(terms, dx, x, at, log)) {
+    const bool relax = may_relax;
+    may_relax = false;
+    if (relax) watch = Reference{x, at, at.gradient.dot(dx), it};
+    if (!line_search(terms, dx, x, at, log, relax)) {
+      if (watch) {
+        go_back(it);
+        continue;
+      }
       result.status = StaticsStatus::NotConverged;
       result.reason = "line search failed at residual " + sci(residual_before) + " N after " +
                       std::to_string(it) + " iterations";
       return result;
     }
+    log.relaxed = relax;
     result.log.push_back(log);
   }
 }

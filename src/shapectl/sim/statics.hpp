@@ -13,6 +13,16 @@
 // accepted when the energy does not rise beyond round-off and the force norm falls (Armijo on
 // |∇E|², which Newton's step with the true Hessian descends: d/dα |∇E|² = −2|∇E|²).
 // "Not converged" thus means a force above that tolerance, never a tolerance out of reach.
+// Watchdog (Chamberlain et al. 1982): a cold solve's first Newton step (no nearby factor) is
+// taken in full wherever no element inverts, even where it raises the energy. From rest, that
+// step is the linear solution: on soft, large-deflection objects (a plate or cantilever sagging
+// under gravity) it stretches them, and the energy test cut it to a small fraction, after which
+// Newton crept along the bending arc (the 21,600-tet plate: 24 iterations). Newton from the
+// full step's state rotates into place in a few (7). The solve goes back to the state before
+// that step, and on with the energy test only, unless within watchdog_iterations iterations
+// the energy falls below that state's Armijo level; an equilibrium found above it, and any
+// failure or end of the solve during the watch, also go back. The convergence test is the
+// same; on every case measured (docs/benchmarks.md) so is the equilibrium, to < 1e-6 m.
 #include <algorithm>
 #include <functional>
 #include <limits>
@@ -54,6 +64,9 @@ struct StaticsOptions {
   // Chord and Krylov steps turn the nearby factorization with the object's best-fit rotation
   // since it was made (see rigid_motion.hpp); off only to measure what that saves.
   bool rotate_chord = true;
+  // The watchdog (see the top of this file): iterations a cold solve's first, relaxed Newton
+  // step gets to bring the energy below where it started; 0: off.
+  int watchdog_iterations = 6;
 };
 
 struct NewtonIterate {
@@ -65,6 +78,8 @@ struct NewtonIterate {
   bool projected = false;  // the PSD-projected Hessian was used
   bool chord = false;      // an earlier factorization was reused (no new one)
   int krylov = 0;          // conjugate-gradient products of a Krylov step (0: none)
+  bool relaxed = false;    // the watchdog's step, accepted without lowering the energy
+  bool went_back = false;  // the watchdog gave up: back at the state before its step (no step)
 };
 
 struct StaticsResult {
@@ -180,8 +195,12 @@ class StaticsSolver {
                                    int& factorizations, const StopRequest& stop) const;
   // `result` ended by a stop request at iteration `it`.
   StaticsResult stopped(StaticsResult& result, const Point& at, int it) const;
+  // The first of α = 1, 1/2, 1/4, ... whose state lowers the energy enough; relaxed: whose
+  // state is finite (no element inverted; the watchdog's step).
   bool line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x, Point& at,
-                   NewtonIterate& log) const;
+                   NewtonIterate& log, bool relaxed) const;
+  // `to` passes the line search's test as the full step from `from` (slope = ∇E·dx there).
+  bool lowers_enough(const Point& from, double slope, const Point& to) const;
   double largest_node_step(const Eigen::VectorXd& dx) const;
   // Energy differences below this are round-off (see the top of this file).
   double energy_noise(double energy) const;
