@@ -1,6 +1,5 @@
 #include <shapectl/robot/visual_meshes.hpp>
 
-
 #include <shapectl/io/ascii_case.hpp>
 #include <shapectl/io/input_file.hpp>  // bounded_preview
 #include <shapectl/robot/mesh_resource.hpp>
