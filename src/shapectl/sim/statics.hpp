@@ -54,6 +54,11 @@ struct StaticsOptions {
   // Chord and Krylov steps turn the nearby factorization with the object's best-fit rotation
   // since it was made (see rigid_motion.hpp); off only to measure what that saves.
   bool rotate_chord = true;
+  // Chord and Krylov steps solve with the nearby factorization rounded to single precision
+  // (SparseCholesky::solve_preconditioner): half the memory traffic of the solve that
+  // dominates them. Their steps are checked by the true residual, so the equilibrium and the
+  // sensitivities (which solve in double) are unchanged; off only to measure what it saves.
+  bool single_precision_chord = true;
 };
 
 struct NewtonIterate {
