@@ -39,6 +39,7 @@ struct BenchArgs {
   unsigned seed = 1;
   std::string sizes;  // --sizes / --scaling: the scaling table instead of the paper's
   bool no_krylov = false;
+  bool double_chord = false;
 };
 
 // Timings of one reduced-gradient variant, seconds.
@@ -263,6 +264,9 @@ void add_bench_command(CLI::App& app) {
                   "counts (e.g. 1.5k,6k,12k,25k,50k)");
   cmd->add_flag("--no-krylov", args->no_krylov,
                 "with --sizes: statics without conjugate-gradient steps (to measure them)");
+  cmd->add_flag("--double-chord", args->double_chord,
+                "with --sizes: chord and Krylov steps solve in double precision, not single (to "
+                "measure what single saves)");
   cmd->add_flag_callback(
       "--scaling", [args] { args->sizes = kDefaultSizes; },
       std::string("the scaling table at ") + kDefaultSizes + " tets (--sizes " + kDefaultSizes +
@@ -271,7 +275,9 @@ void add_bench_command(CLI::App& app) {
     if (!args->sizes.empty()) {
       const auto counts = parse_tet_counts(args->sizes, "--sizes");
       bench_scaling(scenes->count() ? args->scenes.front() : "scenes/yumi_bar.json", counts,
-                    args->trials, args->seed, !args->no_krylov);
+                    args->trials, args->seed,
+                    {.krylov_steps = !args->no_krylov,
+                     .single_precision_chord = !args->double_chord});
       return;
     }
     for (const auto& s : args->scenes) bench_scene(s, *args);

@@ -196,9 +196,10 @@ std::vector<int> parse_tet_counts(const std::string& text, const std::string& op
 }
 
 void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_counts, int trials,
-                   unsigned seed, bool krylov_steps) {
+                   unsigned seed, ScalingLevers levers) {
   Scene scene = load_scene(scene_file);
-  scene.statics.krylov_steps = krylov_steps;
+  scene.statics.krylov_steps = levers.krylov_steps;
+  scene.statics.single_precision_chord = levers.single_precision_chord;
   if (!scene.robot) throw InputError(scene_file, "robot", "a scene with a robot (missing key)");
   const auto cells = box_cells(*scene.object_mesh);
   if (!cells || (scene.fixed && !scene.fixed->nodes.empty()))
@@ -206,8 +207,9 @@ void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_co
                      "a box mesh without hole and no fixed nodes by index (for --sizes)");
   std::printf(
       "\n%s refined (--sizes): %d random reachable target sets per size, Gauss-Newton to a mean "
-      "error < 1 mm; Krylov steps %s\n",
-      scene_file.c_str(), trials, krylov_steps ? "on from 5,000 unknowns" : "off");
+      "error < 1 mm; Krylov steps %s; chord and Krylov solves in %s precision\n",
+      scene_file.c_str(), trials, levers.krylov_steps ? "on from 5,000 unknowns" : "off",
+      levers.single_precision_chord ? "single" : "double");
   std::printf("  %7s | %-22s | %-22s | %-27s | %-13s | %-9s | %s\n", "tets", "statics from rest ms",
               "warm 1 mm grip move ms", "target change ms: med (p90)", "Newton it/fac", "GN steps",
               "peak MB");

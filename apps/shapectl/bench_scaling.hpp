@@ -10,10 +10,15 @@ namespace shapectl::cli {
 // "1.5k,6k,12k" → {1500, 6000, 12000}. Throws InputError naming `option` for anything else.
 std::vector<int> parse_tet_counts(const std::string& text, const std::string& option);
 
+// Solver levers a run can turn off, to measure what each saves.
+struct ScalingLevers {
+  bool krylov_steps = true;            // conjugate-gradient steps (`--no-krylov`)
+  bool single_precision_chord = true;  // chord/Krylov solves in float (`--double-chord`)
+};
+
 // Runs and prints the table for the scene file (its object must be a box mesh without hole);
-// `trials` random reachable target sets per size; krylov_steps off measures statics without
-// the conjugate-gradient steps.
+// `trials` random reachable target sets per size.
 void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_counts, int trials,
-                   unsigned seed, bool krylov_steps);
+                   unsigned seed, ScalingLevers levers);
 
 }  // namespace shapectl::cli

@@ -98,6 +98,37 @@ TEST(BandCholesky, SolvesLikeADenseCholeskyForEveryBandwidthAndColumnCount) {
   }
 }
 
+// The single-precision solve (chord and Krylov steps' preconditioner) is the same solve with
+// float's ε: within the bound above with ε_float, doubled for rounding the factor itself to
+// float. And it is single precision: off by more than double's bound somewhere.
+TEST(BandCholesky, SinglePrecisionSolveIsWithinSinglePrecisionsBound) {
+  std::mt19937 rng(21);
+  int checked = 0;
+  bool beyond_double = false;
+  for (const Case& c : kCases) {
+    const SparseMatrix lower = random_band_spd(c.size, c.bandwidth, c.margin, c.stiff, rng);
+    const Eigen::MatrixXd full = SparseMatrix(lower.selfadjointView<Eigen::Lower>());
+    BandCholesky band;
+    band.analyze(lower);
+    ASSERT_TRUE(band.factorize(lower));
+    const double kappa = condition_number(full);
+    const double dot_length = 3 * (band.bandwidth() + 1) + 1;
+    const double tolerance = 4 * dot_length * std::numeric_limits<float>::epsilon() * kappa;
+    if (tolerance > 0.1) continue;  // an ill-conditioned case says nothing at this precision
+    const Eigen::VectorXd rhs = 1e-3 * Eigen::VectorXd::Random(c.size);  // scaled inside
+    const Eigen::VectorXd reference = full.llt().solve(rhs);
+    const Eigen::VectorXd x = band.solve_single_precision(rhs);
+    const double error = (x - reference).norm() / reference.norm();
+    EXPECT_LE(error, tolerance) << "n " << c.size << ", bandwidth " << c.bandwidth;
+    beyond_double |= error > 2 * dot_length * std::numeric_limits<double>::epsilon() * kappa;
+    ++checked;
+    EXPECT_EQ(band.solve_single_precision(Eigen::VectorXd::Zero(c.size)),
+              Eigen::VectorXd::Zero(c.size));
+  }
+  EXPECT_GE(checked, 8);
+  EXPECT_TRUE(beyond_double);
+}
+
 // The cases cover what they claim: RCM keeps a full band's width (it cannot narrow it).
 TEST(BandCholesky, TheTestBandsKeepTheirWidth) {
   std::mt19937 rng(14);

@@ -219,6 +219,29 @@ describe('side panel and view tools', () => {
     await waitFor(async () => !(await page.locator('#hover-readout').isVisible()), 'the read-out to go');
   });
 
+  it('keeps the read-out current when a target moves under a still pointer', async () => {
+    await page.click('#pause');  // the node stays where the pointer is
+    const paused = await waitFor(async () => { const p = await state(page); return p.paused && p; }, 'paused');
+    const { node } = paused.targets[0];
+    const at = await hooks(page, (n) => window.shapectl.nodeToPage(n), node);
+    await page.mouse.move(at.x, at.y);
+    const before = await waitFor(async () => { const h = await tools(page, 'hovered'); return h?.node === node && h; }, 'the node under the pointer');
+    // Another page moves the target 1 cm down; the pointer does not move.
+    const moved = before.target.map((v, i) => (i === 2 ? v - 0.01 : v));
+    const ws = await RawWebSocket.connect(server.port);
+    ws.sendJson({ type: 'set_targets', id: 7, targets: [{ node, position: moved }] });
+    await ws.next((m) => m.text && JSON.parse(m.text).id === 7);
+    ws.close();
+    const after = await waitFor(async () => {
+      const h = await tools(page, 'hovered');
+      return h?.node === node && Math.hypot(...h.target.map((v, i) => v - moved[i])) < 1e-12 && h;
+    }, 'the read-out to show the moved target');
+    assert.ok(Math.abs(after.error - Math.hypot(...moved.map((v, i) => v - after.position[i]))) < 1e-9);
+    assert.match(await page.locator('#hover-readout').textContent(), new RegExp(`target \\(.*\\) mm · error ${(1000 * after.error).toFixed(1)} mm`));
+    await page.click('#pause');
+    await waitFor(async () => !(await state(page)).paused, 'resumed');
+  });
+
   it('turns the camera to the presets 1, 3, 7, 0 and sizes the scale bar to the view', async () => {
     await page.mouse.click(5, 5);  // keys to the page, not the last checkbox (off the object: no target)
     const expected = { 1: [-1, 0, 0], 3: [0, 1, 0], 7: [0, 0, -1], 0: [-1, 1, -1].map((v) => v / Math.sqrt(3)) };

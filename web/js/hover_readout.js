@@ -1,6 +1,8 @@
 // What is under the pointer in the 3D view, in an overlay: the surface node (id and position,
 // mm) and, when the node has a target, the target's position and the node's distance from it
 // (its error). One raycast per animation frame at most; none while a mouse button is down.
+// The object and the targets change under a still pointer (the optimizer moves the object, a
+// drag or another page moves a target): refresh() reads the read-out anew.
 import { Raycaster, Vector2, Vector3 } from 'three';
 
 const mm = (v) => (Math.abs(v) < 5e-5 ? 0 : 1000 * v).toFixed(1);  // no "-0.0"
@@ -19,15 +21,29 @@ export class HoverReadout {
     this.pending = false;
     this.hovered = null;  // {node, position: [x, y, z], target: [x, y, z] | null, error: m | null}
     const canvas = view.renderer.domElement;
+    this.buttons = 0;
     canvas.addEventListener('pointermove', (e) => {
+      this.buttons = e.buttons;
       if (e.buttons !== 0) return;
       const rect = canvas.getBoundingClientRect();
       this.pointer.set((e.clientX - rect.left) / rect.width * 2 - 1, -(e.clientY - rect.top) / rect.height * 2 + 1);
-      if (this.pending) return;
-      this.pending = true;
-      requestAnimationFrame(() => { this.pending = false; this.update(); });
+      this.schedule();
     });
+    canvas.addEventListener('pointerdown', (e) => { this.buttons = e.buttons; });
+    // A drag ends with the pointer still: its new target shows without a move.
+    window.addEventListener('pointerup', (e) => { this.buttons = e.buttons; this.refresh(); });
     canvas.addEventListener('pointerleave', () => this.show(null));
+  }
+
+  // Reads what is under the pointer again, if something was (the pointer is on the object).
+  refresh() {
+    if (this.hovered) this.schedule();
+  }
+
+  schedule() {
+    if (this.pending || this.buttons !== 0) return;
+    this.pending = true;
+    requestAnimationFrame(() => { this.pending = false; if (this.buttons === 0) this.update(); });
   }
 
   update() {

@@ -53,6 +53,7 @@ export class ViewTools {
     this.notices.setState(state);
     this.state = state;
     this.frames.setLinkPoses(state.links);
+    this.hover.refresh();  // the object or a target may have moved under the pointer
     const selected = this.view.selected;
     const exists = selected !== null && (state.targets.some((t) => t.node === selected) || this.view.objectView.localTargets.has(selected));
     this.elements.deleteButton.disabled = !exists;

@@ -1,19 +1,18 @@
 #include <shapectl/calib/point_cloud_file.hpp>
 
-#include <cctype>
 #include <string>
 
 #include <shapectl/calib/npy_points.hpp>
 #include <shapectl/calib/ply_points.hpp>
 #include <shapectl/calib/xyz_points.hpp>
+#include <shapectl/io/ascii_case.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/input_file.hpp>
 
 namespace shapectl {
 
 std::vector<Vec3> read_point_cloud(const std::filesystem::path& file) {
-  std::string extension = file.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string extension = lowercase_extension(file);
   const std::string name = file.string();
   if (extension != ".xyz" && extension != ".ply" && extension != ".npy")
     throw InputError(name, "",

@@ -1,11 +1,11 @@
 #include <shapectl/io/surface_writer.hpp>
 
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+
+#include <shapectl/io/ascii_case.hpp>
 
 namespace shapectl {
 
@@ -48,9 +48,7 @@ void write_obj(std::ostream& out, const Positions& x,
 }  // namespace
 
 std::optional<SurfaceFormat> surface_format(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowercase_extension(file);
   if (ext == ".ply") return SurfaceFormat::Ply;
   if (ext == ".obj") return SurfaceFormat::Obj;
   return std::nullopt;

@@ -1,8 +1,8 @@
 #include <shapectl/mesh/load_mesh.hpp>
 
-#include <cctype>
 #include <string>
 
+#include <shapectl/io/ascii_case.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/mesh/msh_reader.hpp>
 #include <shapectl/mesh/tetgen_reader.hpp>
@@ -10,8 +10,7 @@
 namespace shapectl {
 
 TetMesh load_mesh(const std::filesystem::path& file, const SurfaceMeshOptions& surface_options) {
-  std::string extension = file.extension().string();
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string extension = lowercase_extension(file);
   if (extension == ".msh") return read_msh(file);
   if (extension == ".node" || extension == ".ele") return read_tetgen(file);
   if (is_surface_file(file)) return mesh_surface(file, surface_options);

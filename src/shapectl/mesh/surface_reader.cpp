@@ -1,8 +1,8 @@
 #include <shapectl/mesh/surface_reader.hpp>
 
-#include <cctype>
 #include <string>
 
+#include <shapectl/io/ascii_case.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/mesh/obj_reader.hpp>
 #include <shapectl/mesh/off_reader.hpp>
@@ -11,22 +11,13 @@
 
 namespace shapectl {
 
-namespace {
-
-std::string lowercase(std::string s) {
-  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return s;
-}
-
-}  // namespace
-
 bool is_surface_file(const std::filesystem::path& file) {
-  const std::string extension = lowercase(file.extension().string());
+  const std::string extension = lowercase_extension(file);
   return extension == ".obj" || extension == ".stl" || extension == ".off";
 }
 
 TriangleSurface read_surface(const std::filesystem::path& file) {
-  const std::string extension = lowercase(file.extension().string());
+  const std::string extension = lowercase_extension(file);
   const std::string name = file.string();
   if (!is_surface_file(file))
     throw InputError(name, "",

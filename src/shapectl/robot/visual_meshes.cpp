@@ -1,8 +1,6 @@
 #include <shapectl/robot/visual_meshes.hpp>
 
-#include <algorithm>
-#include <cctype>
-
+#include <shapectl/io/ascii_case.hpp>
 #include <shapectl/io/input_file.hpp>  // bounded_preview
 #include <shapectl/robot/mesh_resource.hpp>
 
@@ -18,9 +16,7 @@ const char* to_string(MeshFormat format) {
 }
 
 std::optional<MeshFormat> mesh_format_of(const std::filesystem::path& file) {
-  std::string ext = file.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowercase_extension(file);
   if (ext == ".stl") return MeshFormat::Stl;
   if (ext == ".obj") return MeshFormat::Obj;
   if (ext == ".dae") return MeshFormat::Dae;

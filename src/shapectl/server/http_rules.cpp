@@ -3,18 +3,12 @@
 #include <arpa/inet.h>
 
 #include <algorithm>
-#include <cctype>
+
+#include <shapectl/io/ascii_case.hpp>
 
 namespace shapectl::server {
 
 namespace {
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return out;
-}
 
 bool all_digits(std::string_view s) {
   return !s.empty() &&
@@ -78,7 +72,7 @@ std::string host_name(std::string_view header) {
   if (!port.empty() && (!all_digits(port) || port.size() > 5 || std::stoi(std::string(port)) < 1 ||
                         std::stoi(std::string(port)) > 65535))
     return "";
-  const std::string h = lower(host);
+  const std::string h = ascii_lowercase(host);
   if (h.starts_with('[') || is_ipv4_literal(h) || is_hostname(h)) return h;
   return "";
 }
@@ -128,7 +122,7 @@ std::optional<RobotMeshRequest> parse_robot_mesh_target(std::string_view target)
 }
 
 std::string content_type(const std::filesystem::path& file) {
-  const std::string ext = lower(file.extension().string());
+  const std::string ext = lowercase_extension(file);
   if (ext == ".html") return "text/html; charset=utf-8";
   if (ext == ".js" || ext == ".mjs") return "text/javascript; charset=utf-8";
   if (ext == ".css") return "text/css; charset=utf-8";
@@ -147,12 +141,12 @@ bool host_allowed(std::string_view host_header, std::string_view bind_host) {
   const std::string h = host_name(host_header);
   if (h.empty()) return false;
   if (h == "localhost" || h.starts_with('[') || is_ipv4_literal(h)) return true;
-  return h == lower(bind_host);
+  return h == ascii_lowercase(bind_host);
 }
 
 bool origin_allowed(std::string_view origin_header, std::string_view host_header) {
   if (origin_header.empty()) return true;
-  return lower(origin_header) == "http://" + lower(host_header);
+  return ascii_lowercase(origin_header) == "http://" + ascii_lowercase(host_header);
 }
 
 }  // namespace shapectl::server

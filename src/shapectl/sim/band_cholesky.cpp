@@ -9,6 +9,8 @@ extern "C" {  // LAPACK and BLAS (OpenBLAS)
 void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);
 void dpbtrs_(const char* uplo, const int* n, const int* kd, const int* nrhs, const double* ab,
              const int* ldab, double* b, const int* ldb, int* info);
+void stbsv_(const char* uplo, const char* trans, const char* diag, const int* n, const int* k,
+            const float* a, const int* lda, float* x, const int* incx);
 void dtrsm_(const char* side, const char* uplo, const char* trans, const char* diag, const int* m,
             const int* n, const double* alpha, const double* a, const int* lda, double* b,
             const int* ldb);
@@ -226,6 +228,7 @@ constexpr int kOwnFactorBlock = 32;  // columns per block column
 }  // namespace
 
 bool BandCholesky::factorize(const SparseMatrix& lower) {
+  band_single_current_ = false;
   band_.assign(static_cast<std::size_t>(bandwidth_ + 1) * size_, 0.0);
   const double* values = lower.valuePtr();
   for (std::size_t k = 0; k < slot_.size(); ++k) band_[slot_[k]] += values[k];
@@ -250,6 +253,32 @@ bool BandCholesky::factorize(const SparseMatrix& lower) {
     largest = std::max(largest, pivot);
   }
   return smallest > 1e-13 * largest;
+}
+
+Eigen::VectorXd BandCholesky::solve_single_precision(const Eigen::VectorXd& rhs) const {
+  // Subnormal floats are slow on most CPUs: entries of L a factor 1e-15 below its largest
+  // (fill far from the diagonal decays) are dropped, and the right-hand side is scaled to 1.
+  // Both change the result by far less than single precision's rounding.
+  if (!band_single_current_) {
+    double largest = 0;
+    for (const double v : band_) largest = std::max(largest, std::abs(v));
+    const double negligible = 1e-15 * largest;
+    band_single_.resize(band_.size());
+    for (std::size_t k = 0; k < band_.size(); ++k)
+      band_single_[k] = std::abs(band_[k]) < negligible ? 0.0f : static_cast<float>(band_[k]);
+    band_single_current_ = true;
+  }
+  const double scale = rhs.size() > 0 ? rhs.cwiseAbs().maxCoeff() : 0.0;
+  if (scale == 0) return Eigen::VectorXd::Zero(size_);
+  if (!std::isfinite(scale)) return solve(rhs).col(0);  // non-finite in, non-finite out
+  std::vector<float> x(size_);
+  for (int i = 0; i < size_; ++i) x[new_index_[i]] = static_cast<float>(rhs[i] / scale);
+  const int rows = bandwidth_ + 1, step = 1;
+  stbsv_("L", "N", "N", &size_, &bandwidth_, band_single_.data(), &rows, x.data(), &step);
+  stbsv_("L", "T", "N", &size_, &bandwidth_, band_single_.data(), &rows, x.data(), &step);
+  Eigen::VectorXd result(size_);
+  for (int i = 0; i < size_; ++i) result[i] = scale * x[new_index_[i]];
+  return result;
 }
 
 Eigen::MatrixXd BandCholesky::solve(const Eigen::MatrixXd& rhs) const {

@@ -31,13 +31,20 @@ class BandCholesky {
   // Solves with the factor. Many right-hand sides go through a blocked level-3 substitution
   // that reads the band once per sweep for all of them; one or two go through LAPACK's dpbtrs.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
+  // Solves with the factor rounded to single precision (LAPACK's stbsv): half the memory a
+  // one-column solve streams, and a solve is memory-bound. For preconditioning and chord steps
+  // only, whose results the true residual checks. The rounded copy is made by the first call
+  // after each factorization; like solve(), calls take turns (the caller's lock).
+  Eigen::VectorXd solve_single_precision(const Eigen::VectorXd& rhs) const;
 
  private:
   int size_ = 0;
   int bandwidth_ = 0;
-  std::vector<int> new_index_;  // new_index_[old] = position in the band
-  std::vector<int> slot_;       // band storage index of each stored entry of `lower`
-  std::vector<double> band_;    // LAPACK lower band storage, (bandwidth_ + 1) × size_
+  std::vector<int> new_index_;              // new_index_[old] = position in the band
+  std::vector<int> slot_;                   // band storage index of each stored entry of `lower`
+  std::vector<double> band_;                // LAPACK lower band storage, (bandwidth_ + 1) × size_
+  mutable std::vector<float> band_single_;  // band_ rounded, when band_single_current_
+  mutable bool band_single_current_ = false;
 };
 
 }  // namespace shapectl

@@ -100,7 +100,8 @@ StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double
           .krylov_steps = scene.statics.krylov_steps &&
                           (!scene.statics.chord_steps || 3 * placed.node_count() >= kKrylovFrom),
           .chord_steps = scene.statics.chord_steps,
-          .rotate_chord = scene.statics.rotate_chord};
+          .rotate_chord = scene.statics.rotate_chord,
+          .single_precision_chord = scene.statics.single_precision_chord};
 }
 }  // namespace
 

@@ -42,6 +42,7 @@ struct StaticsSettings {
   bool krylov_steps = true;
   bool chord_steps = true;   // off: Krylov steps only (tests force that path with it)
   bool rotate_chord = true;  // StaticsOptions::rotate_chord; off only to measure what it saves
+  bool single_precision_chord = true;  // StaticsOptions::single_precision_chord; likewise
 };
 
 struct EndEffector {

@@ -121,6 +121,11 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
   return impl_->ldlt.solve(rhs);
 }
 
+Eigen::VectorXd SparseCholesky::solve_preconditioner(const Eigen::VectorXd& rhs) const {
+  if (backend_ == Backend::Band) return impl_->band.solve_single_precision(rhs);
+  return solve(rhs);
+}
+
 Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& rhs) const {
   switch (backend_) {
     case Backend::Band: return impl_->band.solve(rhs).col(0);

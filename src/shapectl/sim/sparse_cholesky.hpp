@@ -31,6 +31,9 @@ class SparseCholesky {
   // Solves with the last successful factorization.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
   Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const;
+  // A solve good enough to precondition with: the band's factor in single precision
+  // (BandCholesky::solve_single_precision); the other back-ends solve exactly.
+  Eigen::VectorXd solve_preconditioner(const Eigen::VectorXd& rhs) const;
 
  private:
   struct Impl;

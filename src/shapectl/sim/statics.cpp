@@ -158,7 +158,9 @@ Eigen::VectorXd StaticsSolver::solve_rotated(const StaticsWorkspace& chord, cons
   // nodes have zero residual rows and stay zero (R turns a node's three dofs together).
   const Eigen::VectorXd turned = rotate_nodes(R, r, /*transpose=*/true);
   std::lock_guard lock(*chord.solve_mutex);
-  return rotate_nodes(R, chord.cholesky.solve(turned));
+  return rotate_nodes(R, options_.single_precision_chord
+                             ? chord.cholesky.solve_preconditioner(turned)
+                             : chord.cholesky.solve(turned));
 }
 
 bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord,

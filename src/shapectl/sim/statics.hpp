@@ -67,6 +67,11 @@ struct StaticsOptions {
   // The watchdog (see the top of this file): iterations a cold solve's first, relaxed Newton
   // step gets to bring the energy below where it started; 0: off.
   int watchdog_iterations = 6;
+  // Chord and Krylov steps solve with the nearby factorization rounded to single precision
+  // (SparseCholesky::solve_preconditioner): half the memory traffic of the solve that
+  // dominates them. Their steps are checked by the true residual, so the equilibrium and the
+  // sensitivities (which solve in double) are unchanged; off only to measure what it saves.
+  bool single_precision_chord = true;
 };
 
 struct NewtonIterate {
