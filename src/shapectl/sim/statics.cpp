@@ -60,6 +60,16 @@ Eigen::VectorXd StaticsSolver::gradient(const EnergyTerms& terms, const Position
   return g;
 }
 
+double StaticsSolver::energy_and_gradient(const EnergyTerms& terms, const Positions& x,
+                                          Eigen::VectorXd& g) const {
+  g = Eigen::VectorXd::Zero(x.size());
+  double e = 0;
+  for (const auto* t : terms) e += t->value_and_add_gradient(x, g);
+  for (int d = 0; d < g.size(); ++d)
+    if (fixed_dof_[d]) g[d] = 0;
+  return std::isnan(e) ? std::numeric_limits<double>::infinity() : e;
+}
+
 double StaticsSolver::max_force(const Eigen::VectorXd& g) const {
   double m = 0;
   for (int i = 0; i < node_count_; ++i) m = std::max(m, g.segment<3>(3 * i).norm());
@@ -170,9 +180,9 @@ bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace&
   const Eigen::VectorXd dx = -solve_rotated(chord, chord_rotation(chord, x), at.gradient);
   if (!(at.gradient.dot(dx) < 0)) return false;
   Positions trial = x + dx;
-  const double e_trial = energy(terms, trial);
+  Eigen::VectorXd g_trial;  // in one pass with the energy: a chord step is mostly kept
+  const double e_trial = energy_and_gradient(terms, trial, g_trial);
   if (!std::isfinite(e_trial) || e_trial > at.energy + energy_noise(at.energy)) return false;
-  Eigen::VectorXd g_trial = gradient(terms, trial);
   const double r_trial = max_force(g_trial);
   if (!(r_trial <= 0.25 * at.residual)) return false;
   log.chord = true;
@@ -284,13 +294,12 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
   if (max_iterations <= 0) max_iterations = options_.max_iterations;
   StaticsResult result;
   Point at;
-  at.energy = energy(terms, x);
+  at.energy = energy_and_gradient(terms, x, at.gradient);
   if (!std::isfinite(at.energy)) {
     result.status = StaticsStatus::Inverted;
     result.reason = "the starting state has an inverted element or a non-finite energy";
     return result;
   }
-  at.gradient = gradient(terms, x);
   at.residual = max_force(at.gradient);
   const double tolerance = effective_tolerance();
   if (!(tolerance < std::numeric_limits<double>::infinity())) {

@@ -155,6 +155,9 @@ class StaticsSolver {
   // Total energy and its gradient (fixed dofs zeroed) at x.
   double energy(const EnergyTerms& terms, const Positions& x) const;
   Eigen::VectorXd gradient(const EnergyTerms& terms, const Positions& x) const;
+  // Both in one pass over the elements (EnergyTerm::value_and_add_gradient; the same bits).
+  double energy_and_gradient(const EnergyTerms& terms, const Positions& x,
+                             Eigen::VectorXd& gradient) const;
   // Factors the true Hessian at x into `ws`; false if it is not positive definite (then `ws`
   // holds no factorization).
   bool factor(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x) const;
