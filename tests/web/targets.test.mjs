@@ -296,32 +296,4 @@ describe('targets in the browser GUI', () => {
     await waitFor(() => page.locator('#toast').textContent().then((t) => t.includes('notes.json') && t), 'the file error as a toast');
     await page.click('#pause');
   });
-
-  // Last: the target set from another client brings a notice over the view for a few seconds.
-  it('frames the targets with the object on the f key', async () => {
-    const centroid = await hooks(page, () => window.shapectl.objectCentroid());
-    const far = [centroid[0], centroid[1], centroid[2] + 1.0];  // a metre above the object
-    const ws = await RawWebSocket.connect(server.port);
-    ws.sendJson({ type: 'set_targets', id: 3, targets: [{ node: 0, position: far }] });
-    await ws.next((m) => m.text && JSON.parse(m.text).id === 3);
-    await waitFor(async () => (await state(page)).targets.length === 1, 'the far target');
-    const inView = async () => {
-      const { view } = await hooks(page, () => window.shapectl.objectOnPage());
-      const p = await hooks(page, (q) => window.shapectl.worldToPage(q), far);
-      return p.x >= view.left && p.x <= view.right && p.y >= view.top && p.y <= view.bottom;
-    };
-    try {
-      await page.mouse.click(5, 5);  // keys to the page, not a field
-      await page.keyboard.press('f');
-      await waitFor(() => hooks(page, () => window.shapectl.ready), 'the page to draw');
-      assert.equal(await inView(), true, 'f frames the target');
-      assert.equal((await objectInView(page)).outside, 0, 'and the whole object');
-    } finally {  // the tests after this one start without targets
-      ws.sendJson({ type: 'clear_targets', id: 4 });
-      await ws.next((m) => m.text && JSON.parse(m.text).id === 4);
-      ws.close();
-      await waitFor(async () => (await state(page)).targets.length === 0, 'the target cleared');
-      await page.keyboard.press('f');
-    }
-  });
 });

@@ -213,19 +213,15 @@ export class View3D {
     this.gizmo.attach(at ? node : null, at);
   }
 
-  // Frames the robot, the object and its targets (and centre-line) from the front (+x, where
-  // the robot faces), a little from the side and above, all in view (on load, on a scene
-  // switch, and the f key): a target far from the object is still one to see and drag.
+  // Frames the robot and the object from the front (+x, where the robot faces), a little from
+  // the side and above, all of both in view (on load, on a scene switch, and the f key).
   fitView() {
     if (!this.objectView.positions) return;
     const robot = this.robotView.group, object = this.objectView.positionAttribute, point = new THREE.Vector3();
     robot.updateMatrixWorld(true);  // link poses set since the last render
-    const goals = this.goalPoints();
-    const bounds = new THREE.Box3().setFromBufferAttribute(object).union(new THREE.Box3().setFromObject(robot));
-    for (const g of goals) bounds.expandByPoint(g);
-    fitCamera(this.camera, this.orbit, bounds.getCenter(new THREE.Vector3()), FRONT_VIEW, (visit) => {
+    const box = new THREE.Box3().setFromBufferAttribute(object).union(new THREE.Box3().setFromObject(robot));
+    fitCamera(this.camera, this.orbit, box.getCenter(new THREE.Vector3()), FRONT_VIEW, (visit) => {
       for (let i = 0; i < object.count; i++) visit(point.fromBufferAttribute(object, i));
-      for (const g of goals) visit(g);
       // Primitive visuals, and loaded mesh visuals inside their holders.
       for (const visual of this.robotView.visualMeshes) visual.traverse((mesh) => {
         const vertices = mesh.isMesh ? mesh.geometry.getAttribute('position') : null;
@@ -235,16 +231,6 @@ export class View3D {
     this.requestRender();
   }
 
-
-  // Where the user wants the object: the targets (the server's, and any being dragged) and the
-  // centre-line's points.
-  goalPoints() {
-    const points = [];
-    for (const t of this.state?.targets ?? []) points.push(new THREE.Vector3().fromArray(t.position));
-    for (const p of this.objectView.localTargets.values()) points.push(p.clone());
-    for (const p of this.state?.centerline ?? []) points.push(new THREE.Vector3().fromArray(p));
-    return points;
-  }
 
   // Looks at a bar square on from the robot's front, so the sketch plane contains its axis.
   faceBar(direction) {
