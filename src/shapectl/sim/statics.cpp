@@ -252,19 +252,18 @@ bool StaticsSolver::line_search(const EnergyTerms& terms, const Eigen::VectorXd&
   // watchdog's step): the first finite state is taken.
   const double slope = at.gradient.dot(dx);
   const double noise = energy_noise(at.energy);
-  const double force_norm2 = at.gradient.squaredNorm();
   double alpha = 1.0;
   for (int k = 0; k < 40; ++k, alpha *= 0.5) {
     Positions trial = x + alpha * dx;
     const double e_trial = energy(terms, trial);
     if (!std::isfinite(e_trial)) continue;
-    const bool armijo = relaxed || e_trial <= at.energy + 1e-4 * alpha * slope;
-    if (!armijo && e_trial > at.energy + noise) continue;
+    // Clearly higher: rejected before its gradient is computed.
+    if (!relaxed && e_trial > at.energy + noise && e_trial > at.energy + 1e-4 * alpha * slope)
+      continue;
     Eigen::VectorXd g_trial = gradient(terms, trial);
     const double r_trial = max_force(g_trial);
     if (!std::isfinite(r_trial)) continue;
-    // Energy within round-off of the start: the force norm decides.
-    if (!armijo && !(g_trial.squaredNorm() <= (1 - 1e-4 * alpha) * force_norm2)) continue;
+    if (!relaxed && !decreases(at, alpha * slope, alpha, e_trial, g_trial)) continue;
     log.step_length = alpha;
     log.step = largest_node_step(alpha * dx);
     x = std::move(trial);
@@ -274,11 +273,12 @@ bool StaticsSolver::line_search(const EnergyTerms& terms, const Eigen::VectorXd&
   return false;
 }
 
-bool StaticsSolver::lowers_enough(const Point& from, double slope, const Point& to) const {
-  // The line search's test at α = 1, with the gradient at hand.
-  if (to.energy <= from.energy + 1e-4 * slope) return true;
-  return to.energy <= from.energy + energy_noise(from.energy) &&
-         to.gradient.squaredNorm() <= (1 - 1e-4) * from.gradient.squaredNorm();
+bool StaticsSolver::decreases(const Point& from, double slope, double alpha, double energy,
+                              const Eigen::VectorXd& gradient) const {
+  if (energy <= from.energy + 1e-4 * slope) return true;  // Armijo
+  // Energy within round-off of the start: the force norm decides.
+  return energy <= from.energy + energy_noise(from.energy) &&
+         gradient.squaredNorm() <= (1 - 1e-4 * alpha) * from.gradient.squaredNorm();
 }
 
 StaticsResult StaticsSolver::stopped(StaticsResult& result, const Point& at, int it) const {
@@ -342,7 +342,7 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
   };
   for (int it = 0;; ++it) {
     if (watch) {
-      if (lowers_enough(watch->at, watch->slope, at)) watch.reset();
+      if (decreases(watch->at, watch->slope, 1, at.energy, at.gradient)) watch.reset();
       else if (it - watch->iteration >= options_.watchdog_iterations || at.residual <= tolerance ||
                !std::isfinite(at.residual))
         go_back(it);  // not below the start in time, or an equilibrium above it

@@ -207,8 +207,10 @@ class StaticsSolver {
   // state is finite (no element inverted; the watchdog's step).
   bool line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x, Point& at,
                    NewtonIterate& log, bool relaxed) const;
-  // `to` passes the line search's test as the full step from `from` (slope = ∇E·dx there).
-  bool lowers_enough(const Point& from, double slope, const Point& to) const;
+  // The line search's acceptance of a step α·dx from `from` (slope = α ∇E·dx) reaching a state
+  // with this energy and gradient: Armijo, or within the energy's round-off a falling force.
+  bool decreases(const Point& from, double slope, double alpha, double energy,
+                 const Eigen::VectorXd& gradient) const;
   double largest_node_step(const Eigen::VectorXd& dx) const;
   // Energy differences below this are round-off (see the top of this file).
   double energy_noise(double energy) const;
