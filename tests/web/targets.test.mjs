@@ -264,7 +264,12 @@ describe('targets in the browser GUI', () => {
     ws.sendJson({ type: 'set_targets', id: 1, targets: asked });
     await ws.next((m) => m.text && JSON.parse(m.text).id === 1);
     ws.close();
-    const shown = await waitFor(async () => { const s = await state(page); return s.targets.length === 2 && s; }, 'the two targets');
+    // Saved once the optimizer has stopped: loading joints jogs the robot there, and a jog
+    // further than max_jog_step (0.05 rad) from where the optimizer went on to is refused.
+    const shown = await waitFor(async () => {
+      const s = await state(page);
+      return s.targets.length === 2 && s.status !== 'optimizing' && s;
+    }, 'the two targets, optimized');
 
     const save = async (button) => {
       const [download] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
@@ -299,7 +304,9 @@ describe('targets in the browser GUI', () => {
     const joints = await waitFor(async () => {
       const s = await state(page);
       return scene.robot.joint_names.every((name, k) => Math.abs(s.joints[k] - savedJoints[name]) < 1e-12) && s;
-    }, 'the loaded joints');
+    }, 'the loaded joints').catch(async (e) => {
+      throw new Error(`${e.message}; toast: ${await page.locator('#toast').textContent()}`);
+    });
     assert.ok(joints.paused, 'loading joints pauses the optimizer');
     // A file that is neither says so.
     await page.setInputFiles('#load-file', { name: 'notes.json', mimeType: 'application/json', buffer: Buffer.from('{"note": 1}') });
