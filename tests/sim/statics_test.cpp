@@ -91,15 +91,29 @@ void move_right_clamp(const ObjectStatics& statics, Positions& x, double dy) {
     if (statics.fixed_node()[i] && statics.mesh().rest_positions()[i].x() > 0) x[3 * i + 1] += dy;
 }
 
-TEST(Statics, KrylovStepsSaveFactorizationsAndReachTheSameEquilibrium) {
-  // Conjugate gradients preconditioned with the earlier factorization, chord steps off so that
-  // every step without a new factorization is a Krylov one.
-  Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
-  scene.statics.chord_steps = false;
-  const ObjectStatics statics(scene);
-  Positions x = scene.world_rest_positions();
+// The bar clamped at both ends, at its equilibrium, with chord steps off: a warm solve's steps
+// without a new factorization are then all Krylov ones (conjugate gradients preconditioned with
+// the equilibrium's factorization, which `ws` holds).
+struct KrylovBar {
+  ObjectStatics statics{krylov_scene()};
   StaticsWorkspace ws = statics.make_workspace();
-  ASSERT_TRUE(statics.solve(ws, x).converged());
+  Positions x = statics_equilibrium();
+
+  static Scene krylov_scene() {
+    Scene scene = bar_scene({16, 4, 4}, material_from_youngs(2e4, 0.3, 60), 0.001, true);
+    scene.statics.chord_steps = false;
+    return scene;
+  }
+  Positions statics_equilibrium() {
+    Positions rest = krylov_scene().world_rest_positions();
+    EXPECT_TRUE(statics.solve(ws, rest).converged());
+    return rest;
+  }
+};
+
+TEST(Statics, KrylovStepsSaveFactorizationsAndReachTheSameEquilibrium) {
+  KrylovBar bar;
+  auto& [statics, ws, x] = bar;
   move_right_clamp(statics, x, 2e-3);
   Positions newton_x = x;
   const StaticsResult rn = statics.solve(newton_x);  // from scratch: factors every step
@@ -113,6 +127,31 @@ TEST(Statics, KrylovStepsSaveFactorizationsAndReachTheSameEquilibrium) {
   // Converged on the true residual: the same equilibrium to a sub-micrometre.
   EXPECT_LE(rk.residual, statics.force_tolerance());
   EXPECT_LT((x - newton_x).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+TEST(Statics, KrylovStepsThatMeetNegativeCurvatureSkipTheTrueFactorization) {
+  // The bar clamped at both ends and pushed together by 10 %, far past its Euler load (~3 %):
+  // its Hessian is indefinite there. A Krylov step preconditioned with the rest state's factor
+  // finds a direction of negative curvature, which proves it; Newton then factors only the
+  // projected Hessian instead of first trying (and failing on) the true one.
+  KrylovBar bar;
+  auto& [statics, ws, x] = bar;
+  for (int i = 0; i < statics.mesh().node_count(); ++i) x[3 * i] = -0.16 + 0.9 * (x[3 * i] + 0.16);
+  const long long factorizations_before = statics_totals().factorizations;
+  const StaticsResult r = statics.solve(ws, x, nullptr, 0, &ws);
+  const long long factorizations = statics_totals().factorizations - factorizations_before;
+  ASSERT_TRUE(r.converged()) << r.reason;
+  int negative = 0;
+  long long expected = 0;  // one per Newton step, two where the true Hessian was tried first
+  for (const auto& it : r.log) {
+    negative += it.negative_curvature;
+    if (it.negative_curvature) EXPECT_TRUE(it.projected) << "iteration " << it.iteration;
+    if (!it.chord && it.krylov == 0 && !it.went_back)
+      expected += it.projected && !it.negative_curvature ? 2 : 1;
+  }
+  EXPECT_GT(negative, 0);
+  EXPECT_EQ(factorizations, expected);
+  EXPECT_EQ(r.factorizations, expected);
 }
 
 TEST(Statics, ChordStepsFollowARigidTurnOfTheWholeObject) {

@@ -213,7 +213,11 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
   for (int k = 1; k <= options_.krylov_iterations; ++k) {
     const Eigen::VectorXd Hp = H.selfadjointView<Eigen::Lower>() * p;
     const double curvature = p.dot(Hp);
-    if (!(curvature > 0)) return {};  // not positive definite along p: Newton factors
+    // Not positive definite along p: Newton factors. pᵀHp ≤ 0 (not NaN) proves H indefinite.
+    if (!(curvature > 0)) {
+      log.negative_curvature = curvature <= 0;
+      return {};
+    }
     const double alpha = rz / curvature;
     dx += alpha * p;
     r -= alpha * Hp;
@@ -233,11 +237,15 @@ Eigen::VectorXd StaticsSolver::newton_direction(const EnergyTerms& terms, Static
                                                 const Positions& x, const Eigen::VectorXd& g,
                                                 NewtonIterate& log, int& factorizations,
                                                 const StopRequest& stop) const {
-  // The true Hessian at x, if it gives a descent direction; else the PSD-projected one.
-  ++factorizations;
-  if (factor_at(terms, ws, x, false)) {
-    Eigen::VectorXd dx = -ws.cholesky.solve(g);
-    if (g.dot(dx) < 0) return dx;
+  // The true Hessian at x, if it gives a descent direction; else the PSD-projected one. A
+  // true Hessian known to be indefinite is not tried: its factorization would fail, after
+  // 35-60 % of the columns on the 50k bar.
+  if (!log.negative_curvature) {
+    ++factorizations;
+    if (factor_at(terms, ws, x, false)) {
+      Eigen::VectorXd dx = -ws.cholesky.solve(g);
+      if (g.dot(dx) < 0) return dx;
+    }
   }
   if (stop && stop()) return {};  // the caller reports the stop
   log.projected = true;

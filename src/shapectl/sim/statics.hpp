@@ -83,6 +83,9 @@ struct NewtonIterate {
   bool projected = false;  // the PSD-projected Hessian was used
   bool chord = false;      // an earlier factorization was reused (no new one)
   int krylov = 0;          // conjugate-gradient products of a Krylov step (0: none)
+  // A Krylov step met a direction p with pᵀHp ≤ 0: H is not positive definite, so only the
+  // projected Hessian was factored (the true one would certainly have failed).
+  bool negative_curvature = false;
   bool relaxed = false;    // the watchdog's step, accepted without lowering the energy
   bool went_back = false;  // the watchdog gave up: back at the state before its step (no step)
 };
@@ -198,6 +201,7 @@ class StaticsSolver {
                                    const StaticsWorkspace& chord, const Positions& x,
                                    const Eigen::VectorXd& g, NewtonIterate& log) const;
   // Empty when not even the projected Hessian factors, or when `stop` asks before it is tried.
+  // The true Hessian is tried first unless log.negative_curvature says it is indefinite.
   Eigen::VectorXd newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                    const Positions& x, const Eigen::VectorXd& g, NewtonIterate& log,
                                    int& factorizations, const StopRequest& stop) const;
