@@ -138,14 +138,28 @@ export class TargetEditor {
   }
 
   // Each chosen file: targets (or a centre-line) replace the session's; joints pause the
-  // optimizer and jog the robot there.
+  // optimizer and jog the robot there. With joints among the files the optimizer is paused
+  // before anything lands: new targets would otherwise set it moving, away from the saved
+  // joints, and a jog beyond the step limit from where it got to is refused.
   async loadFiles() {
     const files = [...this.el.load.files];
     this.el.load.value = '';  // the same file again is a new choice
+    const robot = this.page.scene()?.robot;
+    const read = [];
     for (const file of files) {
       try {
-        const asked = readTargetsOrJoints(file.name, await file.text(), this.page.scene()?.robot);
-        await this.apply(asked);
+        read.push(readTargetsOrJoints(file.name, await file.text(), robot));
+      } catch (e) {
+        this.page.notify(e.message);
+      }
+    }
+    const steps = read.map((asked) => () => this.apply(asked));
+    if (read.some((asked) => asked.joints)) {
+      steps.unshift(() => this.page.command(Command.SetPaused, { paused: true }));
+    }
+    for (const step of steps) {
+      try {
+        await step();
       } catch (e) {
         this.page.notify(e.message);
       }
