@@ -314,9 +314,14 @@ TEST(SceneChecks, LargeTetCountIsAWarningWithTheExpectedTimeAndHowToCoarsen) {
 }
 
 TEST(SceneChecks, ExpectedTimeGrowsWithTheTetCountThroughTheBenchmarks) {
-  EXPECT_NEAR(expected_seconds_per_target_change(1536), 0.05, 1e-9);
-  EXPECT_NEAR(expected_seconds_per_target_change(12288), 0.7, 1e-9);
-  EXPECT_GT(expected_seconds_per_target_change(50000), 2.0);  // "several seconds"
+  EXPECT_NEAR(expected_seconds_per_target_change(1536), 0.015, 1e-12);
+  EXPECT_NEAR(expected_seconds_per_target_change(12288), 0.21, 1e-12);
+  EXPECT_NEAR(expected_seconds_per_target_change(51714), 1.9, 1e-12);
+  // Between and beyond the benchmarks: growing, without a jump at 12,288.
+  EXPECT_LT(expected_seconds_per_target_change(6000), expected_seconds_per_target_change(12287));
+  EXPECT_NEAR(expected_seconds_per_target_change(12287), 0.21, 1e-3);
+  EXPECT_GT(expected_seconds_per_target_change(100000), 1.9);
+  EXPECT_LT(expected_seconds_per_target_change(500), 0.015);
 }
 
 // The CLI refuses each implausible robot scene before it computes anything: exit 1, the field

@@ -71,7 +71,7 @@ std::string tet_count_warning(const Scene& scene) {
   }
   return scene.source.string() + ": " + scene.mesh_origin.field + ": " + std::to_string(tets) +
          " tetrahedra: expect about " + show(expected_seconds_per_target_change(tets), 2) +
-         " s per target change (1,536 tets take ~50 ms, 12,288 ~0.7 s, 50,000 several seconds); to "
+         " s per target change on 2 cores (1,536 tets take ~15 ms, 12,288 ~0.2 s, 50,000 ~2 s); to "
          "coarsen, " +
          coarsen;
 }
@@ -255,9 +255,13 @@ std::vector<std::string> describe_grips(const Scene& scene) {
 }
 
 double expected_seconds_per_target_change(int tet_count) {
-  // t = 0.05 s (n / 1536)^p through 12,288 tets at 0.7 s: p = ln 14 / ln 8 ≈ 1.27.
-  const double p = std::log(0.7 / 0.05) / std::log(12288.0 / 1536.0);
-  return 0.05 * std::pow(std::max(tet_count, 1) / 1536.0, p);
+  // Log-log interpolation between `shapectl bench --sizes` medians (2-core VM, 2026-11-24,
+  // docs/benchmarks.md), extrapolated with the nearest segment's slope.
+  constexpr double tets[] = {1536, 12288, 51714}, seconds[] = {0.015, 0.21, 1.9};
+  const double n = std::max(tet_count, 1);
+  const int k = n < tets[1] ? 0 : 1;
+  const double p = std::log(seconds[k + 1] / seconds[k]) / std::log(tets[k + 1] / tets[k]);
+  return seconds[k] * std::pow(n / tets[k], p);
 }
 
 std::vector<std::string> check_scene(const Scene& scene) {
