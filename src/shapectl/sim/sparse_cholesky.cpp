@@ -56,13 +56,18 @@ SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
 void SparseCholesky::analyze(const SparseMatrix& lower) {
   if (automatic_) {
-    // Measured (bench/statics_bench.cpp, README) on a 2-core Xeon with box meshes of 400 to
-    // 50k tets: LAPACK's band Cholesky after reverse Cuthill–McKee runs 3-10x the flop rate
-    // of Eigen's simplicial LDLᵀ and 2-3x CHOLMOD's supernodal one, so it is the faster while
-    // it does at most ~2.5x the flops of the sparse factorization: bars, frames, plates and
-    // blocks up to ~12 cells a side. Otherwise (or over 1 GiB of band) the sparse one: LDLᵀ
-    // for small systems, CHOLMOD for large ones.
+    // The band Cholesky after reverse Cuthill–McKee runs at several times the flop rate of
+    // Eigen's simplicial LDLᵀ and of CHOLMOD's supernodal one, so it is the faster while it
+    // does at most a few times their flops. Measured on 2 cores (docs/benchmarks.md, "the
+    // back-end choice"): up to 2.5x at any width (box meshes of 400 to 50k tets), and up to
+    // 8x while the band is at most 1,000 sub-diagonals wide: TetGen bars of 12.8k and 51k
+    // tets (5.4-5.5x the flops, bands 336 and 746 wide) solve 1.75x and 1.25x faster with it,
+    // a 14-cell cube (2.8x, ~700) 1.6x; a TetGen cube (21x) or a 24-cell box cube (4.1x,
+    // ~1,900 wide) 1.3-2x slower. Otherwise (or over 1 GiB of band) the sparse one: LDLᵀ for
+    // small systems, CHOLMOD for large ones.
     constexpr double kBandFlopAllowance = 2.5;
+    constexpr double kNarrowBandFlopAllowance = 8;
+    constexpr int kNarrowBand = 1000;  // sub-diagonals
     constexpr double kBandBytesLimit = 1 << 30;
     constexpr int kCholmodFrom = 2500;  // unknowns
     const bool small = lower.rows() < kCholmodFrom;
@@ -75,7 +80,9 @@ void SparseCholesky::analyze(const SparseMatrix& lower) {
       impl_->cholmod.analyzePattern(lower);
       sparse_flops = impl_->cholmod.cholmod().fl;
     }
-    const bool band = impl_->band.flops() <= kBandFlopAllowance * sparse_flops &&
+    const double allowance =
+        impl_->band.bandwidth() <= kNarrowBand ? kNarrowBandFlopAllowance : kBandFlopAllowance;
+    const bool band = impl_->band.flops() <= allowance * sparse_flops &&
                       impl_->band.storage_bytes() <= kBandBytesLimit;
     backend_ = band ? Backend::Band : small ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
     return;
