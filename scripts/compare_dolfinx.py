@@ -20,6 +20,7 @@ given that force as its absolute tolerance on the residual's 2-norm (never loose
 largest nodal force) with rtol 0, the residual criterion, and MUMPS via PETSc's LU.
 
     python3 scripts/compare_dolfinx.py                       # bar 1.5k and 12k, frame, plate
+    python3 scripts/compare_dolfinx.py --cases bar12k-tetgen,frame-tetgen   # unstructured
     python3 scripts/compare_dolfinx.py --cases bar12k --repeat 3
     python3 scripts/compare_dolfinx.py --msh my_bar.msh --clamp-x 0.011   # any tet mesh
 """
@@ -120,6 +121,73 @@ def read_msh(path):
     return nodes, orient(nodes, np.asarray(tets, dtype=np.int64))
 
 
+def box_surface(lo, hi):
+    """The closed, outward-oriented triangle surface of an axis-aligned box: (vertices, faces)."""
+    v = np.array([[x, y, z] for z in (lo[2], hi[2]) for y in (lo[1], hi[1]) for x in (lo[0], hi[0])])
+    quads = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+    return v, [t for a, b, c, d in quads for t in ((a, b, c), (a, c, d))]
+
+
+def frame_surface(outer, inner, thickness):
+    """A rectangular frame: the outer rectangle minus the inner one (both centred at the
+    origin, sizes in x and y), extruded over z in [-thickness/2, thickness/2]."""
+    ox, oy, ix, iy = outer[0] / 2, outer[1] / 2, inner[0] / 2, inner[1] / 2
+    ring_outer = [(-ox, -oy), (ox, -oy), (ox, oy), (-ox, oy)]  # counter-clockwise from above
+    ring_inner = [(-ix, -iy), (ix, -iy), (ix, iy), (-ix, iy)]
+    v = []
+    for z in (-thickness / 2, thickness / 2):
+        v += [(x, y, z) for x, y in ring_outer] + [(x, y, z) for x, y in ring_inner]
+    # Vertex index: ring r (0 outer, 1 inner), corner k, layer l (0 bottom, 1 top).
+    def idx(l, r, k):
+        return 8 * l + 4 * r + k % 4
+    f = []
+    for k in range(4):
+        # Top and bottom: the trapezoid between the rings on side k.
+        f += [(idx(1, 0, k), idx(1, 0, k + 1), idx(1, 1, k + 1)), (idx(1, 0, k), idx(1, 1, k + 1), idx(1, 1, k))]
+        f += [(idx(0, 0, k), idx(0, 1, k + 1), idx(0, 0, k + 1)), (idx(0, 0, k), idx(0, 1, k), idx(0, 1, k + 1))]
+        # Outer wall facing out, inner wall facing the hole.
+        f += [(idx(0, 0, k), idx(0, 0, k + 1), idx(1, 0, k + 1)), (idx(0, 0, k), idx(1, 0, k + 1), idx(1, 0, k))]
+        f += [(idx(0, 1, k), idx(1, 1, k + 1), idx(0, 1, k + 1)), (idx(0, 1, k), idx(1, 1, k), idx(1, 1, k + 1))]
+    return np.array(v, float), f
+
+
+def tetgen_mesh(shapectl, workdir, name, surface, max_tet_volume):
+    """An unstructured mesh of a closed surface, made by shapectl's TetGen (a scene's surface
+    file with max_tet_volume) and read back from `shapectl statics --vtu` with gravity off, so
+    that the written points are the rest positions. Returns (nodes (n,3), tets (m,4))."""
+    vertices, faces = surface
+    obj = os.path.join(workdir, name + ".obj")
+    with open(obj, "w") as f:
+        f.writelines("v %.17g %.17g %.17g\n" % tuple(p) for p in vertices)
+        f.writelines("f %d %d %d\n" % (a + 1, b + 1, c + 1) for a, b, c in faces)
+    lo = vertices.min(axis=0)
+    scene = {
+        "object": {"mesh": {"file": os.path.basename(obj), "max_tet_volume": max_tet_volume},
+                   "material": {"youngs_modulus": 2e5, "poisson_ratio": 0.3, "density": 40}},
+        "gravity": [0, 0, 0],
+        "fixed": {"box": {"min": (lo - 1).tolist(), "max": [lo[0] + 1e-3, 1, 1]}},
+    }
+    scene_file = os.path.join(workdir, name + "_mesh.json")
+    with open(scene_file, "w") as f:
+        json.dump(scene, f)
+    vtu = os.path.join(workdir, name + ".vtu")
+    run = subprocess.run([shapectl, "statics", scene_file, "--out", vtu + ".json", "--vtu", vtu],
+                         capture_output=True, text=True)
+    if run.returncode != 0:
+        sys.exit("shapectl could not mesh %s:\n%s" % (name, run.stderr))
+    with open(vtu) as f:
+        text = f.read()
+
+    def array(name_attribute, dtype):
+        start = text.index('Name="%s"' % name_attribute)
+        body = text[text.index(">", start) + 1:text.index("</DataArray>", start)]
+        return np.array(body.split(), dtype=dtype)
+
+    nodes = array("Points", float).reshape(-1, 3)
+    tets = array("connectivity", np.int64).reshape(-1, 4)
+    return nodes, orient(nodes, tets)
+
+
 # --- the cases --------------------------------------------------------------------------------
 
 BAR = dict(size=(0.32, 0.03, 0.03), E=2e5, nu=0.3, rho=40.0)
@@ -136,11 +204,24 @@ def clamped_left(nodes, depth):
     return x <= x.min() + depth
 
 
-def make_cases():
-    """name → (nodes, tets, material, fixed-node mask)."""
+UNSTRUCTURED = ("bar12k-tetgen", "frame-tetgen")
+
+
+def make_cases(shapectl=None, workdir=None, names=()):
+    """name → (nodes, tets, material, fixed-node mask). The unstructured (TetGen) cases are
+    made only when named, by `shapectl` in `workdir`."""
     bar = dict(E=2e5, nu=0.3, rho=40.0)
     frame = dict(E=3e5, nu=0.3, rho=60.0)
     cases = {}
+    half = np.array(BAR["size"]) / 2
+    for name in set(names) & set(UNSTRUCTURED):
+        if name == "bar12k-tetgen":  # about the issue's 12,751-tet Gmsh bar
+            nodes, tets = tetgen_mesh(shapectl, workdir, "bar_tetgen", box_surface(-half, half), 6.0e-8)
+            cases[name] = (nodes, tets, bar, clamped_ends(nodes, 0.011))
+        else:  # about the issue's 2,841-tet frame
+            nodes, tets = tetgen_mesh(shapectl, workdir, "frame_tetgen",
+                                      frame_surface((0.32, 0.16), (0.24, 0.08), 0.02), 9e-7)
+            cases[name] = (nodes, tets, frame, clamped_ends(nodes, 0.011))
     for name, cells in (("bar1.5k", (16, 4, 4)), ("bar12k", (32, 8, 8)), ("bar50k", (51, 13, 13))):
         nodes, tets = box_mesh(BAR["size"], cells)
         cases[name] = (nodes, tets, bar, clamped_ends(nodes, 0.011))
@@ -266,7 +347,8 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--shapectl", default=os.path.join("build", "shapectl"))
     parser.add_argument("--cases", default="bar1.5k,bar12k,frame,plate",
-                        help="comma-separated: bar1.5k, bar12k, bar50k, frame, plate")
+                        help="comma-separated: bar1.5k, bar12k, bar50k, frame, plate, and "
+                             "unstructured (TetGen through shapectl): bar12k-tetgen, frame-tetgen")
     parser.add_argument("--msh", help="instead: a tet mesh (MSH 2.2 ASCII) clamped at both ends")
     parser.add_argument("--clamp-x", type=float, default=0.011,
                         help="with --msh: clamp depth at each end along x, metres")
@@ -275,22 +357,23 @@ def main():
                         help="skip DOLFINx (where it is not installed): shapectl's side only")
     args = parser.parse_args()
 
-    cases = make_cases()
-    if args.msh:
-        nodes, tets = read_msh(args.msh)
-        cases = {os.path.basename(args.msh): (nodes, tets, dict(E=2e5, nu=0.3, rho=40.0),
-                                              clamped_ends(nodes, args.clamp_x))}
-        names = list(cases)
-    else:
-        names = args.cases.split(",")
-        unknown = [n for n in names if n not in cases]
-        if unknown:
-            sys.exit("--cases: unknown %s (known: %s)" % (", ".join(unknown), ", ".join(cases)))
+    names = args.cases.split(",")
+    known = list(make_cases()) + list(UNSTRUCTURED)
+    unknown = [n for n in names if n not in known]
+    if unknown and not args.msh:
+        sys.exit("--cases: unknown %s (known: %s)" % (", ".join(unknown), ", ".join(known)))
 
-    print("%-10s %7s | %-24s | %-9s | %-24s | %-22s | %s" % (
+    print("%-13s %7s | %-24s | %-9s | %-24s | %-22s | %s" % (
         "case", "tets", "shapectl whole solve", "+ process", "DOLFINx Newton loop",
         "ratio: solve (process)", "max |x_shapectl - x_dolfinx|"))
     with tempfile.TemporaryDirectory() as workdir:
+        if args.msh:
+            nodes, tets = read_msh(args.msh)
+            cases = {os.path.basename(args.msh): (nodes, tets, dict(E=2e5, nu=0.3, rho=40.0),
+                                                  clamped_ends(nodes, args.clamp_x))}
+            names = list(cases)
+        else:
+            cases = make_cases(args.shapectl, workdir, names)
         for name in names:
             nodes, tets, material, fixed = cases[name]
             # shapectl's tolerance: relative_tolerance (1e-6) x the object's weight.
@@ -310,7 +393,7 @@ def main():
                 t, it_theirs, x_theirs = run_dolfinx(nodes, tets, material, fixed, tolerance)
                 theirs.append(t)
             a, s = float(np.median(ours)), float(np.median(ours_solve))
-            ours_text = "%-10s %7d | %8.4f s, %2d Newton it | %7.3f s" % (
+            ours_text = "%-13s %7d | %8.4f s, %2d Newton it | %7.3f s" % (
                 name, len(tets), s, it_ours, a)
             if args.shapectl_only:
                 print(ours_text + " | (not run)")
