@@ -46,17 +46,28 @@ StaticsWorkspace StaticsSolver::make_workspace() const {
   return StaticsWorkspace(3 * node_count_, fixed_dof_, options_.backend);
 }
 
+namespace {
+// An energy that is NaN (an inverted element) counts as infinitely high.
+double nan_as_infinity(double e) {
+  return std::isnan(e) ? std::numeric_limits<double>::infinity() : e;
+}
+}  // namespace
+
+void StaticsSolver::zero_fixed_dofs(Eigen::VectorXd& g) const {
+  for (int d = 0; d < g.size(); ++d)
+    if (fixed_dof_[d]) g[d] = 0;
+}
+
 double StaticsSolver::energy(const EnergyTerms& terms, const Positions& x) const {
   double e = 0;
   for (const auto* t : terms) e += t->value(x);
-  return std::isnan(e) ? std::numeric_limits<double>::infinity() : e;
+  return nan_as_infinity(e);
 }
 
 Eigen::VectorXd StaticsSolver::gradient(const EnergyTerms& terms, const Positions& x) const {
   Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
   for (const auto* t : terms) t->add_gradient(x, g);
-  for (int d = 0; d < g.size(); ++d)
-    if (fixed_dof_[d]) g[d] = 0;
+  zero_fixed_dofs(g);
   return g;
 }
 
@@ -65,9 +76,8 @@ double StaticsSolver::energy_and_gradient(const EnergyTerms& terms, const Positi
   g = Eigen::VectorXd::Zero(x.size());
   double e = 0;
   for (const auto* t : terms) e += t->value_and_add_gradient(x, g);
-  for (int d = 0; d < g.size(); ++d)
-    if (fixed_dof_[d]) g[d] = 0;
-  return std::isnan(e) ? std::numeric_limits<double>::infinity() : e;
+  zero_fixed_dofs(g);
+  return nan_as_infinity(e);
 }
 
 double StaticsSolver::max_force(const Eigen::VectorXd& g) const {

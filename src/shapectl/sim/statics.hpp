@@ -219,6 +219,7 @@ class StaticsSolver {
   // Energy differences below this are round-off (see the top of this file).
   double energy_noise(double energy) const;
   double max_force(const Eigen::VectorXd& gradient) const;
+  void zero_fixed_dofs(Eigen::VectorXd& gradient) const;
   // Assembles and factors at x into ws; projected = use PSD-projected element Hessians.
   bool factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
                  bool projected) const;
