@@ -188,7 +188,9 @@ enum class Piece {
   Assemble,
   FactorOnly,
   Factorize,
-  Solve
+  Solve,
+  Precondition,
+  HessianProduct
 };
 void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::Backend> backend,
            int rhs_columns = 14) {
@@ -224,30 +226,28 @@ void piece(benchmark::State& state, Piece which, std::optional<SparseCholesky::B
         break;
       case Piece::Factorize: benchmark::DoNotOptimize(solver.factor(terms, ws, x)); break;
       case Piece::Solve: benchmark::DoNotOptimize(solver.solve_with_factor(ws, rhs)); break;
+      case Piece::Precondition:
+        benchmark::DoNotOptimize(ws.cholesky.solve_preconditioner(rhs.col(0)));
+        break;
+      case Piece::HessianProduct: {
+        const Eigen::VectorXd Hv =
+            ws.assembler.matrix().selfadjointView<Eigen::Lower>() * rhs.col(0);
+        benchmark::DoNotOptimize(Hv.data());
+        break;
+      }
     }
   }
   state.counters["tets"] = statics.mesh().tet_count();
 }
-BENCHMARK_CAPTURE(piece, energy, Piece::Energy, std::nullopt)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, gradient, Piece::Gradient, std::nullopt)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, energy, Piece::Energy, std::nullopt)->Apply(four_bars);
+BENCHMARK_CAPTURE(piece, gradient, Piece::Gradient, std::nullopt)->Apply(four_bars);
 BENCHMARK_CAPTURE(piece, energy_and_gradient, Piece::EnergyAndGradient, std::nullopt)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
+    ->Apply(four_bars);
 BENCHMARK_CAPTURE(piece, hessian, Piece::Hessian, std::nullopt)
     ->Arg(4)
     ->Arg(8)
     ->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(piece, assemble, Piece::Assemble, std::nullopt)
-    ->Arg(4)
-    ->Arg(8)
-    ->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(piece, assemble, Piece::Assemble, std::nullopt)->Apply(four_bars);
 BENCHMARK_CAPTURE(piece, factor_only_band, Piece::FactorOnly, SparseCholesky::Backend::Band)
     ->Apply(four_bars);
 BENCHMARK_CAPTURE(piece, assemble_and_factor_auto, Piece::Factorize, std::nullopt)
@@ -270,6 +270,11 @@ BENCHMARK_CAPTURE(piece, solve1_auto, Piece::Solve, std::nullopt, 1)->Apply(both
 BENCHMARK_CAPTURE(piece, solve2_auto, Piece::Solve, std::nullopt, 2)->Apply(both_bars);
 BENCHMARK_CAPTURE(piece, solve4_auto, Piece::Solve, std::nullopt, 4)->Apply(both_bars);
 BENCHMARK_CAPTURE(piece, solve1_cholmod, Piece::Solve, kCholmod, 1)->Apply(both_bars);
+
+// What one conjugate-gradient product of a Krylov step costs: the single-precision solve with
+// the factor (the preconditioner) and the product with the assembled Hessian.
+BENCHMARK_CAPTURE(piece, precondition, Piece::Precondition, std::nullopt)->Apply(four_bars);
+BENCHMARK_CAPTURE(piece, hessian_product, Piece::HessianProduct, std::nullopt)->Apply(four_bars);
 
 // The band factorization alone (no assembly), with its flop rate: BandCholesky::flops() per
 // CPU second of the calling thread, the share of one core's peak that dpbtrf reaches below 192

@@ -115,9 +115,10 @@ TEST(GrippedObject, SensitivityMatchesCentralDifferencesOfStatics) {
 }
 
 // The same check with the perturbed equilibria re-solved by Krylov steps (conjugate gradients
-// preconditioned with x̂(θ)'s factorization, tolerance StaticsOptions::krylov_tolerance), chord
-// steps off: Newton stops on the true residual, so the central differences are of exact
-// equilibria and still match the sensitivities to 1e-5.
+// preconditioned with x̂(θ)'s factorization, each to Eisenstat–Walker's relative residual
+// between StaticsOptions::krylov_first_forcing and krylov_tolerance), chord steps off: Newton
+// stops on the true residual, so the central differences are of exact equilibria and still
+// match the sensitivities to 1e-5.
 TEST(GrippedObject, SensitivityMatchesCentralDifferencesWithKrylovResolves) {
   Scene scene = test::two_arm_scene();
   scene.statics.relative_tolerance = 1e-11;

@@ -145,13 +145,58 @@ TEST(Statics, KrylovStepsThatMeetNegativeCurvatureSkipTheTrueFactorization) {
   long long expected = 0;  // one per Newton step, two where the true Hessian was tried first
   for (const auto& it : r.log) {
     negative += it.negative_curvature;
-    if (it.negative_curvature) EXPECT_TRUE(it.projected) << "iteration " << it.iteration;
+    if (it.negative_curvature) {
+      EXPECT_TRUE(it.projected) << "iteration " << it.iteration;
+    }
     if (!it.chord && it.krylov == 0 && !it.went_back)
       expected += it.projected && !it.negative_curvature ? 2 : 1;
   }
   EXPECT_GT(negative, 0);
   EXPECT_EQ(factorizations, expected);
   EXPECT_EQ(r.factorizations, expected);
+}
+
+TEST(Statics, ASolvesOwnFactorizationPreconditionsItsNextNewtonSteps) {
+  // From rest, with no nearby factorization: Newton factors once, and its next steps are
+  // solved by conjugate gradients preconditioned with that factor, not by factoring again.
+  KrylovBar bar;
+  auto& [statics, ws, x] = bar;
+  Positions krylov_x = KrylovBar::krylov_scene().world_rest_positions(), newton_x = krylov_x;
+  ws.forget_factor();
+  const StaticsResult rk = statics.solve(ws, krylov_x);
+  Scene exact = KrylovBar::krylov_scene();
+  exact.statics.krylov_steps = false;
+  const StaticsResult rn = ObjectStatics(exact).solve(newton_x);
+  ASSERT_TRUE(rk.converged()) << rk.reason;
+  ASSERT_TRUE(rn.converged()) << rn.reason;
+  int krylov_steps = 0;
+  for (const auto& it : rk.log) krylov_steps += it.krylov > 0;
+  EXPECT_GT(krylov_steps, 0);
+  EXPECT_EQ(rk.factorizations + krylov_steps, rk.iterations);
+  EXPECT_LT(rk.factorizations, rn.factorizations);
+  EXPECT_LE(rk.residual, statics.force_tolerance());
+  EXPECT_LT((krylov_x - newton_x).cwiseAbs().maxCoeff(), 1e-6);
+}
+
+TEST(Statics, WhereTheHessianIsIndefiniteKrylovStepsSolveTheProjectedOne) {
+  // The compressed bar of the test above: after the first projected factorization, the next
+  // projected Newton steps are solved by conjugate gradients preconditioned with it (their
+  // true-Hessian attempt meets negative curvature), without factoring.
+  KrylovBar bar;
+  auto& [statics, ws, x] = bar;
+  for (int i = 0; i < statics.mesh().node_count(); ++i) x[3 * i] = -0.16 + 0.9 * (x[3 * i] + 0.16);
+  const StaticsResult r = statics.solve(ws, x, nullptr, 0, &ws);
+  ASSERT_TRUE(r.converged()) << r.reason;
+  int projected_krylov = 0;
+  for (const auto& it : r.log) {
+    projected_krylov += it.projected && it.krylov > 0;
+    if (it.projected && it.krylov > 0) {
+      EXPECT_TRUE(it.negative_curvature) << "iteration " << it.iteration;
+    }
+  }
+  EXPECT_GT(projected_krylov, 0);
+  // The equilibrium found is stable: the true Hessian factors there.
+  EXPECT_TRUE(statics.solver().factor(statics.terms(), ws, x));
 }
 
 TEST(Statics, ChordStepsFollowARigidTurnOfTheWholeObject) {

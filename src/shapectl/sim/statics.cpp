@@ -104,7 +104,8 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
   const bool ok = ws.cholesky.factorize(H);
   ++total_factorizations;
   ws.has_factor = ok && !projected;
-  if (ws.has_factor) ws.factor_x = x;
+  ws.has_preconditioner = ok;
+  if (ok) ws.factor_x = x;
   return ok;
 }
 
@@ -205,13 +206,13 @@ bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace&
 
 Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                                 const StaticsWorkspace& chord, const Positions& x,
-                                                const Eigen::VectorXd& g,
-                                                NewtonIterate& log) const {
+                                                const Eigen::VectorXd& g, double target,
+                                                bool projected, NewtonIterate& log) const {
   // Preconditioned conjugate gradients on H dx = −g. The chord's factor is of the Hessian at a
   // nearby state: H is close to it, so few products reach the tolerance. Assembling H costs a
   // fraction of factoring it on large meshes. Fixed dofs: H has identity rows there and g zeros,
   // so dx stays zero on them.
-  const SparseMatrix& H = assemble_hessian(terms, ws.assembler, x, false);
+  const SparseMatrix& H = assemble_hessian(terms, ws.assembler, x, projected);
   const Mat3 R = chord_rotation(chord, x);
   auto precondition = [&](const Eigen::VectorXd& r) { return solve_rotated(chord, R, r); };
   Eigen::VectorXd dx = Eigen::VectorXd::Zero(g.size());
@@ -219,7 +220,6 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
   Eigen::VectorXd z = precondition(r);
   Eigen::VectorXd p = z;
   double rz = r.dot(z);
-  const double target = options_.krylov_tolerance * g.norm();
   for (int k = 1; k <= options_.krylov_iterations; ++k) {
     const Eigen::VectorXd Hp = H.selfadjointView<Eigen::Lower>() * p;
     const double curvature = p.dot(Hp);
@@ -241,6 +241,22 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
     rz = rz_next;
   }
   return {};
+}
+
+bool StaticsSolver::krylov_step(const EnergyTerms& terms, StaticsWorkspace& ws,
+                                const StaticsWorkspace& chord, double target, Positions& x,
+                                Point& at, NewtonIterate& log) const {
+  Eigen::VectorXd dx = krylov_direction(terms, ws, chord, x, at.gradient, target, false, log);
+  // Indefinite: the projected Hessian is positive definite, and its factor would be the
+  // preconditioner's match as well. (log.negative_curvature stays: Newton then factors only it.)
+  if (dx.size() == 0 && log.negative_curvature) {
+    dx = krylov_direction(terms, ws, chord, x, at.gradient, target, true, log);
+    log.projected = dx.size() > 0;
+  }
+  if (dx.size() > 0 && line_search(terms, dx, x, at, log, false)) return true;
+  log.krylov = 0;
+  log.projected = false;
+  return false;
 }
 
 Eigen::VectorXd StaticsSolver::newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
@@ -329,10 +345,12 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
   }
   // Chord steps first: the true Hessian's factor of a nearby state is used while it works.
   // This saves the factorization, the dominant cost, on warm re-solves. Once the solve factors
-  // anew it stays with Newton: chord steps from a factor of an earlier iterate stalled Newton
-  // near buckling (seconds instead of milliseconds in `shapectl bench`), and Newton's last
-  // step leaves a factorization the sensitivities can reuse.
+  // anew it stays with Newton steps (solved by Krylov with its own factor first): chord steps
+  // from a factor of an earlier iterate stalled Newton near buckling (seconds instead of
+  // milliseconds in `shapectl bench`).
   bool may_chord = chord && chord->has_factor && chord->factor_x.size() == x.size();
+  bool may_refine = false;                         // ws holds a factorization this solve made
+  double previous_forcing = 0, previous_norm = 0;  // Eisenstat–Walker's η, and |∇E| it saw
   // The watchdog (see the header): a cold solve's first Newton step is taken in full while no
   // element inverts, even where it raises the energy; the solve returns to the state before it
   // (and to the descent rule, for good) unless the energy falls below that state's Armijo level
@@ -392,22 +410,36 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     }
     NewtonIterate log{.iteration = it, .residual = at.residual, .energy = at.energy};
     ++total_iterations;
+    // A Krylov step's residual: η |∇E| (see StaticsOptions), but no less than a quarter of the
+    // tolerance. Every nodal force is at most |∇E|, so below that the step's linear model is
+    // already converged, and solving further is wasted.
+    const double gradient_norm = at.gradient.norm();
+    double forcing = previous_norm > 0 ? 0.9 * std::pow(gradient_norm / previous_norm, 2)
+                                       : options_.krylov_first_forcing;
+    if (0.9 * previous_forcing * previous_forcing > 0.1)  // their safeguard against a lucky drop
+      forcing = std::max(forcing, 0.9 * previous_forcing * previous_forcing);
+    forcing =
+        std::clamp(forcing, options_.krylov_tolerance, std::max(options_.krylov_tolerance, 0.1));
+    previous_forcing = forcing;
+    previous_norm = gradient_norm;
+    const double krylov_target = std::max(forcing * gradient_norm, 0.25 * tolerance);
     if (may_chord && options_.chord_steps && chord_step(terms, *chord, x, at, log)) {
       result.log.push_back(log);
       continue;
     }
     // Then a Newton step solved by conjugate gradients with the chord's factor: kept while it
     // takes full steps (a shorter one means the factor no longer fits: Newton factors anew).
-    if (may_chord && options_.krylov_steps) {
-      const Eigen::VectorXd dx = krylov_direction(terms, ws, *chord, x, at.gradient, log);
-      if (dx.size() > 0 && line_search(terms, dx, x, at, log, false)) {
-        may_chord = log.step_length == 1;
-        result.log.push_back(log);
-        continue;
-      }
-      log.krylov = 0;
+    // After a factorization of its own, the solve's next Newton steps are first solved so,
+    // preconditioned with it (the same rule).
+    const StaticsWorkspace* preconditioner = may_chord ? chord : may_refine ? &ws : nullptr;
+    if (preconditioner && options_.krylov_steps &&
+        krylov_step(terms, ws, *preconditioner, krylov_target, x, at, log)) {
+      may_chord = may_chord && log.step_length == 1;
+      may_refine = may_refine && log.step_length == 1;
+      result.log.push_back(log);
+      continue;
     }
-    may_chord = false;
+    may_chord = may_refine = false;
     const Eigen::VectorXd dx =
         newton_direction(terms, ws, x, at.gradient, log, result.factorizations, stop);
     if (dx.size() == 0 && stop && stop()) {
@@ -438,6 +470,7 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
       return result;
     }
     log.relaxed = relax;
+    may_refine = ws.has_preconditioner;
     result.log.push_back(log);
   }
 }

@@ -54,9 +54,16 @@ struct StaticsOptions {
   std::optional<SparseCholesky::Backend> backend;
   // When a chord step fails, a Newton step whose system is solved by conjugate gradients
   // preconditioned with the chord's (stale) factorization, before factoring anew: an inexact
-  // Newton step (relative residual krylov_tolerance, at most krylov_iterations products).
+  // Newton step (at most krylov_iterations products). The same after the solve's own
+  // factorizations, preconditioned with the last one. Where the true Hessian shows negative
+  // curvature, the projected one is solved so (a projected Newton step without factoring).
   bool krylov_steps = true;
   bool chord_steps = true;  // off: a nearby factorization is used by Krylov steps only (tests)
+  // How closely a Krylov step solves Newton's system, as a relative residual η (Eisenstat and
+  // Walker 1996, choice 2): krylov_first_forcing for a solve's first iteration, then
+  // 0.9 (|∇E_k| / |∇E_k−1|)², within [krylov_tolerance, 0.1]. Far from the equilibrium a rough
+  // Newton step does as well as an exact one; near it η tightens as convergence turns quadratic.
+  double krylov_first_forcing = 1e-2;
   double krylov_tolerance = 1e-4;
   // A CG product costs a solve with the factor (and a product with H): on the 12k-tet bar ~1/15
   // of a factorization, so a Krylov step that needs more than this is better refactored.
@@ -110,13 +117,16 @@ struct StaticsWorkspace {
                    std::optional<SparseCholesky::Backend> backend)
       : assembler(dof_count, std::move(fixed_dof)), cholesky(backend) {}
   // Drops the factorization (the buffers and the symbolic analysis stay).
-  void forget_factor() { has_factor = false; }
+  void forget_factor() { has_factor = has_preconditioner = false; }
 
   HessianAssembler assembler;
   SparseCholesky cholesky;
   bool analyzed = false;
-  // The factor is of the true Hessian at `factor_x` (else it is unusable).
+  // The factor is of the true Hessian at `factor_x` (sensitivities and chord steps may use it).
   bool has_factor = false;
+  // The factor is of the true or of the projected Hessian at `factor_x` (Krylov steps of the
+  // same solve may precondition with it).
+  bool has_preconditioner = false;
   Positions factor_x;
   // CHOLMOD's solve writes to its common workspace: solves with this factor take turns.
   std::unique_ptr<std::mutex> solve_mutex = std::make_unique<std::mutex>();
@@ -194,12 +204,18 @@ class StaticsSolver {
   Mat3 chord_rotation(const StaticsWorkspace& chord, const Positions& x) const;
   Eigen::VectorXd solve_rotated(const StaticsWorkspace& chord, const Mat3& R,
                                 const Eigen::VectorXd& r) const;
-  // Newton's direction at x by conjugate gradients on the true Hessian (assembled into `ws`,
-  // not factored), preconditioned with `chord`'s factorization; empty when they do not converge
-  // within the options' limits or meet non-positive curvature.
+  // Newton's direction at x by conjugate gradients on the true Hessian (or the projected one;
+  // assembled into `ws`, not factored), preconditioned with `chord`'s factorization, to a
+  // residual of at most `target`; empty when they do not converge within krylov_iterations
+  // products or meet non-positive curvature (log.negative_curvature then says so).
   Eigen::VectorXd krylov_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                    const StaticsWorkspace& chord, const Positions& x,
-                                   const Eigen::VectorXd& g, NewtonIterate& log) const;
+                                   const Eigen::VectorXd& g, double target, bool projected,
+                                   NewtonIterate& log) const;
+  // A Krylov step with `chord`'s factorization (see krylov_direction), on the projected Hessian
+  // where the true one shows negative curvature; false when neither gives an accepted step.
+  bool krylov_step(const EnergyTerms& terms, StaticsWorkspace& ws, const StaticsWorkspace& chord,
+                   double target, Positions& x, Point& at, NewtonIterate& log) const;
   // Empty when not even the projected Hessian factors, or when `stop` asks before it is tried.
   // The true Hessian is tried first unless log.negative_curvature says it is indefinite.
   Eigen::VectorXd newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
