@@ -257,7 +257,7 @@ std::vector<std::string> describe_grips(const Scene& scene) {
 double expected_seconds_per_target_change(int tet_count) {
   // Log-log interpolation between `shapectl bench --sizes` medians (2-core VM, 2026-11-24,
   // docs/benchmarks.md), extrapolated with the nearest segment's slope.
-  constexpr double tets[] = {1536, 12288, 51714}, seconds[] = {0.015, 0.21, 1.9};
+  constexpr double tets[] = {1536, 12288, 51714}, seconds[] = {0.015, 0.21, 1.4};
   const double n = std::max(tet_count, 1);
   const int k = n < tets[1] ? 0 : 1;
   const double p = std::log(seconds[k + 1] / seconds[k]) / std::log(tets[k + 1] / tets[k]);
