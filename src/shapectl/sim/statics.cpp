@@ -29,6 +29,26 @@ std::vector<char> dof_mask(const std::vector<char>& fixed_node) {
 }
 std::atomic<long long> total_iterations{0}, total_factorizations{0};
 
+// Eisenstat and Walker's (1996) forcing term η, choice 2 with their safeguard (see
+// StaticsOptions::krylov_first_forcing).
+class ForcingTerm {
+ public:
+  ForcingTerm(double first, double tightest) : first_(first), tightest_(tightest) {}
+  // η for the iteration that starts at gradient norm `norm`.
+  double next(double norm) {
+    double eta = previous_norm_ > 0 ? 0.9 * std::pow(norm / previous_norm_, 2) : first_;
+    const double safeguard = 0.9 * previous_ * previous_;  // against a lucky drop of |∇E|
+    if (safeguard > 0.1) eta = std::max(eta, safeguard);
+    previous_ = std::clamp(eta, tightest_, std::max(tightest_, 0.1));
+    previous_norm_ = norm;
+    return previous_;
+  }
+
+ private:
+  double first_, tightest_;
+  double previous_ = 0, previous_norm_ = 0;
+};
+
 std::string sci(double v) {
   std::ostringstream s;
   s.precision(3);
@@ -349,8 +369,8 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
   // from a factor of an earlier iterate stalled Newton near buckling (seconds instead of
   // milliseconds in `shapectl bench`).
   bool may_chord = chord && chord->has_factor && chord->factor_x.size() == x.size();
-  bool may_refine = false;                         // ws holds a factorization this solve made
-  double previous_forcing = 0, previous_norm = 0;  // Eisenstat–Walker's η, and |∇E| it saw
+  bool may_refine = false;  // ws holds a factorization this solve made
+  ForcingTerm forcing(options_.krylov_first_forcing, options_.krylov_tolerance);
   // The watchdog (see the header): a cold solve's first Newton step is taken in full while no
   // element inverts, even where it raises the energy; the solve returns to the state before it
   // (and to the descent rule, for good) unless the energy falls below that state's Armijo level
@@ -410,19 +430,12 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     }
     NewtonIterate log{.iteration = it, .residual = at.residual, .energy = at.energy};
     ++total_iterations;
-    // A Krylov step's residual: η |∇E| (see StaticsOptions), but no less than a quarter of the
-    // tolerance. Every nodal force is at most |∇E|, so below that the step's linear model is
-    // already converged, and solving further is wasted.
+    // A Krylov step's residual: η |∇E|, but no less than a quarter of the tolerance. Every
+    // nodal force is at most |∇E|, so below that the step's linear model is already converged,
+    // and solving further is wasted.
     const double gradient_norm = at.gradient.norm();
-    double forcing = previous_norm > 0 ? 0.9 * std::pow(gradient_norm / previous_norm, 2)
-                                       : options_.krylov_first_forcing;
-    if (0.9 * previous_forcing * previous_forcing > 0.1)  // their safeguard against a lucky drop
-      forcing = std::max(forcing, 0.9 * previous_forcing * previous_forcing);
-    forcing =
-        std::clamp(forcing, options_.krylov_tolerance, std::max(options_.krylov_tolerance, 0.1));
-    previous_forcing = forcing;
-    previous_norm = gradient_norm;
-    const double krylov_target = std::max(forcing * gradient_norm, 0.25 * tolerance);
+    const double krylov_target =
+        std::max(forcing.next(gradient_norm) * gradient_norm, 0.25 * tolerance);
     if (may_chord && options_.chord_steps && chord_step(terms, *chord, x, at, log)) {
       result.log.push_back(log);
       continue;
