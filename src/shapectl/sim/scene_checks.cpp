@@ -71,9 +71,10 @@ std::string tet_count_warning(const Scene& scene) {
   }
   return scene.source.string() + ": " + scene.mesh_origin.field + ": " + std::to_string(tets) +
          " tetrahedra: expect about " + show(expected_seconds_per_target_change(tets), 2) +
-         " s per target change on 2 cores (1,536 tets take ~15 ms, 12,288 ~0.2 s, 50,000 ~2 s); to "
-         "coarsen, " +
-         coarsen;
+         " s per target change on 2 cores (1,536 tets take ~" +
+         show(1e3 * expected_seconds_per_target_change(1536), 2) + " ms, 12,288 ~" +
+         show(expected_seconds_per_target_change(12288), 2) + " s, 51,714 ~" +
+         show(expected_seconds_per_target_change(51714), 2) + " s); to coarsen, " + coarsen;
 }
 
 // The scene field that sets a joint's reference value.

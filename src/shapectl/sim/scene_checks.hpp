@@ -37,7 +37,7 @@ std::vector<std::string> describe_grips(const Scene& scene);
 
 // Time per target change (Gauss–Newton, to < 1 mm) expected for a mesh of `tet_count` tets,
 // seconds, through the benchmarks' medians on 2 cores (1,536 tets ~15 ms, 12,288 ~0.2 s,
-// 51,714 ~2 s).
+// 51,714 ~1.4 s).
 double expected_seconds_per_target_change(int tet_count);
 
 // Throws InputError naming `source` and origin.field when an object of bounding-box `size`
