@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <random>
+#include <set>
 
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/sim/band_cholesky.hpp>
+#include <shapectl/sim/node_pattern.hpp>
 #include <shapectl/sim/object_statics.hpp>
 
 namespace shapectl {
@@ -114,20 +116,95 @@ SparseMatrix rest_hessian(const Scene& scene) {
 }
 
 TEST(SparseCholesky, AutomaticChoiceFollowsTheMeshShape) {
-  // Elongated or small meshes, and a block whose band is still narrow (~700 sub-diagonals,
-  // 2.8x the sparse flops, measured 1.6x faster): the band.
+  // Elongated or small meshes: the band (at most 2x CHOLMOD's flops, 8x LDLᵀ's below 2,500
+  // unknowns; docs/benchmarks.md, "the back-end choice, again").
   for (const auto& [size, cells] : {std::pair{Vec3(0.32, 0.03, 0.03), std::array{16, 4, 4}},
                                     std::pair{Vec3(0.08, 0.08, 0.08), std::array{8, 8, 8}},
-                                    std::pair{Vec3(0.64, 0.12, 0.11), std::array{64, 12, 11}},
-                                    std::pair{Vec3(0.14, 0.14, 0.14), std::array{14, 14, 14}}}) {
+                                    std::pair{Vec3(0.64, 0.12, 0.11), std::array{64, 12, 11}}}) {
     SparseCholesky cholesky;
     cholesky.analyze(rest_hessian(clamped_box(size, cells)));
     EXPECT_EQ(cholesky.backend(), Backend::Band) << cells[0] << "x" << cells[1] << "x" << cells[2];
   }
-  // A larger compact block: a band over 1,000 wide doing 3.7x the supernodal flops.
-  SparseCholesky block;
-  block.analyze(rest_hessian(clamped_box({0.2, 0.2, 0.2}, {20, 20, 20})));
-  EXPECT_EQ(block.backend(), Backend::CholmodSupernodal);
+  // Compact blocks and a wide plate: CHOLMOD, whose flops are under half the band's.
+  for (const auto& [size, cells] : {std::pair{Vec3(0.14, 0.14, 0.14), std::array{14, 14, 14}},
+                                    std::pair{Vec3(0.2, 0.2, 0.2), std::array{20, 20, 20}},
+                                    std::pair{Vec3(0.4, 0.4, 0.01), std::array{40, 40, 1}}}) {
+    SparseCholesky cholesky;
+    cholesky.analyze(rest_hessian(clamped_box(size, cells)));
+    EXPECT_EQ(cholesky.backend(), Backend::CholmodSupernodal)
+        << cells[0] << "x" << cells[1] << "x" << cells[2];
+  }
+}
+
+TEST(NodePattern, AFemHessianIsItsNodePatternInBlocks) {
+  const SparseMatrix H = bar_hessian();  // clamped: the held dofs keep only their diagonal
+  const std::optional<SparseMatrix> nodes = node_pattern(H);
+  ASSERT_TRUE(nodes);
+  ASSERT_EQ(3 * nodes->rows(), H.rows());
+  std::set<std::pair<int, int>> from_dofs, from_nodes;
+  for (int j = 0; j < H.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(H, j); it; ++it)
+      from_dofs.insert({static_cast<int>(it.row()) / 3, j / 3});
+  for (int j = 0; j < nodes->outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(*nodes, j); it; ++it)
+      from_nodes.insert({static_cast<int>(it.row()), j});
+  EXPECT_EQ(from_nodes, from_dofs);
+  EXPECT_EQ(dof_order({2, 0, 1}), (std::vector<int>{6, 7, 8, 0, 1, 2, 3, 4, 5}));
+}
+
+TEST(NodePattern, AMatrixNotInNodeBlocksHasNone) {
+  const SparseMatrix H = bar_hessian();
+  // One coupling entry less: its node pair is still there, the block is not whole.
+  std::vector<Eigen::Triplet<double>> entries;
+  bool dropped = false;
+  for (int j = 0; j < H.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(H, j); it; ++it) {
+      if (!dropped && it.row() / 3 != j / 3) {
+        dropped = true;
+        continue;
+      }
+      entries.emplace_back(static_cast<int>(it.row()), j, it.value());
+    }
+  ASSERT_TRUE(dropped);
+  SparseMatrix holed(H.rows(), H.cols());
+  holed.setFromTriplets(entries.begin(), entries.end());
+  holed.makeCompressed();
+  EXPECT_FALSE(node_pattern(holed));
+  // Not 3 dofs per node.
+  SparseMatrix odd(4, 4);
+  odd.setIdentity();
+  odd.makeCompressed();
+  EXPECT_FALSE(node_pattern(odd));
+}
+
+TEST(BandCholesky, OrdersAFemHessiansNodes) {
+  // The bar's nodes renumbered at random (each node's dofs kept together): ordering the node
+  // pattern finds a band as narrow as the natural slice-by-slice numbering's.
+  const SparseMatrix H = bar_hessian();
+  const int n = static_cast<int>(H.rows());
+  std::vector<int> node_shuffle(n / 3);
+  for (int i = 0; i < n / 3; ++i) node_shuffle[i] = i;
+  std::shuffle(node_shuffle.begin(), node_shuffle.end(), std::mt19937(11));
+  const std::vector<int> shuffle = dof_order(node_shuffle);
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> P(n);
+  for (int i = 0; i < n; ++i) P.indices()[i] = shuffle[i];
+  SparseMatrix full_shuffled;
+  full_shuffled = H.selfadjointView<Eigen::Lower>().twistedBy(P);
+  const SparseMatrix shuffled = full_shuffled.triangularView<Eigen::Lower>();
+  ASSERT_TRUE(node_pattern(shuffled));
+  std::vector<int> identity(n);
+  for (int i = 0; i < n; ++i) identity[i] = i;
+  ASSERT_GT(bandwidth(shuffled, identity), n / 2);
+  BandCholesky band;
+  band.analyze(shuffled);
+  EXPECT_LE(band.bandwidth(), bandwidth(H, identity));
+  // And it solves: the band factor of the shuffled matrix against LDLᵀ's.
+  ASSERT_TRUE(band.factorize(shuffled));
+  SparseCholesky ldlt(Backend::SimplicialLDLT);
+  ldlt.analyze(shuffled);
+  ASSERT_TRUE(ldlt.factorize(shuffled));
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(n, -1, 1);
+  EXPECT_LT((band.solve(b).col(0) - ldlt.solve(b)).norm(), 1e-9 * ldlt.solve(b).norm());
 }
 
 TEST(SparseCholesky, StaticsReachesTheSameEquilibriumWithEveryBackend) {

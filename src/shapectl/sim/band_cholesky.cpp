@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <shapectl/sim/band_factor.hpp>
+#include <shapectl/sim/node_pattern.hpp>
 
 extern "C" {  // LAPACK and BLAS (OpenBLAS)
 void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);
@@ -195,7 +197,10 @@ void blocked_band_solve(const BandBlocks& blocks, int n, double* b, int columns)
 
 void BandCholesky::analyze(const SparseMatrix& lower) {
   size_ = static_cast<int>(lower.rows());
-  const std::vector<int> order = reverse_cuthill_mckee(lower);
+  // On a FEM Hessian, the ordering of its nodes: the same band at a ninth of the work.
+  const std::optional<SparseMatrix> nodes = node_pattern(lower);
+  const std::vector<int> order =
+      nodes ? dof_order(reverse_cuthill_mckee(*nodes)) : reverse_cuthill_mckee(lower);
   new_index_.assign(size_, 0);
   for (int k = 0; k < size_; ++k) new_index_[order[k]] = k;
   bandwidth_ = 0;

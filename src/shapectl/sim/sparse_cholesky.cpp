@@ -2,10 +2,13 @@
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 #include <atomic>
 #include <cstdlib>
 
 #include <shapectl/sim/band_cholesky.hpp>
+#include <shapectl/sim/node_pattern.hpp>
+#include <shapectl/sim/serial_openmp.hpp>
 
 namespace shapectl {
 
@@ -34,6 +37,44 @@ struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
     return f;
   }
 };
+
+using CholmodLlt = Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>;
+
+constexpr int kCholmodDefault = -1;  // CHOLMOD's own strategy instead of one ordering
+
+// Flops of CHOLMOD's factorization of `lower` with an ordering method; *entries: of the factor.
+double cholmod_flops(const SparseMatrix& lower, int ordering, double* entries) {
+  SerialOpenMp serial;
+  CholmodLlt cholmod;
+  cholmod.cholmod().print = 0;
+  if (ordering != kCholmodDefault) {
+    cholmod.cholmod().nmethods = 1;
+    cholmod.cholmod().method[0].ordering = ordering;
+  }
+  cholmod.analyzePattern(lower);
+  *entries = cholmod.cholmod().lnz;
+  return cholmod.cholmod().fl;
+}
+
+// Flops of the sparse factorization CHOLMOD would make, without its analysis of the dofs:
+// found on the node pattern (node_pattern.hpp) by CHOLMOD's own default rule, AMD and then
+// METIS too where AMD's factor is dense (over 500 flops per entry of it and 5 entries per
+// entry of the matrix; on the dofs, each node's ratios are 3x and 1x its own). Within 4 % of
+// the dof analysis on the meshes of docs/benchmarks.md, "the back-end choice, again".
+double cholmod_flops_by_nodes(const SparseMatrix& nodes) {
+  double entries = 0;
+  const double amd = 27 * cholmod_flops(nodes, CHOLMOD_AMD, &entries);
+  const bool dense = amd >= 500 * 9 * entries && entries >= 5 * nodes.nonZeros();
+  if (!dense) return amd;
+  return std::min(amd, 27 * cholmod_flops(nodes, CHOLMOD_METIS, &entries));
+}
+
+// The same for Eigen's LDLᵀ (AMD ordering).
+double ldlt_flops_by_nodes(const SparseMatrix& nodes) {
+  CountingLdlt ldlt;
+  ldlt.analyzePattern(nodes);
+  return 27 * ldlt.flops();
+}
 }  // namespace
 
 struct SparseCholesky::Impl {
@@ -55,43 +96,51 @@ SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
 void SparseCholesky::analyze(const SparseMatrix& lower) {
-  if (automatic_) {
-    // The band Cholesky after reverse Cuthill–McKee runs at several times the flop rate of
-    // Eigen's simplicial LDLᵀ and of CHOLMOD's supernodal one, so it is the faster while it
-    // does at most a few times their flops. Measured on 2 cores (docs/benchmarks.md, "the
-    // back-end choice"): up to 2.5x at any width (box meshes of 400 to 50k tets), and up to
-    // 8x while the band is at most 1,000 sub-diagonals wide: TetGen bars of 12.8k and 51k
-    // tets (5.4-5.5x the flops, bands 336 and 746 wide) solve 1.75x and 1.25x faster with it,
-    // a 14-cell cube (2.8x, ~700) 1.6x; a TetGen cube (21x) or a 24-cell box cube (4.1x,
-    // ~1,900 wide) 1.3-2x slower. Otherwise (or over 1 GiB of band) the sparse one: LDLᵀ for
-    // small systems, CHOLMOD for large ones.
-    constexpr double kBandFlopAllowance = 2.5;
-    constexpr double kNarrowBandFlopAllowance = 8;
-    constexpr int kNarrowBand = 1000;  // sub-diagonals
-    constexpr double kBandBytesLimit = 1 << 30;
-    constexpr int kCholmodFrom = 2500;  // unknowns
-    const bool small = lower.rows() < kCholmodFrom;
-    impl_->band.analyze(lower);
-    double sparse_flops = 0;
-    if (small) {
-      impl_->ldlt.analyzePattern(lower);
-      sparse_flops = impl_->ldlt.flops();
-    } else {
-      impl_->cholmod.analyzePattern(lower);
-      sparse_flops = impl_->cholmod.cholmod().fl;
-    }
-    const double allowance =
-        impl_->band.bandwidth() <= kNarrowBand ? kNarrowBandFlopAllowance : kBandFlopAllowance;
-    const bool band = impl_->band.flops() <= allowance * sparse_flops &&
-                      impl_->band.storage_bytes() <= kBandBytesLimit;
-    backend_ = band ? Backend::Band : small ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
-    return;
-  }
+  if (automatic_) backend_ = choose(lower);
   switch (backend_) {
     case Backend::SimplicialLDLT: impl_->ldlt.analyzePattern(lower); break;
-    case Backend::Band: impl_->band.analyze(lower); break;
-    case Backend::CholmodSupernodal: impl_->cholmod.analyzePattern(lower); break;
+    case Backend::Band:
+      if (!automatic_) impl_->band.analyze(lower);  // choose() did
+      break;
+    case Backend::CholmodSupernodal: {
+      SerialOpenMp serial;
+      impl_->cholmod.analyzePattern(lower);
+      break;
+    }
   }
+}
+
+SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
+  // The band Cholesky after reverse Cuthill–McKee runs at several times the flop rate of the
+  // sparse ones (dense kernels), so it is the faster while it does at most a few times their
+  // flops. Measured on 2 cores with CHOLMOD on one thread (docs/benchmarks.md, "the back-end
+  // choice, again"): against CHOLMOD the crossover is near 2x (box bars of 12k and 50k tets at
+  // 1.3-1.9x are faster as a band; TetGen bars at 5x, a 40x40x1 plate at 3x, box cubes from 14
+  // cells are faster with CHOLMOD); against Eigen's simplicial LDLᵀ, used below 2,500
+  // unknowns, near 8x. Over 1 GiB of band, always the sparse one.
+  constexpr double kCholmodAllowance = 2;
+  constexpr double kLdltAllowance = 8;
+  constexpr double kBandBytesLimit = 1 << 30;
+  constexpr int kCholmodFrom = 2500;  // unknowns
+  const bool small = lower.rows() < kCholmodFrom;
+  impl_->band.analyze(lower);
+  // The sparse flops from the node pattern of a FEM Hessian: a fraction of the analysis time.
+  const std::optional<SparseMatrix> nodes = node_pattern(lower);
+  double sparse_flops = 0;
+  if (nodes) {
+    sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes);
+  } else if (small) {
+    CountingLdlt ldlt;
+    ldlt.analyzePattern(lower);
+    sparse_flops = ldlt.flops();
+  } else {
+    double entries = 0;
+    sparse_flops = cholmod_flops(lower, kCholmodDefault, &entries);
+  }
+  const double allowance = small ? kLdltAllowance : kCholmodAllowance;
+  const bool band = impl_->band.flops() <= allowance * sparse_flops &&
+                    impl_->band.storage_bytes() <= kBandBytesLimit;
+  return band ? Backend::Band : small ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
 }
 
 bool SparseCholesky::factorize(const SparseMatrix& lower) {
@@ -105,10 +154,14 @@ bool SparseCholesky::factorize(const SparseMatrix& lower) {
       use_blas_threads(impl_->band.bandwidth() >= kThreadedBandFrom);
       return positive_definite;
     }
-    case Backend::CholmodSupernodal:
-      use_blas_threads(true);
+    case Backend::CholmodSupernodal: {
+      // One thread for CHOLMOD's BLAS as for its OpenMP (serial_openmp.hpp): measured as fast
+      // or faster on 2 cores at every size of docs/benchmarks.md, "the back-end choice, again".
+      use_blas_threads(false);
+      SerialOpenMp serial;
       impl_->cholmod.factorize(lower);
       return impl_->cholmod.info() == Eigen::Success;
+    }
     case Backend::SimplicialLDLT: break;
   }
   impl_->ldlt.factorize(lower);
@@ -122,7 +175,10 @@ bool SparseCholesky::factorize(const SparseMatrix& lower) {
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
   switch (backend_) {
     case Backend::Band: return impl_->band.solve(rhs);
-    case Backend::CholmodSupernodal: return impl_->cholmod.solve(rhs);
+    case Backend::CholmodSupernodal: {
+      SerialOpenMp serial;
+      return impl_->cholmod.solve(rhs);
+    }
     case Backend::SimplicialLDLT: break;
   }
   return impl_->ldlt.solve(rhs);
@@ -136,7 +192,10 @@ Eigen::VectorXd SparseCholesky::solve_preconditioner(const Eigen::VectorXd& rhs)
 Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& rhs) const {
   switch (backend_) {
     case Backend::Band: return impl_->band.solve(rhs).col(0);
-    case Backend::CholmodSupernodal: return impl_->cholmod.solve(rhs);
+    case Backend::CholmodSupernodal: {
+      SerialOpenMp serial;
+      return impl_->cholmod.solve(rhs);
+    }
     case Backend::SimplicialLDLT: break;
   }
   return impl_->ldlt.solve(rhs);

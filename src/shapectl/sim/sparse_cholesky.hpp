@@ -1,9 +1,9 @@
 #pragma once
 // Sparse Cholesky with the symbolic analysis done once per pattern and reused. Three
 // backends: simplicial LDLᵀ (Eigen), a dense band after reverse Cuthill–McKee (LAPACK; the
-// fastest for bars, frames, plates and small blocks) and supernodal LLᵀ (CHOLMOD + OpenBLAS,
-// for large compact meshes). Chosen from the matrix unless fixed; the rule's numbers come from
-// bench/statics_bench.cpp.
+// fastest for bars, box frames and small blocks) and supernodal LLᵀ (CHOLMOD + OpenBLAS, one
+// thread, for compact and unstructured meshes). Chosen from the matrix unless fixed; the
+// rule's numbers come from bench/statics_bench.cpp and docs/benchmarks.md.
 #include <memory>
 #include <optional>
 
@@ -34,8 +34,15 @@ class SparseCholesky {
   // A solve good enough to precondition with: the band's factor in single precision
   // (BandCholesky::solve_single_precision); the other back-ends solve exactly.
   Eigen::VectorXd solve_preconditioner(const Eigen::VectorXd& rhs) const;
+  // Whether a solve costs a small fraction of a factorization, so that conjugate gradients
+  // preconditioned with the factor pay: the band's single-precision solve does; CHOLMOD's
+  // solve does not (a 60x60x1 plate took 19 Newton iterations and 1.25 s with such steps,
+  // 7 and 0.70 s without; docs/benchmarks.md, "the back-end choice, again").
+  bool cheap_to_solve() const { return backend_ != Backend::CholmodSupernodal; }
 
  private:
+  // The automatic choice; leaves the band analyzed.
+  Backend choose(const SparseMatrix& lower);
   struct Impl;
   bool automatic_;
   Backend backend_;

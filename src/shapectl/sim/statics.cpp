@@ -444,8 +444,9 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     // takes full steps (a shorter one means the factor no longer fits: Newton factors anew).
     // After a factorization of its own, the solve's next Newton steps are first solved so,
     // preconditioned with it (the same rule).
+    // Only with a factor that is cheap to solve with (SparseCholesky::cheap_to_solve).
     const StaticsWorkspace* preconditioner = may_chord ? chord : may_refine ? &ws : nullptr;
-    if (preconditioner && options_.krylov_steps &&
+    if (preconditioner && options_.krylov_steps && preconditioner->cholesky.cheap_to_solve() &&
         krylov_step(terms, ws, *preconditioner, krylov_target, x, at, log)) {
       may_chord = may_chord && log.step_length == 1;
       may_refine = may_refine && log.step_length == 1;
