@@ -1,5 +1,6 @@
 #include "bench_scaling.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -176,6 +177,11 @@ std::vector<int> parse_tet_counts(const std::string& text, const std::string& op
   while (start <= text.size()) {
     const std::size_t end = std::min(text.find(',', start), text.size());
     const std::string item = text.substr(start, end - start);
+    if (item == "mesh") {
+      counts.push_back(kSceneMesh);
+      start = end + 1;
+      continue;
+    }
     std::size_t used = 0;
     double value = NAN;
     try {
@@ -187,7 +193,8 @@ std::vector<int> parse_tet_counts(const std::string& text, const std::string& op
       value *= 1000, ++used;
     if (used == 0 || used != item.size() || !(value >= 6 && value <= 2e6))
       throw InputError(option, "",
-                       "tet counts separated by commas, each 6 to 2000k (e.g. 1.5k,6k,12k)",
+                       "tet counts separated by commas, each 6 to 2000k or \"mesh\" for the "
+                       "scene's own (e.g. 1.5k,6k,12k)",
                        "\"" + item + "\"");
     counts.push_back(static_cast<int>(std::lround(value)));
     start = end + 1;
@@ -202,11 +209,15 @@ void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_co
   scene.statics.single_precision_chord = levers.single_precision_chord;
   if (!scene.robot) throw InputError(scene_file, "robot", "a scene with a robot (missing key)");
   const auto cells = box_cells(*scene.object_mesh);
-  if (!cells || (scene.fixed && !scene.fixed->nodes.empty()))
+  const bool refines = std::any_of(tet_counts.begin(), tet_counts.end(),
+                                   [](int count) { return count != kSceneMesh; });
+  if (refines && (!cells || (scene.fixed && !scene.fixed->nodes.empty())))
     throw InputError(scene_file, "object.mesh",
-                     "a box mesh without hole and no fixed nodes by index (for --sizes)");
+                     "a box mesh without hole and no fixed nodes by index (for --sizes with tet "
+                     "counts; --sizes mesh takes the scene's mesh as it is)");
   std::printf(
-      "\n%s refined (--sizes): %d random reachable target sets per size, Gauss-Newton to a mean "
+      "\n%s at each size (--sizes; \"mesh\": as it is): %d random reachable target sets per size, "
+      "Gauss-Newton to a mean "
       "error < 1 mm; Krylov steps %s; chord and Krylov solves in %s precision\n",
       scene_file.c_str(), trials, levers.krylov_steps ? "on from 5,000 unknowns" : "off",
       levers.single_precision_chord ? "single" : "double");
@@ -216,7 +227,8 @@ void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_co
   std::vector<double> tets, target_medians, rest_medians, warm_medians;
   for (int count : tet_counts) {
     const bool per_size = reset_peak_memory();
-    SizeRow row = measure(refined_scene(scene, *cells, count), trials, seed);
+    SizeRow row =
+        measure(count == kSceneMesh ? scene : refined_scene(scene, *cells, count), trials, seed);
     row.peak_mb = peak_memory_mb();
     std::printf(
         "  %7d | %7.1f (first %7.1f) %d it | %7.2f %2d it %d fac | %8.1f (%8.1f) %2zu/%-2d ok | "
@@ -234,11 +246,13 @@ void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_co
     rest_medians.push_back(row.from_rest);
     warm_medians.push_back(row.warm);
   }
-  std::printf(
-      "  growth exponent (time ~ tets^k, least squares on log-log): target change %.2f, statics "
-      "from rest %.2f, warm re-solve %.2f\n",
-      growth_exponent(tets, target_medians), growth_exponent(tets, rest_medians),
-      growth_exponent(tets, warm_medians));
+  // An exponent needs two sizes.
+  if (std::set<double>(tets.begin(), tets.end()).size() >= 2)
+    std::printf(
+        "  growth exponent (time ~ tets^k, least squares on log-log): target change %.2f, "
+        "statics from rest %.2f, warm re-solve %.2f\n",
+        growth_exponent(tets, target_medians), growth_exponent(tets, rest_medians),
+        growth_exponent(tets, warm_medians));
   std::printf(
       "  Newton it/fac: statics iterations (Newton + chord) and numeric factorizations per target "
       "change, medians; peak MB: VmHWM of /proc/self/status, reset before each size\n");

@@ -17,10 +17,24 @@ TEST(BenchCli, ScalingTableHasARowPerSizeAndTheGrowthExponents) {
   EXPECT_TRUE(std::regex_search(run.out, std::regex(R"(\n +540 \|)"))) << run.out;
   EXPECT_TRUE(std::regex_search(run.out, std::regex(R"(\n +1536 \|)"))) << run.out;
   // Both sizes reached the targets of both trials, and three finite exponents follow.
-  EXPECT_EQ(std::regex_search(run.out, std::regex(R"(\b[01]/2 ok)")), false) << run.out;
+  // (The count is padded: "2/2  ok".)
+  EXPECT_TRUE(std::regex_search(run.out, std::regex(R"(\b2/2 +ok)"))) << run.out;
+  EXPECT_FALSE(std::regex_search(run.out, std::regex(R"(\b[01]/2 +ok)"))) << run.out;
   EXPECT_TRUE(std::regex_search(
       run.out, std::regex(R"(target change -?\d+\.\d+, statics from rest -?\d+\.\d+, warm )")))
       << run.out;
+}
+
+TEST(BenchCli, SizesMeshMeasuresTheScenesOwnMeshOfAnyKind) {
+  // The frame (a box with a hole, not refinable) as it is: one row, and no growth exponent,
+  // which needs two sizes.
+  const CliRun run = run_cli({"bench", source_path("scenes/yumi_frame.json").string(), "--sizes",
+                              "mesh", "--trials", "2"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::smatch row;
+  ASSERT_TRUE(std::regex_search(run.out, row, std::regex(R"(\n +(\d+) \|.*\b2/2 +ok)"))) << run.out;
+  EXPECT_GT(std::stoi(row[1]), 100) << run.out;
+  EXPECT_EQ(run.out.find("growth exponent"), std::string::npos) << run.out;
 }
 
 TEST(BenchCli, BadSizesAreRefusedNamingTheOptionAndTheItem) {
