@@ -182,6 +182,31 @@ TEST(Statics, ASolvesOwnFactorizationPreconditionsItsNextNewtonSteps) {
   EXPECT_EQ(rk.factorizations + krylov_steps, rk.iterations);
 }
 
+TEST(Statics, AColdSolveBelowTwentyThousandUnknownsTakesExactNewtonSteps) {
+  // 6,027 unknowns: Krylov steps are on (from 5,000), but a cold solve from rest takes exact
+  // Newton steps, one factorization each, and as few iterations as DOLFINx's exact Newton
+  // (two; scripts/compare_dolfinx.py). With cold Krylov steps forced on (chord steps off) the
+  // same solve takes them.
+  Scene scene = bar_scene({40, 6, 6}, material_from_youngs(2e5, 0.3, 40), 0.001, true);
+  ASSERT_GE(3 * scene.object_mesh->node_count(), 5000);
+  for (const bool chord_steps : {true, false}) {
+    scene.statics.chord_steps = chord_steps;
+    ObjectStatics statics(scene);
+    Positions x = scene.world_rest_positions();
+    const StaticsResult r = statics.solve(x);
+    ASSERT_TRUE(r.converged()) << r.reason;
+    int krylov_steps = 0;
+    for (const auto& it : r.log) krylov_steps += it.krylov > 0;
+    if (chord_steps) {
+      EXPECT_EQ(krylov_steps, 0);
+      EXPECT_EQ(r.factorizations, r.iterations);
+      EXPECT_LE(r.iterations, 2);
+    } else {
+      EXPECT_GT(krylov_steps, 0);
+    }
+  }
+}
+
 TEST(Statics, OnlyACheapSolvePreconditionsKrylovSteps) {
   // The same solve from rest with the band, whose single-precision solve is cheap, and with
   // CHOLMOD, whose solve costs a good part of a factorization: only the band's takes Krylov

@@ -85,6 +85,8 @@ std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
 // a factorization costs about what assembling the Hessian and the conjugate gradients do.
 // With chord steps off they are the only reuse of a nearby factorization: then always.
 constexpr int kKrylovFrom = 5000;  // unknowns
+// In a cold solve, from here (StaticsOptions::cold_krylov_steps).
+constexpr int kColdKrylovFrom = 20000;  // unknowns
 
 StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double weight) {
   // Converged when every nodal force is a tiny fraction of the weight (or, for a weightless
@@ -99,6 +101,8 @@ StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double
           .backend = scene.statics.backend,
           .krylov_steps = scene.statics.krylov_steps &&
                           (!scene.statics.chord_steps || 3 * placed.node_count() >= kKrylovFrom),
+          .cold_krylov_steps =
+              !scene.statics.chord_steps || 3 * placed.node_count() >= kColdKrylovFrom,
           .chord_steps = scene.statics.chord_steps,
           .rotate_chord = scene.statics.rotate_chord,
           .single_precision_chord = scene.statics.single_precision_chord};

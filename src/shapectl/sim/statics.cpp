@@ -369,7 +369,8 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
   // from a factor of an earlier iterate stalled Newton near buckling (seconds instead of
   // milliseconds in `shapectl bench`).
   bool may_chord = chord && chord->has_factor && chord->factor_x.size() == x.size();
-  bool may_refine = false;  // ws holds a factorization this solve made
+  const bool warm = may_chord;  // else cold: Krylov steps only if cold_krylov_steps
+  bool may_refine = false;      // ws holds a factorization this solve made
   ForcingTerm forcing(options_.krylov_first_forcing, options_.krylov_tolerance);
   // The watchdog (see the header): a cold solve's first Newton step is taken in full while no
   // element inverts, even where it raises the energy; the solve returns to the state before it
@@ -484,7 +485,7 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
       return result;
     }
     log.relaxed = relax;
-    may_refine = ws.has_preconditioner;
+    may_refine = ws.has_preconditioner && (warm || options_.cold_krylov_steps);
     result.log.push_back(log);
   }
 }

@@ -58,6 +58,12 @@ struct StaticsOptions {
   // factorizations, preconditioned with the last one. Where the true Hessian shows negative
   // curvature, the projected one is solved so (a projected Newton step without factoring).
   bool krylov_steps = true;
+  // In a cold solve (no nearby factorization), Krylov steps after its own factorizations too.
+  // From rest Newton needs two or three steps; an inexact second step adds one iteration, and
+  // below ~20,000 unknowns that costs what the factorization it saves does (12k-tet bar: 3
+  // iterations and 39-48 ms with them, 2 and 37-46 ms without; 50k: 0.40 against 0.44 s;
+  // docs/benchmarks.md, session 5).
+  bool cold_krylov_steps = true;
   bool chord_steps = true;  // off: a nearby factorization is used by Krylov steps only (tests)
   // How closely a Krylov step solves Newton's system, as a relative residual η (Eisenstat and
   // Walker 1996, choice 2): krylov_first_forcing for a solve's first iteration, then
