@@ -140,6 +140,21 @@ TEST_F(OnlineCalibrationTest, TheWindowKeepsDistinctPosesAndNothingStartsWithout
   EXPECT_EQ(calibration.status().runs, 0u);
 }
 
+TEST_F(OnlineCalibrationTest, ARobotCreepingInSmallStepsAddsAPoseEverySamePoseDistance) {
+  // Steps of 0.002 rad, each within same_pose (0.005) of the one before: a pose is added once
+  // the robot is 0.006 rad from where the newest pose was first seen (at 0.006, 0.012, 0.018).
+  Controller controller(model);
+  OnlineCalibration calibration(controller, model, {.automatic = false});
+  ASSERT_EQ(calibration.options().same_pose, 0.005);
+  Eigen::VectorXd joints = model.robot->reference_joints;
+  calibration.observe(look(joints));
+  for (int k = 1; k <= 10; ++k) {
+    joints[0] -= 0.002;
+    calibration.observe(look(joints));
+  }
+  EXPECT_EQ(calibration.status().frames, 4);
+}
+
 // One marker from one pose is 3 numbers: no fit of 13 parameters starts from it (it would
 // "explain" the noise exactly and make the model worse elsewhere).
 TEST_F(OnlineCalibrationTest, TooFewObservedNumbersForTheParametersStartNothing) {

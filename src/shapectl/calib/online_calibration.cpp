@@ -25,9 +25,8 @@ bool changed_significantly(const CalibrationResult& r) {
   return false;
 }
 
-bool same_pose(const ObservationFrame& a, const ObservationFrame& b, double tolerance) {
-  return a.joints.size() == b.joints.size() &&
-         (a.joints.size() == 0 || (a.joints - b.joints).cwiseAbs().maxCoeff() <= tolerance);
+bool same_pose(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double tolerance) {
+  return a.size() == b.size() && (a.size() == 0 || (a - b).cwiseAbs().maxCoeff() <= tolerance);
 }
 }  // namespace
 
@@ -43,9 +42,12 @@ OnlineCalibration::~OnlineCalibration() {
 
 void OnlineCalibration::observe(const ObservationFrame& frame) {
   if (!frame.markers.empty()) controller_.observe(live_observation(frame));
-  if (!window_.empty() && same_pose(window_.back(), frame, options_.same_pose))
+  if (!window_.empty() && same_pose(newest_pose_first_joints_, frame.joints, options_.same_pose)) {
     window_.back() = frame;
-  else window_.push_back(frame);
+  } else {
+    window_.push_back(frame);
+    newest_pose_first_joints_ = frame.joints;
+  }
   while (static_cast<int>(window_.size()) > options_.window) window_.pop_front();
   ++frames_since_start_;
   std::lock_guard lock(mutex_);

@@ -7,9 +7,12 @@
 // same joints: the robot sees no jump, only better predictions.
 //
 // The window keeps the newest frames of distinct poses: a frame taken within `same_pose` of
-// the newest kept frame's joints replaces it (a robot standing still adds noise, not
-// information). Parameters the window cannot determine are held (the calibration's
-// identifiability test), never fitted to noise.
+// the joints where the newest kept pose was first seen replaces that pose's frame (a robot
+// standing still adds noise, not information). Measured from where the pose was first seen,
+// not from its newest frame, so that a robot creeping in small steps between frames (a loaded
+// machine's optimizer improving little by little) still adds a pose every `same_pose`. Parameters
+// the window cannot determine are held (the calibration's identifiability test), never fitted to
+// noise.
 #include <atomic>
 #include <cstdint>
 #include <deque>
@@ -89,6 +92,7 @@ class OnlineCalibration {
   Scene model_;  // the controller's model: the scene with every applied fit
   OnlineCalibrationOptions options_;
   std::deque<ObservationFrame> window_;
+  Eigen::VectorXd newest_pose_first_joints_;  // where window_.back()'s pose was first seen
   int frames_since_start_ = 0;
   double last_start_ = -1e300;
   double period_;  // the wait now: options_.period, doubled while fits change nothing
