@@ -28,6 +28,12 @@ void use_blas_threads(bool many) {
   if (current.exchange(threads) != threads) openblas_set_num_threads(threads);
 }
 
+// CHOLMOD's BLAS calls run on all cores from this many flops a factorization, on one below.
+// Measured on 2 cores, whole solves: one thread 5-15 % faster on a TetGen bar (2e8 flops), the
+// 60x60x1 plate (7e8) and a 14-cell cube (1.3e9); all 10-15 % faster on a 50k-tet box bar
+// (8e9) and a 20-cell cube (1.1e10).
+constexpr double kThreadedCholmodFlops = 3e9;
+
 // Eigen's LDLᵀ, plus the flop count of its factorization from the symbolic analysis.
 struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
   double flops() const {
@@ -80,7 +86,8 @@ double ldlt_flops_by_nodes(const SparseMatrix& nodes) {
 struct SparseCholesky::Impl {
   CountingLdlt ldlt;
   BandCholesky band;
-  Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> cholmod;
+  CholmodLlt cholmod;
+  bool cholmod_blas_threads = false;  // see factorize()
 };
 
 SparseCholesky::SparseCholesky(std::optional<Backend> backend)
@@ -105,6 +112,7 @@ void SparseCholesky::analyze(const SparseMatrix& lower) {
     case Backend::CholmodSupernodal: {
       SerialOpenMp serial;
       impl_->cholmod.analyzePattern(lower);
+      impl_->cholmod_blas_threads = impl_->cholmod.cholmod().fl >= kThreadedCholmodFlops;
       break;
     }
   }
@@ -155,9 +163,10 @@ bool SparseCholesky::factorize(const SparseMatrix& lower) {
       return positive_definite;
     }
     case Backend::CholmodSupernodal: {
-      // One thread for CHOLMOD's BLAS as for its OpenMP (serial_openmp.hpp): measured as fast
-      // or faster on 2 cores at every size of docs/benchmarks.md, "the back-end choice, again".
-      use_blas_threads(false);
+      // CHOLMOD's OpenMP on one thread (serial_openmp.hpp), its BLAS on all cores only for
+      // large factorizations, whose supernodes are big dense blocks (docs/benchmarks.md,
+      // "CHOLMOD's OpenMP threads").
+      use_blas_threads(impl_->cholmod_blas_threads);
       SerialOpenMp serial;
       impl_->cholmod.factorize(lower);
       return impl_->cholmod.info() == Eigen::Success;
