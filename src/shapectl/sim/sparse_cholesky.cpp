@@ -123,9 +123,9 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
   // sparse ones (dense kernels), so it is the faster while it does at most a few times their
   // flops. Measured on 2 cores with CHOLMOD on one thread (docs/benchmarks.md, "the back-end
   // choice, again"): against CHOLMOD the crossover is near 2x (box bars of 12k and 50k tets at
-  // 1.3-1.9x are faster as a band; TetGen bars at 5x, a 40x40x1 plate at 3x, box cubes from 14
-  // cells are faster with CHOLMOD); against Eigen's simplicial LDLᵀ, used below 2,500
-  // unknowns, near 8x. Over 1 GiB of band, always the sparse one.
+  // 0.8-1.3x solve 1.7-1.9x faster as a band; a TetGen bar at 5.5x, a 60x60x1 plate at 4x and
+  // box cubes from 14 cells at 2.9x faster with CHOLMOD); against Eigen's simplicial LDLᵀ,
+  // used below 2,500 unknowns, near 8x. Over 1 GiB of band, always the sparse one.
   constexpr double kCholmodAllowance = 2;
   constexpr double kLdltAllowance = 8;
   constexpr double kBandBytesLimit = 1 << 30;
