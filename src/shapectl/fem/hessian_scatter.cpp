@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -133,6 +134,11 @@ void HessianScatter::build_pattern(int dof_count, const std::vector<char>& fixed
   // writes them in place (a slot per block entry would take (3k)² ints per element, 7 MB at
   // 12k tets, to be scanned once).
   auto lands = [&](int row, int col) { return row >= col && !fixed_dof[row] && !fixed_dof[col]; };
+  // A node pair (i > j) lands (free dofs of i) × (free dofs of j) entries; a node with itself
+  // the lower triangle of its free dofs.
+  std::vector<int> free_dofs(node_count);
+  for (int i = 0; i < node_count; ++i)
+    free_dofs[i] = 3 - fixed_dof[3 * i] - fixed_dof[3 * i + 1] - fixed_dof[3 * i + 2];
   entry_offsets_.assign(block_sizes_.size() + 1, 0);
   for (std::size_t t = 0; t < elements.size(); ++t)
     for (std::size_t e = 0; e < elements[t].size(); ++e) {
@@ -140,9 +146,11 @@ void HessianScatter::build_pattern(int dof_count, const std::vector<char>& fixed
       const int k = elements[t].node_count(e);
       int count = 0;
       for (int b = 0; b < k; ++b)
-        for (int a = 0; a < k; ++a)
-          for (int c = 0; c < 3; ++c)
-            for (int r = 0; r < 3; ++r) count += lands(3 * nodes[a] + r, 3 * nodes[b] + c);
+        for (int a = 0; a < k; ++a) {
+          const int fa = free_dofs[nodes[a]], fb = free_dofs[nodes[b]];
+          if (nodes[a] > nodes[b]) count += fa * fb;
+          else if (nodes[a] == nodes[b]) count += fa * (fa + 1) / 2;
+        }
       entry_offsets_[terms_[t].first_element + e + 1] = count;
     }
   for (std::size_t g = 0; g < block_sizes_.size(); ++g) entry_offsets_[g + 1] += entry_offsets_[g];
@@ -168,6 +176,10 @@ void HessianScatter::build_pattern(int dof_count, const std::vector<char>& fixed
           }
     }
   }
+  // The count above and this pass must agree, element by element.
+  for (std::size_t g = 0; g < next.size(); ++g)
+    if (next[g] != entry_offsets_[g + 1])
+      throw std::logic_error("HessianScatter: counted and written entries differ");
   for (int d = 0; d < dof_count; ++d)
     if (fixed_dof[d]) fixed_diagonal_slots_.push_back(outer[d]);
 }
