@@ -182,6 +182,19 @@ TEST(Statics, ASolvesOwnFactorizationPreconditionsItsNextNewtonSteps) {
   EXPECT_EQ(rk.factorizations + krylov_steps, rk.iterations);
 }
 
+// A solve from rest: its result, the equilibrium it reached and how many Krylov steps it took.
+struct FromRest {
+  StaticsResult result;
+  Positions x;
+  int krylov_steps = 0;
+};
+FromRest solve_from_rest(const Scene& scene) {
+  FromRest out{.x = scene.world_rest_positions()};
+  out.result = ObjectStatics(scene).solve(out.x);
+  for (const auto& it : out.result.log) out.krylov_steps += it.krylov > 0;
+  return out;
+}
+
 TEST(Statics, AColdSolveBelowTwentyThousandUnknownsTakesExactNewtonSteps) {
   // 6,027 unknowns: Krylov steps are on (from 5,000), but a cold solve from rest takes exact
   // Newton steps, one factorization each, and as few iterations as DOLFINx's exact Newton
@@ -191,12 +204,10 @@ TEST(Statics, AColdSolveBelowTwentyThousandUnknownsTakesExactNewtonSteps) {
   ASSERT_GE(3 * scene.object_mesh->node_count(), 5000);
   for (const bool chord_steps : {true, false}) {
     scene.statics.chord_steps = chord_steps;
-    ObjectStatics statics(scene);
-    Positions x = scene.world_rest_positions();
-    const StaticsResult r = statics.solve(x);
+    const FromRest solve = solve_from_rest(scene);
+    const StaticsResult& r = solve.result;
     ASSERT_TRUE(r.converged()) << r.reason;
-    int krylov_steps = 0;
-    for (const auto& it : r.log) krylov_steps += it.krylov > 0;
+    const int krylov_steps = solve.krylov_steps;
     if (chord_steps) {
       EXPECT_EQ(krylov_steps, 0);
       EXPECT_EQ(r.factorizations, r.iterations);
@@ -216,19 +227,17 @@ TEST(Statics, OnlyACheapSolvePreconditionsKrylovSteps) {
        {CholeskyBackend::Band, CholeskyBackend::CholmodSupernodal}) {
     Scene scene = KrylovBar::krylov_scene();
     scene.statics.backend = backend;
-    ObjectStatics statics(scene);
-    Positions x = scene.world_rest_positions();
-    const StaticsResult r = statics.solve(x);
+    const FromRest solve = solve_from_rest(scene);
+    const StaticsResult& r = solve.result;
     ASSERT_TRUE(r.converged()) << r.reason;
-    int krylov_steps = 0;
-    for (const auto& it : r.log) krylov_steps += it.krylov > 0;
+    const int krylov_steps = solve.krylov_steps;
     if (backend == CholeskyBackend::Band) {
       EXPECT_GT(krylov_steps, 0);
     } else {
       EXPECT_EQ(krylov_steps, 0);
       EXPECT_GE(r.factorizations, r.iterations);
     }
-    ends.push_back(x);
+    ends.push_back(solve.x);
   }
   EXPECT_LT((ends[0] - ends[1]).cwiseAbs().maxCoeff(), 1e-6);
 }

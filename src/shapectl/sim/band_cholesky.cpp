@@ -195,10 +195,11 @@ void blocked_band_solve(const BandBlocks& blocks, int n, double* b, int columns)
 }
 }  // namespace
 
-void BandCholesky::analyze(const SparseMatrix& lower) {
+void BandCholesky::analyze(const SparseMatrix& lower) { analyze(lower, node_pattern(lower)); }
+
+void BandCholesky::analyze(const SparseMatrix& lower, const std::optional<SparseMatrix>& nodes) {
   size_ = static_cast<int>(lower.rows());
   // On a FEM Hessian, the ordering of its nodes: the same band at a ninth of the work.
-  const std::optional<SparseMatrix> nodes = node_pattern(lower);
   const std::vector<int> order =
       nodes ? dof_order(reverse_cuthill_mckee(*nodes)) : reverse_cuthill_mckee(lower);
   new_index_.assign(size_, 0);

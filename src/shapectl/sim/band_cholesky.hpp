@@ -5,6 +5,7 @@
 // two-thread one for wide bands (band_factor.hpp). On such meshes this runs
 // several times faster than a simplicial sparse factorization of the same matrix, although
 // it does more flops: dense kernels use the vector units, scattered sparse updates do not.
+#include <optional>
 #include <vector>
 
 #include <shapectl/types.hpp>
@@ -20,6 +21,8 @@ class BandCholesky {
  public:
   // Ordering and band layout for this pattern (lower triangle, compressed).
   void analyze(const SparseMatrix& lower);
+  // The same with the node pattern of `lower` (node_pattern.hpp) already found, or nullopt.
+  void analyze(const SparseMatrix& lower, const std::optional<SparseMatrix>& nodes);
   int bandwidth() const { return bandwidth_; }  // sub-diagonals in the band
   // Floating-point operations of one factorization, ~ Σ (column length)².
   double flops() const;

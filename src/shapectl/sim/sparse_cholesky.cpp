@@ -132,9 +132,9 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
   constexpr double kBandBytesLimit = 1 << 30;
   constexpr int kCholmodFrom = 2500;  // unknowns
   const bool small = lower.rows() < kCholmodFrom;
-  impl_->band.analyze(lower);
   // The sparse flops from the node pattern of a FEM Hessian: a fraction of the analysis time.
   const std::optional<SparseMatrix> nodes = node_pattern(lower);
+  impl_->band.analyze(lower, nodes);
   double sparse_flops = 0;
   if (nodes) {
     sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes);
@@ -149,6 +149,7 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
   const double allowance = small ? kLdltAllowance : kCholmodAllowance;
   const bool band = impl_->band.flops() <= allowance * sparse_flops &&
                     impl_->band.storage_bytes() <= kBandBytesLimit;
+  if (!band) impl_->band = BandCholesky();  // its layout (an index per entry) is not needed
   return band ? Backend::Band : small ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
 }
 
