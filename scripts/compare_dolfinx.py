@@ -35,6 +35,11 @@ import time
 
 import numpy as np
 
+# Each timed run starts after this pause: OpenBLAS's idle threads in this process (numpy's,
+# and PETSc's after a DOLFINx solve) spin for ~0.1 s after their last call and would take a
+# core from the run that follows.
+QUIET_SECONDS = 0.3
+
 
 # --- meshes -----------------------------------------------------------------------------------
 
@@ -251,6 +256,7 @@ def run_shapectl(shapectl, workdir, name, nodes, tets, material, fixed):
     with open(scene_file, "w") as f:
         json.dump(scene, f)
     out = os.path.join(workdir, name + "_result.json")
+    time.sleep(QUIET_SECONDS)
     t0 = time.perf_counter()
     run = subprocess.run([shapectl, "statics", scene_file, "--out", out],
                          capture_output=True, text=True)
@@ -325,6 +331,7 @@ def run_dolfinx(nodes, tets, material, fixed, force_tolerance):
     options[prefix + "pc_factor_mat_solver_type"] = "mumps"
     ksp.setFromOptions()
 
+    time.sleep(QUIET_SECONDS)
     t0 = time.perf_counter()
     try:
         iterations, converged = solver.solve(u)

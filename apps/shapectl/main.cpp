@@ -7,9 +7,11 @@
 #include "commands.hpp"
 #include "quiet_blas_threads.hpp"
 #include "shapectl_version.hpp"
+#include "worker_threads.hpp"
 
 int main(int argc, char** argv) {
   shapectl::cli::restart_with_quiet_blas_threads(argv);
+  shapectl::cli::start_worker_threads();
   // A file size limit (ulimit -f) makes a result write fail with an error, not kill us midway.
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"shapectl: interactive robotic shape control of elastic objects"};

@@ -32,15 +32,16 @@ TetMesh::TetMesh(std::vector<Vec3> rest_positions, std::vector<std::array<int, 4
   tets_.reserve(tets.size());
   for (std::size_t e = 0; e < tets.size(); ++e) {
     const auto& t = tets[e];
-    const std::string where = "element " + std::to_string(e);
+    // Only for an error: a string per tet costs more than the checks (~0.6 ms at 12k tets).
+    auto where = [e] { return "element " + std::to_string(e); };
     for (int a = 0; a < 4; ++a) {
       if (t[a] < 0 || t[a] >= n)
-        throw InputError(source, where,
+        throw InputError(source, where(),
                          "node " + std::to_string(t[a]) + " out of range (mesh has " +
                              std::to_string(n) + " nodes)");
       for (int b = 0; b < a; ++b)
         if (t[a] == t[b])
-          throw InputError(source, where, "node " + std::to_string(t[a]) + " appears twice");
+          throw InputError(source, where(), "node " + std::to_string(t[a]) + " appears twice");
     }
     Mat3 Dm;
     double longest = 0;
@@ -50,9 +51,10 @@ TetMesh::TetMesh(std::vector<Vec3> rest_positions, std::vector<std::array<int, 4
         longest = std::max(longest, (rest_positions_[t[a]] - rest_positions_[t[b]]).norm());
     const double volume = Dm.determinant() / 6.0;
     if (std::abs(volume) <= 1e-9 * longest * longest * longest)
-      throw InputError(source, where, "degenerate tetrahedron (volume " + fmt_double(volume) + ")");
+      throw InputError(source, where(),
+                       "degenerate tetrahedron (volume " + fmt_double(volume) + ")");
     if (volume < 0)
-      throw InputError(source, where, "inverted tetrahedron (volume " + fmt_double(volume) + ")");
+      throw InputError(source, where(), "inverted tetrahedron (volume " + fmt_double(volume) + ")");
     tets_.push_back({t, volume, Dm.inverse()});
     for (int a : t) used[a] = 1;
   }

@@ -43,10 +43,10 @@ class BandCholesky {
  private:
   int size_ = 0;
   int bandwidth_ = 0;
-  std::vector<int> new_index_;              // new_index_[old] = position in the band
-  std::vector<int> slot_;                   // band storage index of each stored entry of `lower`
-  std::vector<double> band_;                // LAPACK lower band storage, (bandwidth_ + 1) × size_
-  mutable std::vector<float> band_single_;  // band_ rounded, when band_single_current_
+  std::vector<int> new_index_;           // new_index_[old] = position in the band
+  std::vector<int> slot_;                // band storage index of each stored entry of `lower`
+  Eigen::VectorXd band_;                 // LAPACK lower band storage, (bandwidth_ + 1) × size_
+  mutable Eigen::VectorXf band_single_;  // band_ rounded, when band_single_current_
   mutable bool band_single_current_ = false;
 };
 

@@ -84,9 +84,8 @@ std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
 // docs/benchmarks.md) a third faster target change at 8,019 unknowns, no gain at 1,275, where
 // a factorization costs about what assembling the Hessian and the conjugate gradients do.
 // With chord steps off they are the only reuse of a nearby factorization: then always.
+// (A cold solve's own, exact Krylov steps pay at every size: StaticsOptions::cold_krylov_steps.)
 constexpr int kKrylovFrom = 5000;  // unknowns
-// In a cold solve, from here (StaticsOptions::cold_krylov_steps).
-constexpr int kColdKrylovFrom = 20000;  // unknowns
 
 StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double weight) {
   // Converged when every nodal force is a tiny fraction of the weight (or, for a weightless
@@ -101,8 +100,7 @@ StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double
           .backend = scene.statics.backend,
           .krylov_steps = scene.statics.krylov_steps &&
                           (!scene.statics.chord_steps || 3 * placed.node_count() >= kKrylovFrom),
-          .cold_krylov_steps =
-              !scene.statics.chord_steps || 3 * placed.node_count() >= kColdKrylovFrom,
+          .cold_krylov_steps = scene.statics.krylov_steps,
           .chord_steps = scene.statics.chord_steps,
           .rotate_chord = scene.statics.rotate_chord,
           .single_precision_chord = scene.statics.single_precision_chord};

@@ -38,7 +38,8 @@ struct StaticsSettings {
   double relative_tolerance = 1e-6;        // force tolerance as a fraction of the object's weight
   std::optional<CholeskyBackend> backend;  // "ldlt" | "band" | "cholmod"; default: from the matrix
   // Newton steps by conjugate gradients preconditioned with a nearby state's factorization
-  // (StaticsOptions::krylov_steps); off only to measure what they save (`bench --no-krylov`).
+  // (StaticsOptions::krylov_steps and cold_krylov_steps); off only to measure what they save
+  // (`bench --no-krylov`).
   bool krylov_steps = true;
   bool chord_steps = true;   // off: Krylov steps only (tests force that path with it)
   bool rotate_chord = true;  // StaticsOptions::rotate_chord; off only to measure what it saves

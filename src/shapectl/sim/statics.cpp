@@ -115,8 +115,9 @@ const SparseMatrix& assemble_hessian(const EnergyTerms& terms, HessianAssembler&
 }  // namespace
 
 bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
-                              bool projected) const {
-  const SparseMatrix& H = assemble_hessian(terms, ws.assembler, x, projected);
+                              bool projected, bool assembled) const {
+  const SparseMatrix& H =
+      assembled ? ws.assembler.matrix() : assemble_hessian(terms, ws.assembler, x, projected);
   if (!ws.analyzed || ws.assembler.pattern_changed()) {
     ws.cholesky.analyze(H);
     ws.analyzed = true;
@@ -131,7 +132,7 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
 
 bool StaticsSolver::factor(const EnergyTerms& terms, StaticsWorkspace& ws,
                            const Positions& x) const {
-  return factor_at(terms, ws, x, false);
+  return factor_at(terms, ws, x, false, false);
 }
 
 SparseMatrix StaticsSolver::hessian(const EnergyTerms& terms, const Positions& x) const {
@@ -194,21 +195,21 @@ Mat3 StaticsSolver::chord_rotation(const StaticsWorkspace& chord, const Position
 }
 
 Eigen::VectorXd StaticsSolver::solve_rotated(const StaticsWorkspace& chord, const Mat3& R,
-                                             const Eigen::VectorXd& r) const {
+                                             const Eigen::VectorXd& r, bool rounded) const {
   // H(x) ≈ R H(x_chord) Rᵀ for an object turned by R, so H(x)⁻¹ r ≈ R H(x_chord)⁻¹ Rᵀ r. Fixed
   // nodes have zero residual rows and stay zero (R turns a node's three dofs together).
   const Eigen::VectorXd turned = rotate_nodes(R, r, /*transpose=*/true);
   std::lock_guard lock(*chord.solve_mutex);
-  return rotate_nodes(R, options_.single_precision_chord
-                             ? chord.cholesky.solve_preconditioner(turned)
-                             : chord.cholesky.solve(turned));
+  return rotate_nodes(R, rounded ? chord.cholesky.solve_preconditioner(turned)
+                                 : chord.cholesky.solve(turned));
 }
 
 bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace& chord,
                                Positions& x, Point& at, NewtonIterate& log) const {
   // The full step with the earlier factorization, kept while it lowers the energy and cuts the
   // force 4-fold.
-  const Eigen::VectorXd dx = -solve_rotated(chord, chord_rotation(chord, x), at.gradient);
+  const Eigen::VectorXd dx =
+      -solve_rotated(chord, chord_rotation(chord, x), at.gradient, options_.single_precision_chord);
   if (!(at.gradient.dot(dx) < 0)) return false;
   Positions trial = x + dx;
   Eigen::VectorXd g_trial;  // in one pass with the energy: a chord step is mostly kept
@@ -226,7 +227,7 @@ bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace&
 
 Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                                 const StaticsWorkspace& chord, const Positions& x,
-                                                const Eigen::VectorXd& g, double target,
+                                                const Eigen::VectorXd& g, double target, bool exact,
                                                 bool projected, NewtonIterate& log) const {
   // Preconditioned conjugate gradients on H dx = −g. The chord's factor is of the Hessian at a
   // nearby state: H is close to it, so few products reach the tolerance. Assembling H costs a
@@ -234,9 +235,13 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
   // so dx stays zero on them.
   const SparseMatrix& H = assemble_hessian(terms, ws.assembler, x, projected);
   const Mat3 R = chord_rotation(chord, x);
-  auto precondition = [&](const Eigen::VectorXd& r) { return solve_rotated(chord, R, r); };
+  // An exact step's factor is a cold solve's own, used a few times: its rounded copy would
+  // cost more than it saves (3-4 ms at 12k tets, where a solve in double costs ~1 ms).
+  const bool rounded = options_.single_precision_chord && !exact;
+  auto precondition = [&](const Eigen::VectorXd& r) { return solve_rotated(chord, R, r, rounded); };
   Eigen::VectorXd dx = Eigen::VectorXd::Zero(g.size());
   Eigen::VectorXd r = -g;
+  double previous = r.norm();
   Eigen::VectorXd z = precondition(r);
   Eigen::VectorXd p = z;
   double rz = r.dot(z);
@@ -251,10 +256,19 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
     const double alpha = rz / curvature;
     dx += alpha * p;
     r -= alpha * Hp;
-    if (r.norm() <= target) {
+    const double norm = r.norm();
+    if (norm <= target) {
       log.krylov = k;
       return g.dot(dx) < 0 ? dx : Eigen::VectorXd();
     }
+    // An exact step gives up as soon as the last product's rate cannot reach the target within
+    // the products left: a factorization is then cheaper than trying on (the soft cantilever
+    // from rest, whose large steps change the Hessian much).
+    const double rate = norm / previous;
+    if (exact &&
+        !(rate < 1 && std::log(target / norm) / std::log(rate) <= options_.krylov_iterations - k))
+      return {};
+    previous = norm;
     z = precondition(r);
     const double rz_next = r.dot(z);
     p = z + (rz_next / rz) * p;
@@ -264,13 +278,15 @@ Eigen::VectorXd StaticsSolver::krylov_direction(const EnergyTerms& terms, Static
 }
 
 bool StaticsSolver::krylov_step(const EnergyTerms& terms, StaticsWorkspace& ws,
-                                const StaticsWorkspace& chord, double target, Positions& x,
-                                Point& at, NewtonIterate& log) const {
-  Eigen::VectorXd dx = krylov_direction(terms, ws, chord, x, at.gradient, target, false, log);
+                                const StaticsWorkspace& chord, double target, bool exact,
+                                Positions& x, Point& at, NewtonIterate& log) const {
+  Eigen::VectorXd dx =
+      krylov_direction(terms, ws, chord, x, at.gradient, target, exact, false, log);
   // Indefinite: the projected Hessian is positive definite, and its factor would be the
   // preconditioner's match as well. (log.negative_curvature stays: Newton then factors only it.)
-  if (dx.size() == 0 && log.negative_curvature) {
-    dx = krylov_direction(terms, ws, chord, x, at.gradient, target, true, log);
+  // Not for an exact step: its factor, of a state before a large step, is no match.
+  if (dx.size() == 0 && log.negative_curvature && !exact) {
+    dx = krylov_direction(terms, ws, chord, x, at.gradient, target, exact, true, log);
     log.projected = dx.size() > 0;
   }
   if (dx.size() > 0 && line_search(terms, dx, x, at, log, false)) return true;
@@ -282,13 +298,13 @@ bool StaticsSolver::krylov_step(const EnergyTerms& terms, StaticsWorkspace& ws,
 Eigen::VectorXd StaticsSolver::newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                                 const Positions& x, const Eigen::VectorXd& g,
                                                 NewtonIterate& log, int& factorizations,
-                                                const StopRequest& stop) const {
+                                                bool assembled, const StopRequest& stop) const {
   // The true Hessian at x, if it gives a descent direction; else the PSD-projected one. A
   // true Hessian known to be indefinite is not tried: its factorization would fail, after
   // 35-60 % of the columns on the 50k bar.
   if (!log.negative_curvature) {
     ++factorizations;
-    if (factor_at(terms, ws, x, false)) {
+    if (factor_at(terms, ws, x, false, assembled)) {
       Eigen::VectorXd dx = -ws.cholesky.solve(g);
       if (g.dot(dx) < 0) return dx;
     }
@@ -296,7 +312,7 @@ Eigen::VectorXd StaticsSolver::newton_direction(const EnergyTerms& terms, Static
   if (stop && stop()) return {};  // the caller reports the stop
   log.projected = true;
   ++factorizations;
-  if (!factor_at(terms, ws, x, true)) return {};
+  if (!factor_at(terms, ws, x, true, false)) return {};
   return -ws.cholesky.solve(g);
 }
 
@@ -437,6 +453,9 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     const double gradient_norm = at.gradient.norm();
     const double krylov_target =
         std::max(forcing.next(gradient_norm) * gradient_norm, 0.25 * tolerance);
+    // A cold solve's Krylov steps stand in for its Newton steps: they solve as far as the
+    // tolerance, so the iterates are Newton's (StaticsOptions::cold_krylov_steps).
+    const double exact_target = 0.25 * tolerance;
     if (may_chord && options_.chord_steps && chord_step(terms, *chord, x, at, log)) {
       result.log.push_back(log);
       continue;
@@ -444,19 +463,25 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
     // Then a Newton step solved by conjugate gradients with the chord's factor: kept while it
     // takes full steps (a shorter one means the factor no longer fits: Newton factors anew).
     // After a factorization of its own, the solve's next Newton steps are first solved so,
-    // preconditioned with it (the same rule).
-    // Only with a factor that is cheap to solve with (SparseCholesky::cheap_to_solve).
+    // preconditioned with it (the same rule). A warm solve's only with a factor that is cheap
+    // to solve with (SparseCholesky::cheap_to_solve); a cold solve's exact steps with any: each
+    // that succeeds saves a whole factorization.
     const StaticsWorkspace* preconditioner = may_chord ? chord : may_refine ? &ws : nullptr;
-    if (preconditioner && options_.krylov_steps && preconditioner->cholesky.cheap_to_solve() &&
-        krylov_step(terms, ws, *preconditioner, krylov_target, x, at, log)) {
+    const bool try_krylov =
+        preconditioner && (warm ? options_.krylov_steps && preconditioner->cholesky.cheap_to_solve()
+                                : options_.cold_krylov_steps);
+    if (try_krylov && krylov_step(terms, ws, *preconditioner, warm ? krylov_target : exact_target,
+                                  !warm, x, at, log)) {
       may_chord = may_chord && log.step_length == 1;
       may_refine = may_refine && log.step_length == 1;
       result.log.push_back(log);
       continue;
     }
     may_chord = may_refine = false;
+    // A failed exact Krylov step leaves the true Hessian at x assembled in ws: Newton factors it.
+    const bool assembled = try_krylov && !warm && !log.negative_curvature;
     const Eigen::VectorXd dx =
-        newton_direction(terms, ws, x, at.gradient, log, result.factorizations, stop);
+        newton_direction(terms, ws, x, at.gradient, log, result.factorizations, assembled, stop);
     if (dx.size() == 0 && stop && stop()) {
       if (watch) restore();
       return stopped(result, at, it);
@@ -485,7 +510,9 @@ StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& w
       return result;
     }
     log.relaxed = relax;
-    may_refine = ws.has_preconditioner && (warm || options_.cold_krylov_steps);
+    // In a cold solve, exact Krylov steps follow a full Newton step with the true Hessian only:
+    // after a shorter or a projected one the Hessian has changed too much for its factor.
+    may_refine = ws.has_preconditioner && (warm || (log.step_length == 1 && !log.projected));
     result.log.push_back(log);
   }
 }

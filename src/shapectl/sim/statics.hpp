@@ -52,17 +52,19 @@ struct StaticsOptions {
   int max_iterations = 100;
   // Which sparse Cholesky; by default chosen by system size (SparseCholesky::choose).
   std::optional<SparseCholesky::Backend> backend;
-  // When a chord step fails, a Newton step whose system is solved by conjugate gradients
+  // In a warm solve (one given a nearby factorization, the chord): when a chord step fails, a
+  // Newton step whose system is solved by conjugate gradients
   // preconditioned with the chord's (stale) factorization, before factoring anew: an inexact
   // Newton step (at most krylov_iterations products). The same after the solve's own
   // factorizations, preconditioned with the last one. Where the true Hessian shows negative
   // curvature, the projected one is solved so (a projected Newton step without factoring).
   bool krylov_steps = true;
-  // In a cold solve (no nearby factorization), Krylov steps after its own factorizations too.
-  // From rest Newton needs two or three steps; an inexact second step adds one iteration, and
-  // below ~20,000 unknowns that costs what the factorization it saves does (12k-tet bar: 3
-  // iterations and 39-48 ms with them, 2 and 37-46 ms without; 50k: 0.40 against 0.44 s;
-  // docs/benchmarks.md, session 5).
+  // In a cold solve (no nearby factorization), Krylov steps after its own factorizations too:
+  // exact ones, solved as far as the tolerance (in double precision), so the iterates are
+  // Newton's, one factorization fewer each, and given up as soon as the conjugate gradients'
+  // rate shows the tolerance out of reach in krylov_iterations products. From rest on the 12k
+  // bar: 2 iterations and 1 factorization, 27-29 ms against 40 ms with two factorizations; an
+  // inexact step (the forcing term) took an iteration more (docs/benchmarks.md, session 7).
   bool cold_krylov_steps = true;
   bool chord_steps = true;  // off: a nearby factorization is used by Krylov steps only (tests)
   // How closely a Krylov step solves Newton's system, as a relative residual η (Eisenstat and
@@ -208,25 +210,30 @@ class StaticsSolver {
                   NewtonIterate& log) const;
   // The object's rotation since `chord`'s factorization; the solve with that factor turned by it.
   Mat3 chord_rotation(const StaticsWorkspace& chord, const Positions& x) const;
+  // `rounded`: with the factor in single precision (SparseCholesky::solve_preconditioner).
   Eigen::VectorXd solve_rotated(const StaticsWorkspace& chord, const Mat3& R,
-                                const Eigen::VectorXd& r) const;
+                                const Eigen::VectorXd& r, bool rounded) const;
   // Newton's direction at x by conjugate gradients on the true Hessian (or the projected one;
   // assembled into `ws`, not factored), preconditioned with `chord`'s factorization, to a
   // residual of at most `target`; empty when they do not converge within krylov_iterations
-  // products or meet non-positive curvature (log.negative_curvature then says so).
+  // products or meet non-positive curvature (log.negative_curvature then says so). `exact`: a
+  // cold solve's stand-in for a Newton step (StaticsOptions::cold_krylov_steps), solved in
+  // double precision and given up as soon as its rate shows the target out of reach.
   Eigen::VectorXd krylov_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                    const StaticsWorkspace& chord, const Positions& x,
-                                   const Eigen::VectorXd& g, double target, bool projected,
-                                   NewtonIterate& log) const;
+                                   const Eigen::VectorXd& g, double target, bool exact,
+                                   bool projected, NewtonIterate& log) const;
   // A Krylov step with `chord`'s factorization (see krylov_direction), on the projected Hessian
   // where the true one shows negative curvature; false when neither gives an accepted step.
   bool krylov_step(const EnergyTerms& terms, StaticsWorkspace& ws, const StaticsWorkspace& chord,
-                   double target, Positions& x, Point& at, NewtonIterate& log) const;
+                   double target, bool exact, Positions& x, Point& at, NewtonIterate& log) const;
   // Empty when not even the projected Hessian factors, or when `stop` asks before it is tried.
   // The true Hessian is tried first unless log.negative_curvature says it is indefinite.
+  // `assembled`: ws's assembler already holds the true Hessian at x.
   Eigen::VectorXd newton_direction(const EnergyTerms& terms, StaticsWorkspace& ws,
                                    const Positions& x, const Eigen::VectorXd& g, NewtonIterate& log,
-                                   int& factorizations, const StopRequest& stop) const;
+                                   int& factorizations, bool assembled,
+                                   const StopRequest& stop) const;
   // `result` ended by a stop request at iteration `it`.
   StaticsResult stopped(StaticsResult& result, const Point& at, int it) const;
   // The first of α = 1, 1/2, 1/4, ... whose state lowers the energy enough; relaxed: whose
@@ -242,9 +249,10 @@ class StaticsSolver {
   double energy_noise(double energy) const;
   double max_force(const Eigen::VectorXd& gradient) const;
   void zero_fixed_dofs(Eigen::VectorXd& gradient) const;
-  // Assembles and factors at x into ws; projected = use PSD-projected element Hessians.
-  bool factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
-                 bool projected) const;
+  // Assembles and factors at x into ws; projected = use PSD-projected element Hessians;
+  // assembled: ws's assembler already holds that Hessian at x (only factors).
+  bool factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x, bool projected,
+                 bool assembled) const;
   // Why the projected Hessian factor_at just assembled in ws could not be factored.
   std::string singular_reason(const StaticsWorkspace& ws) const;
 
