@@ -44,12 +44,38 @@ struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
   }
 };
 
-using CholmodLlt = Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower>;
+// CHOLMOD's supernodal LLᵀ, plus its fill-reducing permutation and an analysis that takes one
+// (cholmod_analyze_p with CHOLMOD_GIVEN: the symbolic factorization without ordering anew).
+struct CholmodLlt : Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
+  // perm[k]: the matrix's row and column that comes k-th; as analyzePattern() otherwise.
+  void analyze_with(const SparseMatrix& lower, std::vector<int> perm) {
+    cholmod_common& common = cholmod();
+    if (m_cholmodFactor) cholmod_free_factor(&m_cholmodFactor, &common);
+    cholmod_sparse A = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
+    const int methods = common.nmethods, ordering = common.method[0].ordering;
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_GIVEN;
+    m_cholmodFactor = cholmod_analyze_p(&A, perm.data(), nullptr, 0, &common);
+    common.nmethods = methods;
+    common.method[0].ordering = ordering;
+    m_isInitialized = true;
+    m_info = m_cholmodFactor ? Eigen::Success : Eigen::NumericalIssue;
+    m_analysisIsOk = m_cholmodFactor != nullptr;
+    m_factorizationIsOk = false;
+  }
+  // The analysis's permutation (same convention).
+  std::vector<int> permutation() const {
+    const int* p = static_cast<const int*>(m_cholmodFactor->Perm);
+    return {p, p + m_cholmodFactor->n};
+  }
+};
 
 constexpr int kCholmodDefault = -1;  // CHOLMOD's own strategy instead of one ordering
 
-// Flops of CHOLMOD's factorization of `lower` with an ordering method; *entries: of the factor.
-double cholmod_flops(const SparseMatrix& lower, int ordering, double* entries) {
+// Flops of CHOLMOD's factorization of `lower` with an ordering method; *entries: of the factor,
+// *perm (if given): its permutation.
+double cholmod_flops(const SparseMatrix& lower, int ordering, double* entries,
+                     std::vector<int>* perm = nullptr) {
   SerialOpenMp serial;
   CholmodLlt cholmod;
   cholmod.cholmod().print = 0;
@@ -59,6 +85,7 @@ double cholmod_flops(const SparseMatrix& lower, int ordering, double* entries) {
   }
   cholmod.analyzePattern(lower);
   *entries = cholmod.cholmod().lnz;
+  if (perm) *perm = cholmod.permutation();
   return cholmod.cholmod().fl;
 }
 
@@ -67,12 +94,17 @@ double cholmod_flops(const SparseMatrix& lower, int ordering, double* entries) {
 // METIS too where AMD's factor is dense (over 500 flops per entry of it and 5 entries per
 // entry of the matrix; on the dofs, each node's ratios are 3x and 1x its own). Within 4 % of
 // the dof analysis on the meshes of docs/benchmarks.md, "the back-end choice, again".
-double cholmod_flops_by_nodes(const SparseMatrix& nodes) {
+// *order: the winning ordering of the nodes (reverse_cuthill_mckee's convention).
+double cholmod_flops_by_nodes(const SparseMatrix& nodes, std::vector<int>* order) {
   double entries = 0;
-  const double amd = 27 * cholmod_flops(nodes, CHOLMOD_AMD, &entries);
+  const double amd = 27 * cholmod_flops(nodes, CHOLMOD_AMD, &entries, order);
   const bool dense = amd >= 500 * 9 * entries && entries >= 5 * nodes.nonZeros();
   if (!dense) return amd;
-  return std::min(amd, 27 * cholmod_flops(nodes, CHOLMOD_METIS, &entries));
+  std::vector<int> metis_order;
+  const double metis = 27 * cholmod_flops(nodes, CHOLMOD_METIS, &entries, &metis_order);
+  if (metis >= amd) return amd;
+  *order = std::move(metis_order);
+  return metis;
 }
 
 // The same for Eigen's LDLᵀ (AMD ordering).
@@ -88,6 +120,8 @@ struct SparseCholesky::Impl {
   BandCholesky band;
   CholmodLlt cholmod;
   bool cholmod_blas_threads = false;  // see factorize()
+  // From choose(): CHOLMOD's ordering of the nodes, expanded to the dofs; empty: none.
+  std::vector<int> cholmod_order;
 };
 
 SparseCholesky::SparseCholesky(std::optional<Backend> backend)
@@ -111,7 +145,16 @@ void SparseCholesky::analyze(const SparseMatrix& lower) {
       break;
     case Backend::CholmodSupernodal: {
       SerialOpenMp serial;
-      impl_->cholmod.analyzePattern(lower);
+      // The order the choice found on the nodes: CHOLMOD's own analysis of the dofs would
+      // order their nine times larger graph again (7 of 12 ms on a 12.8k-tet TetGen bar).
+      std::vector<int> order = std::move(impl_->cholmod_order);
+      impl_->cholmod_order.clear();
+      bool analysed = false;
+      if (!order.empty()) {
+        impl_->cholmod.analyze_with(lower, std::move(order));
+        analysed = impl_->cholmod.info() == Eigen::Success;
+      }
+      if (!analysed) impl_->cholmod.analyzePattern(lower);
       impl_->cholmod_blas_threads = impl_->cholmod.cholmod().fl >= kThreadedCholmodFlops;
       break;
     }
@@ -137,7 +180,9 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
   impl_->band.analyze(lower, nodes);
   double sparse_flops = 0;
   if (nodes) {
-    sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes);
+    std::vector<int> order;
+    sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes, &order);
+    if (!order.empty()) impl_->cholmod_order = dof_order(order);
   } else if (small) {
     CountingLdlt ldlt;
     ldlt.analyzePattern(lower);
@@ -150,6 +195,7 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
   const bool band = impl_->band.flops() <= allowance * sparse_flops &&
                     impl_->band.storage_bytes() <= kBandBytesLimit;
   if (!band) impl_->band = BandCholesky();  // its layout (an index per entry) is not needed
+  if (band || small) impl_->cholmod_order.clear();
   return band ? Backend::Band : small ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
 }
 

@@ -64,7 +64,7 @@ struct StaticsOptions {
   // Newton's, one factorization fewer each, and given up as soon as the conjugate gradients'
   // rate shows the tolerance out of reach in krylov_iterations products. From rest on the 12k
   // bar: 2 iterations and 1 factorization, 27-29 ms against 40 ms with two factorizations; an
-  // inexact step (the forcing term) took an iteration more (docs/benchmarks.md, session 7).
+  // inexact step (the forcing term) took an iteration more (docs/benchmarks.md, session 6).
   bool cold_krylov_steps = true;
   bool chord_steps = true;  // off: a nearby factorization is used by Krylov steps only (tests)
   // How closely a Krylov step solves Newton's system, as a relative residual η (Eisenstat and
