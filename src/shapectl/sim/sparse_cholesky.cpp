@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
+#include <tbb/parallel_invoke.h>
 
 #include <shapectl/sim/band_cholesky.hpp>
 #include <shapectl/sim/node_pattern.hpp>
@@ -177,20 +178,23 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
   const bool small = lower.rows() < kCholmodFrom;
   // The sparse flops from the node pattern of a FEM Hessian: a fraction of the analysis time.
   const std::optional<SparseMatrix> nodes = node_pattern(lower);
-  impl_->band.analyze(lower, nodes);
   double sparse_flops = 0;
-  if (nodes) {
-    std::vector<int> order;
-    sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes, &order);
-    if (!order.empty()) impl_->cholmod_order = dof_order(order);
-  } else if (small) {
-    CountingLdlt ldlt;
-    ldlt.analyzePattern(lower);
-    sparse_flops = ldlt.flops();
-  } else {
-    double entries = 0;
-    sparse_flops = cholmod_flops(lower, kCholmodDefault, &entries);
-  }
+  auto estimate_sparse = [&] {
+    if (nodes) {
+      std::vector<int> order;
+      sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes, &order);
+      if (!order.empty()) impl_->cholmod_order = dof_order(order);
+    } else if (small) {
+      CountingLdlt ldlt;
+      ldlt.analyzePattern(lower);
+      sparse_flops = ldlt.flops();
+    } else {
+      double entries = 0;
+      sparse_flops = cholmod_flops(lower, kCholmodDefault, &entries);
+    }
+  };
+  // The two analyses are independent: one on each core.
+  tbb::parallel_invoke([&] { impl_->band.analyze(lower, nodes); }, estimate_sparse);
   const double allowance = small ? kLdltAllowance : kCholmodAllowance;
   const bool band = impl_->band.flops() <= allowance * sparse_flops &&
                     impl_->band.storage_bytes() <= kBandBytesLimit;
