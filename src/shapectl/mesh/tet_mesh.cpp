@@ -32,7 +32,7 @@ TetMesh::TetMesh(std::vector<Vec3> rest_positions, std::vector<std::array<int, 4
   tets_.reserve(tets.size());
   for (std::size_t e = 0; e < tets.size(); ++e) {
     const auto& t = tets[e];
-    // Only for an error: a string per tet costs more than the checks (~0.6 ms at 12k tets).
+    // Made only for an error: a valid mesh should not pay a heap string per tet.
     auto where = [e] { return "element " + std::to_string(e); };
     for (int a = 0; a < 4; ++a) {
       if (t[a] < 0 || t[a] >= n)
