@@ -10,6 +10,7 @@
 #include <shapectl/sim/band_cholesky.hpp>
 #include <shapectl/sim/node_pattern.hpp>
 #include <shapectl/sim/object_statics.hpp>
+#include <shapectl/sim/permuted_cholmod.hpp>
 
 namespace shapectl {
 namespace {
@@ -152,6 +153,46 @@ TEST(SparseCholesky, CholmodGivenTheChoicesNodeOrderSolvesAsWithItsOwnAnalysis) 
   const double scale = H.cwiseAbs().sum() / H.rows() * x.norm();
   EXPECT_LT((H.selfadjointView<Eigen::Lower>() * x - b).norm(), 1e-12 * scale);
   EXPECT_LT((x - y).norm(), 1e-6 * y.norm());
+}
+
+TEST(PermutedCholmod, SolvesInAnyOrderGivenAsInItsOwn) {
+  // CHOLMOD factors P H Pᵀ, gathered by us: in its own order, in a random one (a poor order,
+  // but a permutation all the same) with its supernodes merged as for a small factorization,
+  // and as for a large one.
+  const SparseMatrix H = rest_hessian(clamped_box(Vec3(0.2, 0.2, 0.05), {8, 8, 3}));
+  const int n = static_cast<int>(H.rows());
+  const Eigen::MatrixXd full = SparseMatrix(H.selfadjointView<Eigen::Lower>());
+  const Eigen::MatrixXd rhs = Eigen::MatrixXd::Random(n, 3);
+  const Eigen::MatrixXd reference = full.llt().solve(rhs);
+  std::vector<int> shuffled(n);
+  for (int i = 0; i < n; ++i) shuffled[i] = i;
+  std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(3));
+  for (const auto& [order, flops] :
+       {std::pair{std::vector<int>{}, 0.0}, std::pair{shuffled, 1e6}, std::pair{shuffled, 1e12}}) {
+    PermutedCholmod cholmod;
+    cholmod.analyze(H, order, flops);
+    EXPECT_GT(cholmod.flops(), 0);
+    ASSERT_TRUE(cholmod.factorize(H));
+    EXPECT_LT((cholmod.solve(rhs) - reference).norm(), 1e-9 * reference.norm()) << flops;
+  }
+}
+
+TEST(PermutedCholmod, GathersEachNewMatrixAndRefusesAnIndefiniteOrOtherPattern) {
+  const SparseMatrix H = bar_hessian();
+  PermutedCholmod cholmod;
+  cholmod.analyze(H);
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(H.rows(), -1, 1);
+  ASSERT_TRUE(cholmod.factorize(H));
+  const Eigen::VectorXd x = cholmod.solve(b);
+  ASSERT_TRUE(cholmod.factorize(2 * H));  // same pattern, new values
+  EXPECT_LT((2 * cholmod.solve(b) - x).norm(), 1e-9 * x.norm());
+  SparseMatrix indefinite = H;
+  const int middle = static_cast<int>(H.rows()) / 2;
+  indefinite.coeffRef(middle, middle) = -H.coeff(middle, middle);
+  EXPECT_FALSE(cholmod.factorize(indefinite));
+  SparseMatrix fewer = H;
+  fewer.prune([&](Eigen::Index row, Eigen::Index col, double) { return row != col + 1; });
+  EXPECT_THROW(cholmod.factorize(fewer), std::logic_error);
 }
 
 TEST(NodePattern, AFemHessianIsItsNodePatternInBlocks) {

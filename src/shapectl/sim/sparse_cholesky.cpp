@@ -9,6 +9,7 @@
 
 #include <shapectl/sim/band_cholesky.hpp>
 #include <shapectl/sim/node_pattern.hpp>
+#include <shapectl/sim/permuted_cholmod.hpp>
 #include <shapectl/sim/serial_openmp.hpp>
 
 namespace shapectl {
@@ -45,26 +46,9 @@ struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
   }
 };
 
-// CHOLMOD's supernodal LLᵀ, plus its fill-reducing permutation and an analysis that takes one
-// (cholmod_analyze_p with CHOLMOD_GIVEN: the symbolic factorization without ordering anew).
+// CHOLMOD's supernodal LLᵀ, for its analysis: the flops and the fill-reducing permutation.
 struct CholmodLlt : Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
-  // perm[k]: the matrix's row and column that comes k-th; as analyzePattern() otherwise.
-  void analyze_with(const SparseMatrix& lower, std::vector<int> perm) {
-    cholmod_common& common = cholmod();
-    if (m_cholmodFactor) cholmod_free_factor(&m_cholmodFactor, &common);
-    cholmod_sparse A = Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
-    const int methods = common.nmethods, ordering = common.method[0].ordering;
-    common.nmethods = 1;
-    common.method[0].ordering = CHOLMOD_GIVEN;
-    m_cholmodFactor = cholmod_analyze_p(&A, perm.data(), nullptr, 0, &common);
-    common.nmethods = methods;
-    common.method[0].ordering = ordering;
-    m_isInitialized = true;
-    m_info = m_cholmodFactor ? Eigen::Success : Eigen::NumericalIssue;
-    m_analysisIsOk = m_cholmodFactor != nullptr;
-    m_factorizationIsOk = false;
-  }
-  // The analysis's permutation (same convention).
+  // perm[k]: the matrix's row and column that comes k-th.
   std::vector<int> permutation() const {
     const int* p = static_cast<const int*>(m_cholmodFactor->Perm);
     return {p, p + m_cholmodFactor->n};
@@ -119,19 +103,17 @@ double ldlt_flops_by_nodes(const SparseMatrix& nodes) {
 struct SparseCholesky::Impl {
   CountingLdlt ldlt;
   BandCholesky band;
-  CholmodLlt cholmod;
+  PermutedCholmod cholmod;
   bool cholmod_blas_threads = false;  // see factorize()
   // From choose(): CHOLMOD's ordering of the nodes, expanded to the dofs; empty: none.
   std::vector<int> cholmod_order;
+  double cholmod_order_flops = 0;  // its factorization's flops, estimated
 };
 
 SparseCholesky::SparseCholesky(std::optional<Backend> backend)
     : automatic_(!backend),
       backend_(backend.value_or(Backend::SimplicialLDLT)),
-      impl_(std::make_unique<Impl>()) {
-  // Not positive definite is an expected outcome (we fall back), not something to print.
-  impl_->cholmod.cholmod().print = 0;
-}
+      impl_(std::make_unique<Impl>()) {}
 
 SparseCholesky::~SparseCholesky() = default;
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
@@ -146,17 +128,12 @@ void SparseCholesky::analyze(const SparseMatrix& lower) {
       break;
     case Backend::CholmodSupernodal: {
       SerialOpenMp serial;
-      // The order the choice found on the nodes: CHOLMOD's own analysis of the dofs would
-      // order their nine times larger graph again (7 of 12 ms on a 12.8k-tet TetGen bar).
-      std::vector<int> order = std::move(impl_->cholmod_order);
+      // The order the choice found on the nodes (none when the backend is fixed): CHOLMOD's
+      // own analysis of the dofs would order their nine times larger graph again (7 of 12 ms
+      // on a 12.8k-tet TetGen bar).
+      impl_->cholmod.analyze(lower, std::move(impl_->cholmod_order), impl_->cholmod_order_flops);
       impl_->cholmod_order.clear();
-      bool analysed = false;
-      if (!order.empty()) {
-        impl_->cholmod.analyze_with(lower, std::move(order));
-        analysed = impl_->cholmod.info() == Eigen::Success;
-      }
-      if (!analysed) impl_->cholmod.analyzePattern(lower);
-      impl_->cholmod_blas_threads = impl_->cholmod.cholmod().fl >= kThreadedCholmodFlops;
+      impl_->cholmod_blas_threads = impl_->cholmod.flops() >= kThreadedCholmodFlops;
       break;
     }
   }
@@ -184,6 +161,7 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
       std::vector<int> order;
       sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes, &order);
       if (!order.empty()) impl_->cholmod_order = dof_order(order);
+      impl_->cholmod_order_flops = sparse_flops;
     } else if (small) {
       CountingLdlt ldlt;
       ldlt.analyzePattern(lower);
@@ -220,8 +198,7 @@ bool SparseCholesky::factorize(const SparseMatrix& lower) {
       // "CHOLMOD's OpenMP threads").
       use_blas_threads(impl_->cholmod_blas_threads);
       SerialOpenMp serial;
-      impl_->cholmod.factorize(lower);
-      return impl_->cholmod.info() == Eigen::Success;
+      return impl_->cholmod.factorize(lower);
     }
     case Backend::SimplicialLDLT: break;
   }
@@ -255,7 +232,7 @@ Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& rhs) const {
     case Backend::Band: return impl_->band.solve(rhs).col(0);
     case Backend::CholmodSupernodal: {
       SerialOpenMp serial;
-      return impl_->cholmod.solve(rhs);
+      return impl_->cholmod.solve(rhs).col(0);
     }
     case Backend::SimplicialLDLT: break;
   }

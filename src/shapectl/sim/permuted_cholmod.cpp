@@ -1,0 +1,169 @@
+#include <shapectl/sim/permuted_cholmod.hpp>
+
+#include <Eigen/CholmodSupport>
+#include <algorithm>
+#include <stdexcept>
+
+namespace shapectl {
+
+namespace {
+
+cholmod_sparse lower_view(const SparseMatrix& lower) {
+  return Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
+}
+
+void throw_if_failed(bool ok, const char* what) {
+  if (!ok) throw std::runtime_error(std::string("CHOLMOD could not ") + what + " (out of memory?)");
+}
+
+}  // namespace
+
+struct PermutedCholmod::Impl {
+  cholmod_common common{};
+  cholmod_factor* factor = nullptr;
+  SparseMatrix permuted;   // P A Pᵀ, lower triangle
+  std::vector<int> slot;   // entry k of the analysed matrix's values goes to permuted's slot[k]
+  std::vector<int> order;  // order[k]: the analysed matrix's row that is permuted's row k
+
+  Impl() {
+    cholmod_start(&common);
+    common.print = 0;  // not positive definite is an expected outcome, not something to print
+    common.supernodal = CHOLMOD_SUPERNODAL;
+    common.final_asis = 1;  // keep the supernodal LLᵀ as it is made
+  }
+  ~Impl() {
+    free_factor();
+    cholmod_finish(&common);
+  }
+  void free_factor() {
+    if (factor) cholmod_free_factor(&factor, &common);
+  }
+  // CHOLMOD's own order for `lower`: its default strategy, followed by its postorder.
+  std::vector<int> own_order(const SparseMatrix& lower) {
+    common.nmethods = 0;
+    common.postorder = 1;
+    cholmod_sparse a = lower_view(lower);
+    cholmod_factor* f = cholmod_analyze(&a, &common);
+    throw_if_failed(f != nullptr, "order the Hessian");
+    const int* perm = static_cast<const int*>(f->Perm);
+    std::vector<int> result(perm, perm + f->n);
+    cholmod_free_factor(&f, &common);
+    return result;
+  }
+};
+
+PermutedCholmod::PermutedCholmod() : impl_(std::make_unique<Impl>()) {}
+PermutedCholmod::~PermutedCholmod() = default;
+PermutedCholmod::PermutedCholmod(PermutedCholmod&&) noexcept = default;
+PermutedCholmod& PermutedCholmod::operator=(PermutedCholmod&&) noexcept = default;
+
+void PermutedCholmod::analyze(const SparseMatrix& lower, std::vector<int> order,
+                              double order_flops) {
+  Impl& m = *impl_;
+  m.free_factor();
+  if (order.empty()) {
+    order = m.own_order(lower);
+    order_flops = m.common.fl;
+  }
+  const int n = static_cast<int>(lower.rows());
+  std::vector<int> position(n);
+  for (int k = 0; k < n; ++k) position[order[k]] = k;
+
+  // Entry (i, j) of the lower triangle lands at (max, min) of their positions: count each
+  // permuted column's entries, place them, then sort each column by row.
+  const int* outer = lower.outerIndexPtr();
+  const int* inner = lower.innerIndexPtr();
+  std::vector<int> starts(n + 1, 0);
+  for (int j = 0; j < n; ++j)
+    for (int k = outer[j]; k < outer[j + 1]; ++k)
+      ++starts[std::min(position[inner[k]], position[j]) + 1];
+  for (int c = 0; c < n; ++c) starts[c + 1] += starts[c];
+  struct Landing {
+    int row, entry;
+  };
+  std::vector<Landing> landings(starts[n]);
+  std::vector<int> next(starts.begin(), starts.end() - 1);
+  for (int j = 0; j < n; ++j)
+    for (int k = outer[j]; k < outer[j + 1]; ++k) {
+      const int a = position[inner[k]], b = position[j];
+      landings[next[std::min(a, b)]++] = {std::max(a, b), k};
+    }
+  SparseMatrix& p = m.permuted;
+  p.resize(n, n);
+  p.makeCompressed();
+  p.resizeNonZeros(starts[n]);
+  m.slot.resize(starts[n]);
+  for (int c = 0; c < n; ++c) {
+    std::sort(landings.begin() + starts[c], landings.begin() + starts[c + 1],
+              [](const Landing& x, const Landing& y) { return x.row < y.row; });
+    for (int s = starts[c]; s < starts[c + 1]; ++s) {
+      p.innerIndexPtr()[s] = landings[s].row;
+      m.slot[landings[s].entry] = s;
+    }
+  }
+  std::copy(starts.begin(), starts.end(), p.outerIndexPtr());
+  std::fill(p.valuePtr(), p.valuePtr() + starts[n], 0.0);
+  m.order = std::move(order);
+
+  // The natural order, and no postorder: it would reorder the matrix again.
+  m.common.nmethods = 1;
+  m.common.method[0].ordering = CHOLMOD_NATURAL;
+  m.common.postorder = 0;
+  // Small factorizations are many small supernodes, each a few BLAS calls whose overhead
+  // outweighs their flops: CHOLMOD merges them twice as far (its nrelax and zrelax doubled),
+  // for fewer, larger calls and a few more zeros. A TetGen frame (1.3e7 flops) factors 20 %
+  // faster, a 60x60x1 plate (7e8) 10 %, a 14-cell cube (1.3e9) as fast, a 20-cell cube (1.1e10)
+  // 10 % slower (docs/benchmarks.md, "session 7").
+  constexpr double kMergeMoreBelowFlops = 1e9;
+  const double merge = order_flops < kMergeMoreBelowFlops ? 2 : 1;  // CHOLMOD's defaults times
+  m.common.nrelax[0] = static_cast<std::size_t>(4 * merge);
+  m.common.nrelax[1] = static_cast<std::size_t>(16 * merge);
+  m.common.nrelax[2] = static_cast<std::size_t>(48 * merge);
+  m.common.zrelax[1] = 0.1 * merge;
+  m.common.zrelax[2] = 0.05 * merge;
+  cholmod_sparse a = lower_view(p);
+  m.factor = cholmod_analyze(&a, &m.common);
+  throw_if_failed(m.factor != nullptr, "analyse the Hessian");
+  flops_ = m.common.fl;
+}
+
+bool PermutedCholmod::factorize(const SparseMatrix& lower) {
+  Impl& m = *impl_;
+  if (!m.factor || static_cast<std::size_t>(lower.nonZeros()) != m.slot.size())
+    throw std::logic_error("PermutedCholmod: factorize a matrix of the analysed pattern");
+  const double* from = lower.valuePtr();
+  double* to = m.permuted.valuePtr();
+  for (std::size_t k = 0; k < m.slot.size(); ++k) to[m.slot[k]] = from[k];
+  cholmod_sparse a = lower_view(m.permuted);
+  // On a matrix that is not positive definite CHOLMOD stops at column `minor` < n.
+  return cholmod_factorize(&a, m.factor, &m.common) && m.factor->minor == m.factor->n;
+}
+
+Eigen::MatrixXd PermutedCholmod::solve(const Eigen::MatrixXd& rhs) const {
+  const Impl& m = *impl_;
+  const Eigen::Index n = rhs.rows();
+  Eigen::MatrixXd b(n, rhs.cols());
+  for (Eigen::Index k = 0; k < n; ++k) b.row(k) = rhs.row(m.order[k]);
+  // A CHOLMOD workspace of its own: several threads may solve with one factor at once.
+  cholmod_common common;
+  cholmod_start(&common);
+  common.print = 0;
+  cholmod_dense b_view = Eigen::viewAsCholmod(b);
+  cholmod_dense *solution = nullptr, *work_y = nullptr, *work_e = nullptr;
+  const bool solved = cholmod_solve2(CHOLMOD_A, m.factor, &b_view, nullptr, &solution, nullptr,
+                                     &work_y, &work_e, &common);
+  Eigen::MatrixXd x(n, rhs.cols());
+  if (solved) {
+    const double* values = static_cast<const double*>(solution->x);
+    const Eigen::Index leading = static_cast<Eigen::Index>(solution->d);
+    for (Eigen::Index c = 0; c < rhs.cols(); ++c)
+      for (Eigen::Index k = 0; k < n; ++k) x(m.order[k], c) = values[k + c * leading];
+  }
+  for (cholmod_dense** d : {&solution, &work_y, &work_e})
+    if (*d) cholmod_free_dense(d, &common);
+  cholmod_finish(&common);
+  throw_if_failed(solved, "solve with its factor");
+  return x;
+}
+
+}  // namespace shapectl
