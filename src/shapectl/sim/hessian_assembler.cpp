@@ -26,18 +26,21 @@ class ScatterSink : public ElementHessianSink {
 HessianAssembler::HessianAssembler(int dof_count, std::vector<char> fixed_dof)
     : dof_count_(dof_count), fixed_dof_(std::move(fixed_dof)) {}
 
-const SparseMatrix& HessianAssembler::assemble(const std::vector<const EnergyTerm*>& terms,
-                                               const Positions& x, bool project_psd) {
+void HessianAssembler::learn_pattern(const std::vector<const EnergyTerm*>& terms) {
   asked_.resize(terms.size());
   for (std::size_t t = 0; t < terms.size(); ++t) {
     asked_[t].clear();
     terms[t]->hessian_elements(asked_[t]);
   }
-  pattern_changed_ = !scatter_ || asked_ != elements_;
-  if (pattern_changed_) {
-    std::swap(elements_, asked_);
-    scatter_.emplace(dof_count_, fixed_dof_, elements_, matrix_);
-  }
+  if (scatter_ && asked_ == elements_) return;
+  std::swap(elements_, asked_);
+  scatter_.emplace(dof_count_, fixed_dof_, elements_, matrix_);
+  ++pattern_version_;
+}
+
+const SparseMatrix& HessianAssembler::assemble(const std::vector<const EnergyTerm*>& terms,
+                                               const Positions& x, bool project_psd) {
+  learn_pattern(terms);
   double* values = matrix_.valuePtr();
   std::fill(values, values + matrix_.nonZeros(), 0.0);
   for (std::size_t t = 0; t < terms.size(); ++t) {

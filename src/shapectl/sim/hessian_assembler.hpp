@@ -16,22 +16,26 @@ class HessianAssembler {
  public:
   HessianAssembler(int dof_count, std::vector<char> fixed_dof);
   // ∂²E/∂x² of the sum of `terms` at x (size dof_count); `project_psd` makes each element block
-  // positive semi-definite. `pattern_changed()` then tells if the sparsity pattern is new.
+  // positive semi-definite. A new pattern is built when the terms' elements are new.
   const SparseMatrix& assemble(const std::vector<const EnergyTerm*>& terms, const Positions& x,
                                bool project_psd);
-  bool pattern_changed() const { return pattern_changed_; }
+  // How many patterns were built: a Cholesky analysed at another count must analyse again (a
+  // flag for the last call alone would be lost to a later call with the same elements).
+  int pattern_version() const { return pattern_version_; }
   // The matrix the last assemble() returned.
   const SparseMatrix& matrix() const { return matrix_; }
   const std::vector<char>& fixed_dof() const { return fixed_dof_; }
 
  private:
+  // Builds the pattern and scatter map of the terms' elements, if they are new.
+  void learn_pattern(const std::vector<const EnergyTerm*>& terms);
   int dof_count_;
   std::vector<char> fixed_dof_;
   SparseMatrix matrix_;
   std::vector<ElementNodes> elements_;  // each term's elements the scatter map was built for
   std::vector<ElementNodes> asked_;     // this call's, compared with elements_
   std::optional<HessianScatter> scatter_;
-  bool pattern_changed_ = false;
+  int pattern_version_ = 0;
 };
 
 }  // namespace shapectl

@@ -118,9 +118,9 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
                               bool projected, bool assembled) const {
   const SparseMatrix& H =
       assembled ? ws.assembler.matrix() : assemble_hessian(terms, ws.assembler, x, projected);
-  if (!ws.analyzed || ws.assembler.pattern_changed()) {
+  if (ws.analyzed_pattern != ws.assembler.pattern_version()) {
     ws.cholesky.analyze(H);
-    ws.analyzed = true;
+    ws.analyzed_pattern = ws.assembler.pattern_version();
   }
   const bool ok = ws.cholesky.factorize(H);
   ++total_factorizations;

@@ -129,7 +129,7 @@ struct StaticsWorkspace {
 
   HessianAssembler assembler;
   SparseCholesky cholesky;
-  bool analyzed = false;
+  int analyzed_pattern = 0;  // the assembler's pattern_version() the Cholesky analysed (0: none)
   // The factor is of the true Hessian at `factor_x` (sensitivities and chord steps may use it).
   bool has_factor = false;
   // The factor is of the true or of the projected Hessian at `factor_x` (Krylov steps of the
