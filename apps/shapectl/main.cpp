@@ -5,12 +5,14 @@
 #include <shapectl/io/input_error.hpp>
 
 #include "commands.hpp"
+#include "heap_settings.hpp"
 #include "quiet_blas_threads.hpp"
 #include "shapectl_version.hpp"
 #include "worker_threads.hpp"
 
 int main(int argc, char** argv) {
   shapectl::cli::restart_with_quiet_blas_threads(argv);
+  shapectl::cli::keep_freed_heap_memory();
   shapectl::cli::start_worker_threads();
   // A file size limit (ulimit -f) makes a result write fail with an error, not kill us midway.
   std::signal(SIGXFSZ, SIG_IGN);
