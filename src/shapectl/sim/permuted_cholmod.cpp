@@ -69,39 +69,46 @@ void PermutedCholmod::analyze(const SparseMatrix& lower, std::vector<int> order,
   std::vector<int> position(n);
   for (int k = 0; k < n; ++k) position[order[k]] = k;
 
-  // Entry (i, j) of the lower triangle lands at (max, min) of their positions: count each
-  // permuted column's entries, place them, then sort each column by row.
+  // Entry (i, j) of the lower triangle lands at (max, min) of their positions. Two counting
+  // passes place the entries column by column, rows ascending, without a comparison sort: first
+  // by row, then, row by row in order, into their columns.
   const int* outer = lower.outerIndexPtr();
   const int* inner = lower.innerIndexPtr();
-  std::vector<int> starts(n + 1, 0);
-  for (int j = 0; j < n; ++j)
-    for (int k = outer[j]; k < outer[j + 1]; ++k)
-      ++starts[std::min(position[inner[k]], position[j]) + 1];
-  for (int c = 0; c < n; ++c) starts[c + 1] += starts[c];
-  struct Landing {
-    int row, entry;
-  };
-  std::vector<Landing> landings(starts[n]);
-  std::vector<int> next(starts.begin(), starts.end() - 1);
+  const int entries = static_cast<int>(lower.nonZeros());
+  std::vector<int> row_starts(n + 1, 0), starts(n + 1, 0);
   for (int j = 0; j < n; ++j)
     for (int k = outer[j]; k < outer[j + 1]; ++k) {
       const int a = position[inner[k]], b = position[j];
-      landings[next[std::min(a, b)]++] = {std::max(a, b), k};
+      ++row_starts[std::max(a, b) + 1];
+      ++starts[std::min(a, b) + 1];
+    }
+  for (int r = 0; r < n; ++r) {
+    row_starts[r + 1] += row_starts[r];
+    starts[r + 1] += starts[r];
+  }
+  struct Landing {
+    int column, entry;
+  };
+  std::vector<Landing> by_row(entries);
+  std::vector<int> next(row_starts.begin(), row_starts.end() - 1);
+  for (int j = 0; j < n; ++j)
+    for (int k = outer[j]; k < outer[j + 1]; ++k) {
+      const int a = position[inner[k]], b = position[j];
+      by_row[next[std::max(a, b)]++] = {std::min(a, b), k};
     }
   SparseMatrix& p = m.permuted;
   p.resize(n, n);
   p.makeCompressed();
-  p.resizeNonZeros(starts[n]);
-  m.slot.resize(starts[n]);
-  for (int c = 0; c < n; ++c) {
-    std::sort(landings.begin() + starts[c], landings.begin() + starts[c + 1],
-              [](const Landing& x, const Landing& y) { return x.row < y.row; });
-    for (int s = starts[c]; s < starts[c + 1]; ++s) {
-      p.innerIndexPtr()[s] = landings[s].row;
-      m.slot[landings[s].entry] = s;
-    }
-  }
+  p.resizeNonZeros(entries);
   std::copy(starts.begin(), starts.end(), p.outerIndexPtr());
+  m.slot.resize(entries);
+  next.assign(starts.begin(), starts.end() - 1);
+  for (int r = 0; r < n; ++r)
+    for (int s = row_starts[r]; s < row_starts[r + 1]; ++s) {
+      const int slot = next[by_row[s].column]++;
+      p.innerIndexPtr()[slot] = r;
+      m.slot[by_row[s].entry] = slot;
+    }
   std::fill(p.valuePtr(), p.valuePtr() + starts[n], 0.0);
   m.order = std::move(order);
 
