@@ -2,8 +2,8 @@
 // Sparse Cholesky with the symbolic analysis done once per pattern and reused. Three
 // backends: simplicial LDLᵀ (Eigen), a dense band after reverse Cuthill–McKee (LAPACK; the
 // fastest for bars, box frames and small blocks) and supernodal LLᵀ (CHOLMOD + OpenBLAS, its
-// OpenMP on one thread; for compact and unstructured meshes). Chosen from the matrix unless
-// fixed; the rule's numbers come from bench/statics_bench.cpp and docs/benchmarks.md.
+// OpenMP on one thread, permuted_cholmod.hpp; for compact and unstructured meshes). Chosen from the
+// matrix unless fixed; the rule's numbers come from bench/statics_bench.cpp and docs/benchmarks.md.
 #include <memory>
 #include <optional>
 
