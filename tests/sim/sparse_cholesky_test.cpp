@@ -174,6 +174,8 @@ TEST(PermutedCholmod, SolvesInAnyOrderGivenAsInItsOwn) {
     EXPECT_GT(cholmod.flops(), 0);
     ASSERT_TRUE(cholmod.factorize(H));
     EXPECT_LT((cholmod.solve(rhs) - reference).norm(), 1e-9 * reference.norm()) << flops;
+    const Eigen::VectorXd first = cholmod.solve(Eigen::VectorXd(rhs.col(0)));
+    EXPECT_LT((first - reference.col(0)).norm(), 1e-9 * reference.norm()) << flops;
   }
 }
 

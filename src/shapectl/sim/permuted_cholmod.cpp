@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <stdexcept>
 
+#include <shapectl/sim/supernodal_solve.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -146,31 +148,32 @@ bool PermutedCholmod::factorize(const SparseMatrix& lower) {
   return cholmod_factorize(&a, m.factor, &m.common) && m.factor->minor == m.factor->n;
 }
 
-Eigen::MatrixXd PermutedCholmod::solve(const Eigen::MatrixXd& rhs) const {
-  const Impl& m = *impl_;
+namespace {
+
+// Solves A x = rhs with the factor of P A Pᵀ: rhs gathered into the order, solved in place,
+// scattered back.
+template <typename Matrix>
+Matrix solve_permuted(const cholmod_factor* factor, const std::vector<int>& order,
+                      const Matrix& rhs) {
+  if (!factor || factor->xtype == CHOLMOD_PATTERN)
+    throw std::logic_error("PermutedCholmod: solve after a successful factorization");
   const Eigen::Index n = rhs.rows();
-  Eigen::MatrixXd b(n, rhs.cols());
-  for (Eigen::Index k = 0; k < n; ++k) b.row(k) = rhs.row(m.order[k]);
-  // A CHOLMOD workspace of its own: several threads may solve with one factor at once.
-  cholmod_common common;
-  cholmod_start(&common);
-  common.print = 0;
-  cholmod_dense b_view = Eigen::viewAsCholmod(b);
-  cholmod_dense *solution = nullptr, *work_y = nullptr, *work_e = nullptr;
-  const bool solved = cholmod_solve2(CHOLMOD_A, m.factor, &b_view, nullptr, &solution, nullptr,
-                                     &work_y, &work_e, &common);
-  Eigen::MatrixXd x(n, rhs.cols());
-  if (solved) {
-    const double* values = static_cast<const double*>(solution->x);
-    const Eigen::Index leading = static_cast<Eigen::Index>(solution->d);
-    for (Eigen::Index c = 0; c < rhs.cols(); ++c)
-      for (Eigen::Index k = 0; k < n; ++k) x(m.order[k], c) = values[k + c * leading];
-  }
-  for (cholmod_dense** d : {&solution, &work_y, &work_e})
-    if (*d) cholmod_free_dense(d, &common);
-  cholmod_finish(&common);
-  throw_if_failed(solved, "solve with its factor");
+  Matrix y(n, rhs.cols());
+  for (Eigen::Index k = 0; k < n; ++k) y.row(k) = rhs.row(order[k]);
+  solve_supernodal_in_place(*factor, y);
+  Matrix x(n, rhs.cols());
+  for (Eigen::Index k = 0; k < n; ++k) x.row(order[k]) = y.row(k);
   return x;
+}
+
+}  // namespace
+
+Eigen::MatrixXd PermutedCholmod::solve(const Eigen::MatrixXd& rhs) const {
+  return solve_permuted(impl_->factor, impl_->order, rhs);
+}
+
+Eigen::VectorXd PermutedCholmod::solve(const Eigen::VectorXd& rhs) const {
+  return solve_permuted(impl_->factor, impl_->order, rhs);
 }
 
 }  // namespace shapectl

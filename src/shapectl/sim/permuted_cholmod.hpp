@@ -29,8 +29,9 @@ class PermutedCholmod {
   // Numeric factorization of a matrix with the analysed pattern. False if it is not (numerically)
   // positive definite; the factor is then unusable.
   bool factorize(const SparseMatrix& lower);
-  // Solves with the last successful factorization.
+  // Solves with the last successful factorization. Threads may solve at once.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const;
 
  private:
   struct Impl;

@@ -213,10 +213,7 @@ bool SparseCholesky::factorize(const SparseMatrix& lower) {
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
   switch (backend_) {
     case Backend::Band: return impl_->band.solve(rhs);
-    case Backend::CholmodSupernodal: {
-      SerialOpenMp serial;
-      return impl_->cholmod.solve(rhs);
-    }
+    case Backend::CholmodSupernodal: return impl_->cholmod.solve(rhs);
     case Backend::SimplicialLDLT: break;
   }
   return impl_->ldlt.solve(rhs);
@@ -230,10 +227,7 @@ Eigen::VectorXd SparseCholesky::solve_preconditioner(const Eigen::VectorXd& rhs)
 Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& rhs) const {
   switch (backend_) {
     case Backend::Band: return impl_->band.solve(rhs).col(0);
-    case Backend::CholmodSupernodal: {
-      SerialOpenMp serial;
-      return impl_->cholmod.solve(rhs).col(0);
-    }
+    case Backend::CholmodSupernodal: return impl_->cholmod.solve(rhs);
     case Backend::SimplicialLDLT: break;
   }
   return impl_->ldlt.solve(rhs);
