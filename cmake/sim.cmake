@@ -11,7 +11,7 @@ target_link_libraries(shapectl_sim PUBLIC shapectl_fem shapectl_mesh shapectl_ro
 target_include_directories(shapectl_sim PRIVATE ${SUITESPARSE_INCLUDE})
 
 shapectl_tests(sim shapectl_sim)
-if(TARGET sim_tests)  # supernodal_solve_test.cpp makes CHOLMOD factors of its own
+if(TARGET sim_tests)  # supernodal_llt_test.cpp makes CHOLMOD factors of its own
   target_include_directories(sim_tests PRIVATE ${SUITESPARSE_INCLUDE})
   target_link_libraries(sim_tests PRIVATE ${CHOLMOD_LIB})
 endif()

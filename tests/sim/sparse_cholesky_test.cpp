@@ -156,9 +156,8 @@ TEST(SparseCholesky, CholmodGivenTheChoicesNodeOrderSolvesAsWithItsOwnAnalysis) 
 }
 
 TEST(PermutedCholmod, SolvesInAnyOrderGivenAsInItsOwn) {
-  // CHOLMOD factors P H Pᵀ, gathered by us: in its own order, in a random one (a poor order,
-  // but a permutation all the same) with its supernodes merged as for a small factorization,
-  // and as for a large one.
+  // P H Pᵀ, gathered by us, factored by our kernels and by CHOLMOD's: in CHOLMOD's own order,
+  // and in a random one (a poor order, but a permutation all the same).
   const SparseMatrix H = rest_hessian(clamped_box(Vec3(0.2, 0.2, 0.05), {8, 8, 3}));
   const int n = static_cast<int>(H.rows());
   const Eigen::MatrixXd full = SparseMatrix(H.selfadjointView<Eigen::Lower>());
@@ -167,21 +166,26 @@ TEST(PermutedCholmod, SolvesInAnyOrderGivenAsInItsOwn) {
   std::vector<int> shuffled(n);
   for (int i = 0; i < n; ++i) shuffled[i] = i;
   std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(3));
-  for (const auto& [order, flops] :
-       {std::pair{std::vector<int>{}, 0.0}, std::pair{shuffled, 1e6}, std::pair{shuffled, 1e12}}) {
-    PermutedCholmod cholmod;
-    cholmod.analyze(H, order, flops);
-    EXPECT_GT(cholmod.flops(), 0);
-    ASSERT_TRUE(cholmod.factorize(H));
-    EXPECT_LT((cholmod.solve(rhs) - reference).norm(), 1e-9 * reference.norm()) << flops;
-    const Eigen::VectorXd first = cholmod.solve(Eigen::VectorXd(rhs.col(0)));
-    EXPECT_LT((first - reference.col(0)).norm(), 1e-9 * reference.norm()) << flops;
-  }
+  for (const std::vector<int>& order : {std::vector<int>{}, shuffled})
+    for (const double own_kernels_below : {PermutedCholmod::kOwnKernelsBelowFlops, 0.0}) {
+      SCOPED_TRACE(testing::Message() << "own order " << order.empty() << ", own kernels below "
+                                      << own_kernels_below << " flops");
+      PermutedCholmod cholmod(own_kernels_below);
+      cholmod.analyze(H, order);
+      EXPECT_GT(cholmod.flops(), 0);
+      EXPECT_EQ(cholmod.own_kernels(), own_kernels_below > 0);
+      ASSERT_TRUE(cholmod.factorize(H));
+      EXPECT_LT((cholmod.solve(rhs) - reference).norm(), 1e-9 * reference.norm());
+      const Eigen::VectorXd first = cholmod.solve(Eigen::VectorXd(rhs.col(0)));
+      EXPECT_LT((first - reference.col(0)).norm(), 1e-9 * reference.norm());
+    }
 }
 
-TEST(PermutedCholmod, GathersEachNewMatrixAndRefusesAnIndefiniteOrOtherPattern) {
+class PermutedCholmodKernels : public testing::TestWithParam<double> {};
+
+TEST_P(PermutedCholmodKernels, GathersEachNewMatrixAndRefusesAnIndefiniteOrOtherPattern) {
   const SparseMatrix H = bar_hessian();
-  PermutedCholmod cholmod;
+  PermutedCholmod cholmod(GetParam());
   cholmod.analyze(H);
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(H.rows(), -1, 1);
   ASSERT_TRUE(cholmod.factorize(H));
@@ -192,10 +196,16 @@ TEST(PermutedCholmod, GathersEachNewMatrixAndRefusesAnIndefiniteOrOtherPattern) 
   const int middle = static_cast<int>(H.rows()) / 2;
   indefinite.coeffRef(middle, middle) = -H.coeff(middle, middle);
   EXPECT_FALSE(cholmod.factorize(indefinite));
+  SparseMatrix not_finite = H;
+  not_finite.coeffRef(middle + 1, middle) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(cholmod.factorize(not_finite));
   SparseMatrix fewer = H;
   fewer.prune([&](Eigen::Index row, Eigen::Index col, double) { return row != col + 1; });
   EXPECT_THROW(cholmod.factorize(fewer), std::logic_error);
 }
+
+INSTANTIATE_TEST_SUITE_P(OwnAndCholmods, PermutedCholmodKernels,
+                         testing::Values(PermutedCholmod::kOwnKernelsBelowFlops, 0.0));
 
 TEST(NodePattern, AFemHessianIsItsNodePatternInBlocks) {
   const SparseMatrix H = bar_hessian();  // clamped: the held dofs keep only their diagonal

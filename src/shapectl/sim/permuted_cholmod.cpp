@@ -2,9 +2,10 @@
 
 #include <Eigen/CholmodSupport>
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
-#include <shapectl/sim/supernodal_solve.hpp>
+#include <shapectl/sim/supernodal_llt.hpp>
 
 namespace shapectl {
 
@@ -54,19 +55,16 @@ struct PermutedCholmod::Impl {
   }
 };
 
-PermutedCholmod::PermutedCholmod() : impl_(std::make_unique<Impl>()) {}
+PermutedCholmod::PermutedCholmod(double own_kernels_below_flops)
+    : impl_(std::make_unique<Impl>()), own_kernels_below_flops_(own_kernels_below_flops) {}
 PermutedCholmod::~PermutedCholmod() = default;
 PermutedCholmod::PermutedCholmod(PermutedCholmod&&) noexcept = default;
 PermutedCholmod& PermutedCholmod::operator=(PermutedCholmod&&) noexcept = default;
 
-void PermutedCholmod::analyze(const SparseMatrix& lower, std::vector<int> order,
-                              double order_flops) {
+void PermutedCholmod::analyze(const SparseMatrix& lower, std::vector<int> order) {
   Impl& m = *impl_;
   m.free_factor();
-  if (order.empty()) {
-    order = m.own_order(lower);
-    order_flops = m.common.fl;
-  }
+  if (order.empty()) order = m.own_order(lower);
   const int n = static_cast<int>(lower.rows());
   std::vector<int> position(n);
   for (int k = 0; k < n; ++k) position[order[k]] = k;
@@ -118,18 +116,8 @@ void PermutedCholmod::analyze(const SparseMatrix& lower, std::vector<int> order,
   m.common.nmethods = 1;
   m.common.method[0].ordering = CHOLMOD_NATURAL;
   m.common.postorder = 0;
-  // Small factorizations are many small supernodes, each a few BLAS calls whose overhead
-  // outweighs their flops: CHOLMOD merges them twice as far (its nrelax and zrelax doubled),
-  // for fewer, larger calls and a few more zeros. A TetGen frame (1.3e7 flops) factors 20 %
-  // faster, a 60x60x1 plate (7e8) 10 %, a 14-cell cube (1.3e9) as fast, a 20-cell cube (1.1e10)
-  // 10 % slower (docs/benchmarks.md, "session 7").
-  constexpr double kMergeMoreBelowFlops = 1e9;
-  const double merge = order_flops < kMergeMoreBelowFlops ? 2 : 1;  // CHOLMOD's defaults times
-  m.common.nrelax[0] = static_cast<std::size_t>(4 * merge);
-  m.common.nrelax[1] = static_cast<std::size_t>(16 * merge);
-  m.common.nrelax[2] = static_cast<std::size_t>(48 * merge);
-  m.common.zrelax[1] = 0.1 * merge;
-  m.common.zrelax[2] = 0.05 * merge;
+  // CHOLMOD's own supernode merging (nrelax, zrelax): with our kernels, which make no calls
+  // per supernode, merging twice as far was 5-15 % slower (a TetGen frame and bar, a plate).
   cholmod_sparse a = lower_view(p);
   m.factor = cholmod_analyze(&a, &m.common);
   throw_if_failed(m.factor != nullptr, "analyse the Hessian");
@@ -142,7 +130,19 @@ bool PermutedCholmod::factorize(const SparseMatrix& lower) {
     throw std::logic_error("PermutedCholmod: factorize a matrix of the analysed pattern");
   const double* from = lower.valuePtr();
   double* to = m.permuted.valuePtr();
-  for (std::size_t k = 0; k < m.slot.size(); ++k) to[m.slot[k]] = from[k];
+  bool finite = true;  // CHOLMOD factors a matrix with a NaN "successfully"
+  for (std::size_t k = 0; k < m.slot.size(); ++k) {
+    to[m.slot[k]] = from[k];
+    finite = finite && std::isfinite(from[k]);
+  }
+  if (!finite) return false;
+  if (own_kernels()) {
+    if (m.factor->xtype == CHOLMOD_PATTERN)
+      throw_if_failed(cholmod_change_factor(CHOLMOD_REAL, true, true, true, true, m.factor,
+                                            &m.common),
+                      "allocate its factor");
+    return factorize_supernodal(m.permuted, *m.factor);
+  }
   cholmod_sparse a = lower_view(m.permuted);
   // On a matrix that is not positive definite CHOLMOD stops at column `minor` < n.
   return cholmod_factorize(&a, m.factor, &m.common) && m.factor->minor == m.factor->n;

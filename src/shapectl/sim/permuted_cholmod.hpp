@@ -1,10 +1,10 @@
 #pragma once
-// CHOLMOD's supernodal LLᵀ of P A Pᵀ, with the fill-reducing order P applied by us: the
-// matrix is gathered into that order through a slot per entry (found once), and CHOLMOD
-// analyses and factors it in its natural order. Given an order of its own, CHOLMOD transposes
-// the matrix twice through the permutation at every factorization and permutes every solve:
-// a TetGen frame's factorization took 5.0 ms that way and 3.6 ms this way (docs/benchmarks.md,
-// "session 7").
+// The supernodal LLᵀ of P A Pᵀ, with the fill-reducing order P applied by us: the matrix is
+// gathered into that order through a slot per entry (found once), CHOLMOD analyses it in its
+// natural order, and our kernels factor it and solve with it (supernodal_llt.hpp; CHOLMOD's
+// own for large factorizations). Given an order of its own, CHOLMOD transposes the matrix twice
+// through the permutation at every factorization and permutes every solve: a TetGen frame's
+// factorization took 5.0 ms that way and 3.6 ms this way (docs/benchmarks.md, "session 7").
 #include <memory>
 #include <vector>
 
@@ -14,20 +14,26 @@ namespace shapectl {
 
 class PermutedCholmod {
  public:
-  PermutedCholmod();
+  // Our own kernels factor (supernodal_llt.hpp) below this many flops, where they beat
+  // CHOLMOD on one thread (TetGen frame 2.1x, 14-cell cube 1.1x). Above it CHOLMOD
+  // factors, its BLAS calls on all cores (a 20-cell cube, 1.1e10 flops: 208 ms on 2 threads,
+  // ours 323 ms).
+  static constexpr double kOwnKernelsBelowFlops = 3e9;
+  explicit PermutedCholmod(double own_kernels_below_flops = kOwnKernelsBelowFlops);
   ~PermutedCholmod();
   PermutedCholmod(PermutedCholmod&&) noexcept;
   PermutedCholmod& operator=(PermutedCholmod&&) noexcept;
 
   // Symbolic analysis of `lower` (lower triangle, compressed) in `order`: order[k] is the row
-  // and column that comes k-th, and `order_flops` the factorization's flops in it (an estimate
-  // will do). An empty order: CHOLMOD's own choice (AMD, or METIS where AMD's factor is dense),
-  // then its postorder, with its own flop count.
-  void analyze(const SparseMatrix& lower, std::vector<int> order = {}, double order_flops = 0);
+  // and column that comes k-th. An empty order: CHOLMOD's own choice (AMD, or METIS where AMD's
+  // factor is dense), then its postorder.
+  void analyze(const SparseMatrix& lower, std::vector<int> order = {});
   // The factorization's flops, from the analysis.
   double flops() const { return flops_; }
+  // Whether our own kernels factor, from the analysis's flops.
+  bool own_kernels() const { return flops_ < own_kernels_below_flops_; }
   // Numeric factorization of a matrix with the analysed pattern. False if it is not (numerically)
-  // positive definite; the factor is then unusable.
+  // positive definite or has a non-finite entry; the factor is then unusable.
   bool factorize(const SparseMatrix& lower);
   // Solves with the last successful factorization. Threads may solve at once.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const;
@@ -37,6 +43,7 @@ class PermutedCholmod {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   double flops_ = 0;
+  double own_kernels_below_flops_;
 };
 
 }  // namespace shapectl

@@ -30,12 +30,6 @@ void use_blas_threads(bool many) {
   if (current.exchange(threads) != threads) openblas_set_num_threads(threads);
 }
 
-// CHOLMOD's BLAS calls run on all cores from this many flops a factorization, on one below.
-// Measured on 2 cores, whole solves: one thread 5-15 % faster on a TetGen bar (2e8 flops), the
-// 60x60x1 plate (7e8) and a 14-cell cube (1.3e9); all 10-15 % faster on a 50k-tet box bar
-// (8e9) and a 20-cell cube (1.1e10).
-constexpr double kThreadedCholmodFlops = 3e9;
-
 // Eigen's LDLᵀ, plus the flop count of its factorization from the symbolic analysis.
 struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
   double flops() const {
@@ -107,7 +101,6 @@ struct SparseCholesky::Impl {
   bool cholmod_blas_threads = false;  // see factorize()
   // From choose(): CHOLMOD's ordering of the nodes, expanded to the dofs; empty: none.
   std::vector<int> cholmod_order;
-  double cholmod_order_flops = 0;  // its factorization's flops, estimated
 };
 
 SparseCholesky::SparseCholesky(std::optional<Backend> backend)
@@ -131,9 +124,9 @@ void SparseCholesky::analyze(const SparseMatrix& lower) {
       // The order the choice found on the nodes (none when the backend is fixed): CHOLMOD's
       // own analysis of the dofs would order their nine times larger graph again (7 of 12 ms
       // on a 12.8k-tet TetGen bar).
-      impl_->cholmod.analyze(lower, std::move(impl_->cholmod_order), impl_->cholmod_order_flops);
+      impl_->cholmod.analyze(lower, std::move(impl_->cholmod_order));
       impl_->cholmod_order.clear();
-      impl_->cholmod_blas_threads = impl_->cholmod.flops() >= kThreadedCholmodFlops;
+      impl_->cholmod_blas_threads = !impl_->cholmod.own_kernels();
       break;
     }
   }
@@ -161,7 +154,6 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
       std::vector<int> order;
       sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes, &order);
       if (!order.empty()) impl_->cholmod_order = dof_order(order);
-      impl_->cholmod_order_flops = sparse_flops;
     } else if (small) {
       CountingLdlt ldlt;
       ldlt.analyzePattern(lower);
@@ -193,9 +185,10 @@ bool SparseCholesky::factorize(const SparseMatrix& lower) {
       return positive_definite;
     }
     case Backend::CholmodSupernodal: {
-      // CHOLMOD's OpenMP on one thread (serial_openmp.hpp), its BLAS on all cores only for
-      // large factorizations, whose supernodes are big dense blocks (docs/benchmarks.md,
-      // "CHOLMOD's OpenMP threads").
+      // Below PermutedCholmod::kOwnKernelsBelowFlops our own kernels factor, on this thread.
+      // Above it CHOLMOD does: its OpenMP on one thread (serial_openmp.hpp), its BLAS on all
+      // cores, for large factorizations are big dense blocks (docs/benchmarks.md, "CHOLMOD's
+      // OpenMP threads": all cores 10-15 % faster from 8e9 flops, 5-15 % slower to 1.3e9).
       use_blas_threads(impl_->cholmod_blas_threads);
       SerialOpenMp serial;
       return impl_->cholmod.factorize(lower);

@@ -1,8 +1,9 @@
-#include <shapectl/sim/supernodal_solve.hpp>
+#include <shapectl/sim/supernodal_llt.hpp>
 
 #include <gtest/gtest.h>
 
 #include <Eigen/CholmodSupport>
+#include <limits>
 #include <random>
 #include <stdexcept>
 
@@ -54,7 +55,9 @@ class Factor {
     cholmod_free_factor(&factor_, &common_);
     cholmod_finish(&common_);
   }
-  const cholmod_factor& operator*() const { return *factor_; }
+  cholmod_factor& operator*() const { return *factor_; }
+  void* values() const { return factor_->x; }
+  std::size_t value_count() const { return factor_->xsize; }
 
  private:
   SparseMatrix lower_;
@@ -62,20 +65,28 @@ class Factor {
   cholmod_factor* factor_ = nullptr;
 };
 
+// Solves with CHOLMOD's factor, then again after factoring with our own kernels.
 void expect_solves(const SparseMatrix& lower, const char* what) {
   const Eigen::MatrixXd full = SparseMatrix(lower.selfadjointView<Eigen::Lower>());
-  const Factor factor(lower, true);
-  Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(lower.rows(), -1, 2);
-  const Eigen::VectorXd expected = full.llt().solve(x);
-  solve_supernodal_in_place(*factor, x);
-  EXPECT_LT((x - expected).norm(), 1e-12 * expected.norm()) << what;
-  Eigen::MatrixXd X = Eigen::MatrixXd::Random(lower.rows(), 5);
-  const Eigen::MatrixXd expected_many = full.llt().solve(X);
-  solve_supernodal_in_place(*factor, X);
-  EXPECT_LT((X - expected_many).norm(), 1e-12 * expected_many.norm()) << what;
+  Factor factor(lower, true);
+  for (const bool ours : {false, true}) {
+    SCOPED_TRACE(ours ? "our factor" : "CHOLMOD's factor");
+    if (ours) {
+      std::fill_n(static_cast<double*>(factor.values()), factor.value_count(), 0.0);
+      ASSERT_TRUE(factorize_supernodal(lower, *factor));
+    }
+    Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(lower.rows(), -1, 2);
+    const Eigen::VectorXd expected = full.llt().solve(x);
+    solve_supernodal_in_place(*factor, x);
+    EXPECT_LT((x - expected).norm(), 1e-12 * expected.norm()) << what;
+    Eigen::MatrixXd X = Eigen::MatrixXd::Random(lower.rows(), 5);
+    const Eigen::MatrixXd expected_many = full.llt().solve(X);
+    solve_supernodal_in_place(*factor, X);
+    EXPECT_LT((X - expected_many).norm(), 1e-12 * expected_many.norm()) << what;
+  }
 }
 
-TEST(SupernodalSolve, MatchesADenseSolveForOneAndManyRightHandSides) {
+TEST(SupernodalLlt, FactorsAndSolvesAsADenseLltForOneAndManyRightHandSides) {
   // Many supernodes of all sizes, with rows below them (a random pattern fills in).
   const SparseMatrix sparse = random_spd(300, 3, 7);
   expect_solves(sparse, "random sparse");
@@ -89,7 +100,22 @@ TEST(SupernodalSolve, MatchesADenseSolveForOneAndManyRightHandSides) {
                 "dense");
 }
 
-TEST(SupernodalSolve, RefusesASimplicialFactorOrAnotherSize) {
+TEST(SupernodalLlt, FactorsNoMatrixThatIsNotPositiveDefiniteOrFinite) {
+  const SparseMatrix lower = random_spd(200, 3, 9);
+  const Factor factor(lower, true);
+  ASSERT_TRUE(factorize_supernodal(lower, *factor));
+  SparseMatrix indefinite = lower;
+  indefinite.coeffRef(150, 150) = -1;  // a pivot late in the order
+  EXPECT_FALSE(factorize_supernodal(indefinite, *factor));
+  for (const double bad :
+       {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    SparseMatrix not_finite = lower;
+    not_finite.valuePtr()[not_finite.outerIndexPtr()[10] + 1] = bad;  // below the diagonal
+    EXPECT_FALSE(factorize_supernodal(not_finite, *factor)) << bad;
+  }
+}
+
+TEST(SupernodalLlt, RefusesASimplicialFactorOrAnotherSize) {
   const SparseMatrix lower = random_spd(50, 3, 8);
   Eigen::VectorXd x = Eigen::VectorXd::Ones(50);
   EXPECT_THROW(solve_supernodal_in_place(*Factor(lower, false), x), std::logic_error);

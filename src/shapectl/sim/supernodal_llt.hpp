@@ -1,0 +1,31 @@
+#pragma once
+// The numeric supernodal LLᵀ on a pattern CHOLMOD has analysed, and solves with it: our own
+// kernels on CHOLMOD's symbolic factor (its supernodes, their rows, where their values go).
+//
+// Why not cholmod_factorize and cholmod_solve2: they make a few BLAS calls per supernode, and
+// our factors are many small supernodes (a 12.8k-tet TetGen bar: 1,321 of 7.8 columns on
+// average, a 4.3k-tet TetGen frame: 1,182 of 4), so much of their time went to call overhead.
+// With Eigen's kernels inlined, a TetGen frame factors 2.1x faster, a TetGen bar 1.27x, a
+// 60x60x1 plate 1.2x; one right-hand side solves 1.4-2x faster, several as fast
+// (docs/benchmarks.md, "session 8"). Large factorizations, whose BLAS calls use all cores,
+// stay with CHOLMOD (permuted_cholmod.hpp). The solves need no cholmod_common, so threads may
+// share a factor.
+#include <Eigen/Core>
+#include <cholmod.h>
+
+#include <shapectl/types.hpp>
+
+namespace shapectl {
+
+// Left-looking supernodal Cholesky of `lower` (lower triangle, compressed, of the pattern
+// `factor` was analysed for, in its natural order) into factor.x. `factor`: supernodal, LLᵀ,
+// real, its values allocated (cholmod_change_factor). False if `lower` is not (numerically)
+// positive definite: a pivot ≤ 0; the factor is then unusable.
+bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor);
+
+// Solves L Lᵀ x = b in place, in the factor's order. `factor`: numeric, supernodal, LLᵀ, real
+// (else std::logic_error).
+void solve_supernodal_in_place(const cholmod_factor& factor, Eigen::VectorXd& x);
+void solve_supernodal_in_place(const cholmod_factor& factor, Eigen::MatrixXd& x);
+
+}  // namespace shapectl
