@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/CholmodSupport>
+#include <algorithm>
 #include <limits>
 #include <random>
 #include <stdexcept>
@@ -98,6 +99,68 @@ TEST(SupernodalLlt, FactorsAndSolvesAsADenseLltForOneAndManyRightHandSides) {
   const Eigen::MatrixXd dense = a * a.transpose() + 30 * Eigen::MatrixXd::Identity(30, 30);
   expect_solves(SparseMatrix(dense.triangularView<Eigen::Lower>().toDenseMatrix().sparseView()),
                 "dense");
+}
+
+// The 7-point Laplacian of a cells³ grid plus the identity, in CHOLMOD's fill-reducing order
+// (AMD): an elimination tree with wide branches.
+SparseMatrix ordered_grid_laplacian(int cells) {
+  const int n = cells * cells * cells;
+  auto index = [&](int i, int j, int k) { return (k * cells + j) * cells + i; };
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int k = 0; k < cells; ++k)
+    for (int j = 0; j < cells; ++j)
+      for (int i = 0; i < cells; ++i) {
+        entries.emplace_back(index(i, j, k), index(i, j, k), 7.0);
+        if (i > 0) entries.emplace_back(index(i, j, k), index(i - 1, j, k), -1.0);
+        if (j > 0) entries.emplace_back(index(i, j, k), index(i, j - 1, k), -1.0);
+        if (k > 0) entries.emplace_back(index(i, j, k), index(i, j, k - 1), -1.0);
+      }
+  SparseMatrix lower(n, n);
+  lower.setFromTriplets(entries.begin(), entries.end());
+  cholmod_common common;
+  cholmod_start(&common);
+  common.nmethods = 1;
+  common.method[0].ordering = CHOLMOD_AMD;
+  const SparseMatrix& view = lower;
+  cholmod_sparse a = Eigen::viewAsCholmod(view.selfadjointView<Eigen::Lower>());
+  cholmod_factor* symbolic = cholmod_analyze(&a, &common);
+  const int* order = static_cast<const int*>(symbolic->Perm);
+  Eigen::VectorXi position(n);
+  for (int p = 0; p < n; ++p) position[order[p]] = p;
+  cholmod_free_factor(&symbolic, &common);
+  cholmod_finish(&common);
+  for (auto& e : entries) {
+    const int r = position[e.row()], c = position[e.col()];
+    e = Eigen::Triplet<double>(std::max(r, c), std::min(r, c), e.value());
+  }
+  SparseMatrix ordered(n, n);
+  ordered.setFromTriplets(entries.begin(), entries.end());
+  return ordered;
+}
+
+TEST(SupernodalLlt, FactorsTwoSubtreesAtOnceAsCholmodDoesInOne) {
+  const SparseMatrix lower = ordered_grid_laplacian(18);
+  Factor factor(lower, true);  // by CHOLMOD
+  const std::vector<int> teams = supernodal_teams(*factor);
+  for (const int team : {0, 1, 2})
+    EXPECT_GT(std::count(teams.begin(), teams.end(), team), 0) << "no supernode in team " << team;
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(lower.rows(), -1, 2);
+  Eigen::VectorXd by_cholmod = b, by_ours = b;
+  solve_supernodal_in_place(*factor, by_cholmod);
+  std::fill_n(static_cast<double*>(factor.values()), factor.value_count(), 0.0);
+  ASSERT_TRUE(factorize_supernodal(lower, *factor));
+  solve_supernodal_in_place(*factor, by_ours);
+  EXPECT_LT((by_ours - by_cholmod).norm(), 1e-12 * by_cholmod.norm());
+  const Eigen::VectorXd residual = lower.selfadjointView<Eigen::Lower>() * by_ours - b;
+  EXPECT_LT(residual.norm(), 1e-12 * b.norm());
+  // A pivot that fails in either subtree, or above them, fails the factorization.
+  for (const int team : {0, 1, 2}) {
+    const int k = static_cast<int>(std::find(teams.begin(), teams.end(), team) - teams.begin());
+    const int column = static_cast<const int*>((*factor).super)[k];
+    SparseMatrix indefinite = lower;
+    indefinite.coeffRef(column, column) = -1;
+    EXPECT_FALSE(factorize_supernodal(indefinite, *factor)) << "team " << team;
+  }
 }
 
 TEST(SupernodalLlt, FactorsNoMatrixThatIsNotPositiveDefiniteOrFinite) {

@@ -2,7 +2,10 @@
 
 #include <Eigen/Cholesky>
 #include <algorithm>
+#include <array>
 #include <stdexcept>
+#include <tbb/parallel_invoke.h>
+#include <utility>
 #include <vector>
 
 namespace shapectl {
@@ -86,63 +89,125 @@ void forward_backward(const cholmod_factor& factor, X& x) {
   }
 }
 
-}  // namespace
+constexpr int kAboveBoth = 2;  // a team: factored after both subtrees
 
-bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor) {
-  const Supernodes supernodes(factor);
-  const int n = static_cast<int>(factor.n);
-  if (lower.rows() != n || lower.cols() != n || !lower.isCompressed())
-    throw std::logic_error("supernodal LLᵀ: factorize a compressed matrix of the factor's size");
-  // Left-looking: supernode j first takes its columns of A, then the updates of every earlier
-  // supernode d with rows in j's columns (its descendants), then factors itself. `waiting[j]`
-  // lists those d (linked through next_waiting); once d has updated j it waits for the
-  // supernode of its next row below j's columns, from `next_row[d]` on.
-  std::vector<int> owner(n);  // column → its supernode
-  for (int k = 0; k < supernodes.count(); ++k)
+// Team 0 or 1 for each supernode in one of two disjoint subtrees, kAboveBoth for the rest: from
+// the roots down, the subtree with most of the work is replaced by its children while it has
+// more than half of it; the subtrees left are dealt to the lighter team, largest first. All
+// team 0 where that would leave a team under a tenth of the work, or the work is too small
+// to be worth a second thread.
+std::vector<int> split_in_two(const Supernodes& supernodes) {
+  const int count = supernodes.count();
+  std::vector<int> owner(
+      supernodes.count() ? supernodes[count - 1].first + supernodes[count - 1].columns : 0);
+  for (int k = 0; k < count; ++k)
     for (int c = 0; c < supernodes[k].columns; ++c) owner[supernodes[k].first + c] = k;
-  std::vector<int> waiting(supernodes.count(), -1), next_waiting(supernodes.count(), -1);
-  std::vector<int> next_row(supernodes.count(), 0);
-  auto wait_for_next_row = [&](int d, int position) {
-    const Supernode s = supernodes[d];
-    if (position == s.rows) return;
-    next_row[d] = position;
-    const int target = owner[s.row_index[position]];
-    next_waiting[d] = waiting[target];
-    waiting[target] = d;
+  std::vector<int> parent(count, -1);
+  std::vector<double> subtree(count, 0);
+  double all = 0;
+  for (int k = 0; k < count; ++k) {
+    const Supernode s = supernodes[k];
+    subtree[k] += double(s.columns) * s.rows * s.rows;  // ~ its flops
+    all += double(s.columns) * s.rows * s.rows;
+    if (s.rows > s.columns) {
+      parent[k] = owner[s.row_index[s.columns]];
+      subtree[parent[k]] += subtree[k];
+    }
+  }
+  std::vector<int> team(count, 0);
+  constexpr double kWorthASecondThread = 2e6;  // ~ flops: 0.1-0.2 ms
+  if (all < kWorthASecondThread) return team;
+  std::vector<std::vector<int>> children(count);
+  std::vector<int> frontier;
+  for (int k = 0; k < count; ++k) (parent[k] < 0 ? frontier : children[parent[k]]).push_back(k);
+  std::vector<char> above(count, 0);
+  auto heaviest = [&] {
+    return std::max_element(frontier.begin(), frontier.end(),
+                            [&](int a, int b) { return subtree[a] < subtree[b]; });
   };
-  std::vector<int> local_row(n);  // row → its place in the supernode being factored
-  std::vector<double> work(static_cast<std::size_t>(supernodes.most_rows()) *
-                           supernodes.most_columns());
-  const int* outer = lower.outerIndexPtr();
-  const int* inner = lower.innerIndexPtr();
-  const double* values = lower.valuePtr();
-  for (int j = 0; j < supernodes.count(); ++j) {
-    const Supernode s = supernodes[j];
-    for (int i = 0; i < s.rows; ++i) local_row[s.row_index[i]] = i;
+  double frontier_work = all;
+  while (!frontier.empty() && 2 * subtree[*heaviest()] > frontier_work) {
+    const auto top = heaviest();
+    const int k = *top;
+    frontier.erase(top);
+    above[k] = 1;
+    frontier_work -= double(supernodes[k].columns) * supernodes[k].rows * supernodes[k].rows;
+    frontier.insert(frontier.end(), children[k].begin(), children[k].end());
+  }
+  std::sort(frontier.begin(), frontier.end(),
+            [&](int a, int b) { return subtree[a] > subtree[b]; });
+  std::array<double, 2> load{0, 0};
+  std::vector<int> root_team(count, -1);
+  for (const int k : frontier) {
+    const int t = load[0] <= load[1] ? 0 : 1;
+    root_team[k] = t;
+    load[t] += subtree[k];
+  }
+  if (std::min(load[0], load[1]) < 0.1 * all) return team;
+  for (int k = count - 1; k >= 0; --k)  // parents before children
+    team[k] = above[k] ? kAboveBoth : root_team[k] >= 0 ? root_team[k] : team[parent[k]];
+  return team;
+}
+
+// The left-looking supernodal factorization: supernode j first takes its columns of A, then
+// the updates of every earlier supernode d with rows in j's columns (its descendants), then
+// factors itself. A lane's `waiting[j]` lists those d (linked through next_waiting_); once d has
+// updated j it waits for the supernode of its next row below j's columns, from next_row_[d] on.
+class LeftLooking {
+ public:
+  struct Lane {
+    std::vector<int> waiting;    // supernode → the first descendant waiting for it, or −1
+    std::vector<int> local_row;  // row → its place in the supernode being factored
+    std::vector<double> work;    // one descendant's update
+  };
+
+  LeftLooking(const SparseMatrix& lower, const Supernodes& supernodes)
+      : lower_(lower),
+        supernodes_(supernodes),
+        owner_(lower.rows()),
+        next_waiting_(supernodes.count(), -1),
+        next_row_(supernodes.count(), 0) {
+    for (int k = 0; k < supernodes.count(); ++k)
+      for (int c = 0; c < supernodes[k].columns; ++c) owner_[supernodes[k].first + c] = k;
+  }
+  Lane lane() const {
+    return {std::vector<int>(supernodes_.count(), -1), std::vector<int>(lower_.rows()),
+            std::vector<double>(static_cast<std::size_t>(supernodes_.most_rows()) *
+                                supernodes_.most_columns())};
+  }
+
+  // Factors supernode j with the updates waiting in `lane`; false at a pivot that is not > 0.
+  bool factor(int j, Lane& lane) {
+    const Supernode s = supernodes_[j];
+    for (int i = 0; i < s.rows; ++i) lane.local_row[s.row_index[i]] = i;
     Block block = block_of(s);
     block.setZero();
+    const int* outer = lower_.outerIndexPtr();
+    const int* inner = lower_.innerIndexPtr();
+    const double* values = lower_.valuePtr();
     for (int c = 0; c < s.columns; ++c)
       for (int k = outer[s.first + c]; k < outer[s.first + c + 1]; ++k)
-        block(local_row[inner[k]], c) = values[k];
+        block(lane.local_row[inner[k]], c) = values[k];
     const int end = s.first + s.columns;
-    for (int d = waiting[j]; d != -1;) {
-      const int next = next_waiting[d];
-      const Supernode from = supernodes[d];
+    const int first_waiting = std::exchange(lane.waiting[j], -1);
+    for (int d = first_waiting; d != -1;) {
+      const int next = next_waiting_[d];
+      const Supernode from = supernodes_[d];
       // d's rows from `first` on: those up to `last` are j's columns, all are j's rows.
-      const int first = next_row[d];
+      const int first = next_row_[d];
       int last = first;
       while (last < from.rows && from.row_index[last] < end) ++last;
       const int in_columns = last - first, in_rows = from.rows - first;
       const Block d_block = block_of(from);
-      Block update(work.data(), in_rows, in_columns);
+      Block update(lane.work.data(), in_rows, in_columns);
       update.noalias() =
           d_block.middleRows(first, in_rows) * d_block.middleRows(first, in_columns).transpose();
       for (int c = 0; c < in_columns; ++c) {
         double* column = &block(0, from.row_index[first + c] - s.first);
         for (int r = c; r < in_rows; ++r)
-          column[local_row[from.row_index[first + r]]] -= update(r, c);
+          column[lane.local_row[from.row_index[first + r]]] -= update(r, c);
       }
-      wait_for_next_row(d, last);
+      wait_for_next_row(d, last, lane);
       d = next;
     }
     auto diagonal = block.topRows(s.columns);
@@ -150,12 +215,71 @@ bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor) {
     // LLT stops at a pivot ≤ 0 only; a NaN pivot passes it, and any non-finite entry of A
     // reaches some later pivot through the updates.
     if (llt.info() != Eigen::Success || !diagonal.diagonal().allFinite()) return false;
-    if (s.rows == s.columns) continue;
+    if (s.rows == s.columns) return true;
     auto below = block.bottomRows(s.rows - s.columns);
     diagonal.transpose().triangularView<Eigen::Upper>().solveInPlace<Eigen::OnTheRight>(below);
-    wait_for_next_row(j, s.columns);
+    wait_for_next_row(j, s.columns, lane);
+    return true;
   }
+
+  // Appends `other`'s waiting lists to `into`'s (only supernodes above both subtrees have any
+  // left in both).
+  void join(Lane& into, const Lane& other) {
+    for (int k = 0; k < supernodes_.count(); ++k) {
+      if (other.waiting[k] == -1) continue;
+      int* tail = &into.waiting[k];
+      while (*tail != -1) tail = &next_waiting_[*tail];
+      *tail = other.waiting[k];
+    }
+  }
+
+ private:
+  void wait_for_next_row(int d, int position, Lane& lane) {
+    const Supernode s = supernodes_[d];
+    if (position == s.rows) return;
+    next_row_[d] = position;
+    const int target = owner_[s.row_index[position]];
+    next_waiting_[d] = lane.waiting[target];
+    lane.waiting[target] = d;
+  }
+
+  const SparseMatrix& lower_;
+  const Supernodes& supernodes_;
+  std::vector<int> owner_;  // column → its supernode
+  std::vector<int> next_waiting_, next_row_;
+};
+
+}  // namespace
+
+bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor) {
+  const Supernodes supernodes(factor);
+  const int n = static_cast<int>(factor.n);
+  if (lower.rows() != n || lower.cols() != n || !lower.isCompressed())
+    throw std::logic_error("supernodal LLᵀ: factorize a compressed matrix of the factor's size");
+  LeftLooking left_looking(lower, supernodes);
+  // Two disjoint subtrees of the elimination tree on two threads, then the supernodes above
+  // them on one. Each lane lists its own waiting descendants; those waiting for a supernode
+  // above both subtrees join one list when both are done. The split and the lists depend on
+  // the pattern only, so every run adds the same updates in the same order.
+  const std::vector<int> team = split_in_two(supernodes);
+  std::array<LeftLooking::Lane, 2> lanes{left_looking.lane(), left_looking.lane()};
+  std::array<bool, 2> factored{true, true};
+  auto factor_team = [&](int t) {
+    for (int k = 0; k < supernodes.count() && factored[t]; ++k)
+      if (team[k] == t) factored[t] = left_looking.factor(k, lanes[t]);
+  };
+  if (std::count(team.begin(), team.end(), 1) > 0)
+    tbb::parallel_invoke([&] { factor_team(0); }, [&] { factor_team(1); });
+  else factor_team(0);
+  if (!factored[0] || !factored[1]) return false;
+  left_looking.join(lanes[0], lanes[1]);
+  for (int k = 0; k < supernodes.count(); ++k)
+    if (team[k] == kAboveBoth && !left_looking.factor(k, lanes[0])) return false;
   return true;
+}
+
+std::vector<int> supernodal_teams(const cholmod_factor& factor) {
+  return split_in_two(Supernodes(factor));
 }
 
 void solve_supernodal_in_place(const cholmod_factor& factor, Eigen::VectorXd& x) {
