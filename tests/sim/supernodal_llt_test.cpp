@@ -36,10 +36,11 @@ SparseMatrix random_spd(int n, int per_column, unsigned seed) {
   return lower;
 }
 
-// CHOLMOD's factor of `lower`, supernodal or simplicial, in its natural order.
+// CHOLMOD's factor of `lower`, supernodal or simplicial, in its natural order; numeric, or its
+// symbolic analysis alone.
 class Factor {
  public:
-  Factor(const SparseMatrix& lower, bool supernodal) : lower_(lower) {
+  Factor(const SparseMatrix& lower, bool supernodal, bool numeric = true) : lower_(lower) {
     cholmod_start(&common_);
     common_.print = 0;
     common_.supernodal = supernodal ? CHOLMOD_SUPERNODAL : CHOLMOD_SIMPLICIAL;
@@ -50,7 +51,7 @@ class Factor {
     const SparseMatrix& kept = lower_;
     cholmod_sparse a = Eigen::viewAsCholmod(kept.selfadjointView<Eigen::Lower>());
     factor_ = cholmod_analyze(&a, &common_);
-    EXPECT_TRUE(factor_ && cholmod_factorize(&a, factor_, &common_));
+    EXPECT_TRUE(factor_ && (!numeric || cholmod_factorize(&a, factor_, &common_)));
   }
   ~Factor() {
     cholmod_free_factor(&factor_, &common_);
@@ -74,7 +75,7 @@ void expect_solves(const SparseMatrix& lower, const char* what) {
     SCOPED_TRACE(ours ? "our factor" : "CHOLMOD's factor");
     if (ours) {
       std::fill_n(static_cast<double*>(factor.values()), factor.value_count(), 0.0);
-      ASSERT_TRUE(factorize_supernodal(lower, *factor));
+      ASSERT_TRUE(factorize_supernodal(lower, *factor, supernodal_teams(*factor)));
     }
     Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(lower.rows(), -1, 2);
     const Eigen::VectorXd expected = full.llt().solve(x);
@@ -142,13 +143,14 @@ TEST(SupernodalLlt, FactorsTwoSubtreesAtOnceAsCholmodDoesInOne) {
   const SparseMatrix lower = ordered_grid_laplacian(18);
   Factor factor(lower, true);  // by CHOLMOD
   const std::vector<int> teams = supernodal_teams(*factor);
+  EXPECT_EQ(supernodal_teams(*Factor(lower, true, false)), teams) << "from the analysis alone";
   for (const int team : {0, 1, 2})
     EXPECT_GT(std::count(teams.begin(), teams.end(), team), 0) << "no supernode in team " << team;
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(lower.rows(), -1, 2);
   Eigen::VectorXd by_cholmod = b, by_ours = b;
   solve_supernodal_in_place(*factor, by_cholmod);
   std::fill_n(static_cast<double*>(factor.values()), factor.value_count(), 0.0);
-  ASSERT_TRUE(factorize_supernodal(lower, *factor));
+  ASSERT_TRUE(factorize_supernodal(lower, *factor, teams));
   solve_supernodal_in_place(*factor, by_ours);
   EXPECT_LT((by_ours - by_cholmod).norm(), 1e-12 * by_cholmod.norm());
   const Eigen::VectorXd residual = lower.selfadjointView<Eigen::Lower>() * by_ours - b;
@@ -159,22 +161,22 @@ TEST(SupernodalLlt, FactorsTwoSubtreesAtOnceAsCholmodDoesInOne) {
     const int column = static_cast<const int*>((*factor).super)[k];
     SparseMatrix indefinite = lower;
     indefinite.coeffRef(column, column) = -1;
-    EXPECT_FALSE(factorize_supernodal(indefinite, *factor)) << "team " << team;
+    EXPECT_FALSE(factorize_supernodal(indefinite, *factor, teams)) << "team " << team;
   }
 }
 
 TEST(SupernodalLlt, FactorsNoMatrixThatIsNotPositiveDefiniteOrFinite) {
   const SparseMatrix lower = random_spd(200, 3, 9);
   const Factor factor(lower, true);
-  ASSERT_TRUE(factorize_supernodal(lower, *factor));
+  ASSERT_TRUE(factorize_supernodal(lower, *factor, supernodal_teams(*factor)));
   SparseMatrix indefinite = lower;
   indefinite.coeffRef(150, 150) = -1;  // a pivot late in the order
-  EXPECT_FALSE(factorize_supernodal(indefinite, *factor));
+  EXPECT_FALSE(factorize_supernodal(indefinite, *factor, supernodal_teams(*factor)));
   for (const double bad :
        {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     SparseMatrix not_finite = lower;
     not_finite.valuePtr()[not_finite.outerIndexPtr()[10] + 1] = bad;  // below the diagonal
-    EXPECT_FALSE(factorize_supernodal(not_finite, *factor)) << bad;
+    EXPECT_FALSE(factorize_supernodal(not_finite, *factor, supernodal_teams(*factor))) << bad;
   }
 }
 
@@ -184,6 +186,11 @@ TEST(SupernodalLlt, RefusesASimplicialFactorOrAnotherSize) {
   EXPECT_THROW(solve_supernodal_in_place(*Factor(lower, false), x), std::logic_error);
   Eigen::VectorXd wrong = Eigen::VectorXd::Ones(49);
   EXPECT_THROW(solve_supernodal_in_place(*Factor(lower, true), wrong), std::logic_error);
+  const Factor factor(lower, true);
+  std::vector<int> too_few = supernodal_teams(*factor);
+  too_few.pop_back();
+  EXPECT_THROW(factorize_supernodal(lower, *factor, too_few), std::logic_error);
+  EXPECT_THROW(supernodal_teams(*Factor(lower, false)), std::logic_error);
 }
 
 }  // namespace

@@ -27,6 +27,7 @@ struct PermutedCholmod::Impl {
   SparseMatrix permuted;   // P A Pᵀ, lower triangle
   std::vector<int> slot;   // entry k of the analysed matrix's values goes to permuted's slot[k]
   std::vector<int> order;  // order[k]: the analysed matrix's row that is permuted's row k
+  std::vector<int> teams;  // supernodal_teams of the analysis, for our kernels
 
   Impl() {
     cholmod_start(&common);
@@ -122,6 +123,7 @@ void PermutedCholmod::analyze(const SparseMatrix& lower, std::vector<int> order)
   m.factor = cholmod_analyze(&a, &m.common);
   throw_if_failed(m.factor != nullptr, "analyse the Hessian");
   flops_ = m.common.fl;
+  m.teams = own_kernels() ? supernodal_teams(*m.factor) : std::vector<int>();
 }
 
 bool PermutedCholmod::factorize(const SparseMatrix& lower) {
@@ -141,7 +143,7 @@ bool PermutedCholmod::factorize(const SparseMatrix& lower) {
       throw_if_failed(cholmod_change_factor(CHOLMOD_REAL, true, true, true, true, m.factor,
                                             &m.common),
                       "allocate its factor");
-    return factorize_supernodal(m.permuted, *m.factor);
+    return factorize_supernodal(m.permuted, *m.factor, m.teams);
   }
   cholmod_sparse a = lower_view(m.permuted);
   // On a matrix that is not positive definite CHOLMOD stops at column `minor` < n.

@@ -1,9 +1,10 @@
 #pragma once
 // Sparse Cholesky with the symbolic analysis done once per pattern and reused. Three
 // backends: simplicial LDLᵀ (Eigen), a dense band after reverse Cuthill–McKee (LAPACK; the
-// fastest for bars, box frames and small blocks) and supernodal LLᵀ (CHOLMOD + OpenBLAS, its
-// OpenMP on one thread, permuted_cholmod.hpp; for compact and unstructured meshes). Chosen from the
-// matrix unless fixed; the rule's numbers come from bench/statics_bench.cpp and docs/benchmarks.md.
+// fastest for bars, box frames and small blocks) and supernodal LLᵀ (CHOLMOD's analysis, our
+// kernels or, for large factorizations, CHOLMOD's: permuted_cholmod.hpp; for compact and
+// unstructured meshes). Chosen from the matrix unless fixed; the rule's numbers come from
+// bench/statics_bench.cpp and docs/benchmarks.md.
 #include <memory>
 #include <optional>
 

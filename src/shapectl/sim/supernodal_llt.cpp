@@ -23,15 +23,18 @@ struct Supernode {
 // CHOLMOD's supernodal factor, read through its arrays.
 class Supernodes {
  public:
-  explicit Supernodes(const cholmod_factor& f)
+  // With its values (a numeric factor), or its structure alone.
+  explicit Supernodes(const cholmod_factor& f, bool with_values = true)
       : super_(static_cast<const int*>(f.super)),
         row_starts_(static_cast<const int*>(f.pi)),
         value_starts_(static_cast<const int*>(f.px)),
         row_index_(static_cast<const int*>(f.s)),
         values_(static_cast<double*>(f.x)),
         count_(static_cast<int>(f.nsuper)) {
-    if (!f.is_super || !f.is_ll || f.xtype != CHOLMOD_REAL || f.itype != CHOLMOD_INT || !values_)
-      throw std::logic_error("supernodal LLᵀ: a real supernodal factor with its values");
+    if (!f.is_super || f.itype != CHOLMOD_INT)
+      throw std::logic_error("supernodal LLᵀ: a supernodal factor");
+    if (with_values && (!f.is_ll || f.xtype != CHOLMOD_REAL || !values_))
+      throw std::logic_error("supernodal LLᵀ: a real supernodal LLᵀ factor with its values");
   }
   int count() const { return count_; }
   Supernode operator[](int k) const {
@@ -251,17 +254,19 @@ class LeftLooking {
 
 }  // namespace
 
-bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor) {
+bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor,
+                          const std::vector<int>& team) {
   const Supernodes supernodes(factor);
   const int n = static_cast<int>(factor.n);
   if (lower.rows() != n || lower.cols() != n || !lower.isCompressed())
     throw std::logic_error("supernodal LLᵀ: factorize a compressed matrix of the factor's size");
+  if (team.size() != static_cast<std::size_t>(supernodes.count()))
+    throw std::logic_error("supernodal LLᵀ: a team for each supernode (supernodal_teams)");
   LeftLooking left_looking(lower, supernodes);
   // Two disjoint subtrees of the elimination tree on two threads, then the supernodes above
   // them on one. Each lane lists its own waiting descendants; those waiting for a supernode
   // above both subtrees join one list when both are done. The split and the lists depend on
   // the pattern only, so every run adds the same updates in the same order.
-  const std::vector<int> team = split_in_two(supernodes);
   std::array<LeftLooking::Lane, 2> lanes{left_looking.lane(), left_looking.lane()};
   std::array<bool, 2> factored{true, true};
   auto factor_team = [&](int t) {
@@ -279,7 +284,7 @@ bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor) {
 }
 
 std::vector<int> supernodal_teams(const cholmod_factor& factor) {
-  return split_in_two(Supernodes(factor));
+  return split_in_two(Supernodes(factor, false));
 }
 
 void solve_supernodal_in_place(const cholmod_factor& factor, Eigen::VectorXd& x) {

@@ -18,18 +18,20 @@
 
 namespace shapectl {
 
-// Left-looking supernodal Cholesky of `lower`, on two threads where the elimination tree
-// splits (supernodal_teams), (lower triangle, compressed, of the pattern
-// `factor` was analysed for, in its natural order) into factor.x. `factor`: supernodal, LLᵀ,
-// real, its values allocated (cholmod_change_factor). False if `lower` is not (numerically)
-// positive definite: a pivot ≤ 0; the factor is then unusable.
-bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor);
-
 // Which thread factorize_supernodal gives each supernode: 0 or 1 for the supernodes of two
 // disjoint subtrees of the elimination tree, factored at once; 2 for those above both, after
 // them. All 0 where the tree does not split into two teams of a tenth of the work or more, or
-// the factorization is small.
+// the factorization is small. Depends on the analysis only: find it once per pattern.
+// `factor`: supernodal, symbolic or numeric (else std::logic_error).
 std::vector<int> supernodal_teams(const cholmod_factor& factor);
+
+// Left-looking supernodal Cholesky of `lower` (lower triangle, compressed, of the pattern
+// `factor` was analysed for, in its natural order) into factor.x, on two threads as `teams`
+// (supernodal_teams of this factor) says. `factor`: supernodal, LLᵀ, real, its values
+// allocated (cholmod_change_factor). False if `lower` is not (numerically) positive definite
+// (a pivot ≤ 0) or not finite; the factor is then unusable.
+bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor,
+                          const std::vector<int>& teams);
 
 // Solves L Lᵀ x = b in place, in the factor's order. `factor`: numeric, supernodal, LLᵀ, real
 // (else std::logic_error).
