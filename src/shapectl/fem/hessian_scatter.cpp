@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 namespace shapectl {
@@ -40,6 +41,15 @@ std::vector<int> greedy_colours(const ElementNodes& elements, int node_count) {
 }
 
 constexpr std::size_t kColourGrain = 32;
+constexpr int kPatternElementGrain = 512;
+constexpr int kPatternNodeGrain = 256;
+
+// Runs f(begin, end) over ranges of [0, node_count) on all cores.
+template <typename F>
+void for_node_ranges(int node_count, F&& f) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, node_count, kPatternNodeGrain),
+                    [&](const tbb::blocked_range<int>& range) { f(range.begin(), range.end()); });
+}
 
 }  // namespace
 
@@ -73,7 +83,7 @@ void HessianScatter::build_pattern(int dof_count, const std::vector<char>& fixed
                                    const std::vector<ElementNodes>& elements,
                                    SparseMatrix& pattern) {
   const int node_count = dof_count / 3;
-  // Which elements each node belongs to: (global element, the node's place in it).
+  // Which elements each node belongs to: (term, element, the node's place in it).
   struct Incidence {
     int term, element, place;
   };
@@ -90,122 +100,174 @@ void HessianScatter::build_pattern(int dof_count, const std::vector<char>& fixed
           incidence[next[elements[t].begin(e)[a]]++] = {static_cast<int>(t), static_cast<int>(e),
                                                         a};
   }
+  std::vector<int> free_dofs(node_count);
+  for (int i = 0; i < node_count; ++i)
+    free_dofs[i] = 3 - fixed_dof[3 * i] - fixed_dof[3 * i + 1] - fixed_dof[3 * i + 2];
 
-  // Column 3j + c holds, for each node i ≥ j sharing an element with node j (ascending), the
-  // rows 3i + r ≥ 3j + c of free dofs; a fixed dof's column, and an unused node's, only the
-  // diagonal.
-  std::vector<int> outer(dof_count + 1, 0), inner;
-  std::vector<int> neighbours;
-  std::vector<int> seen(node_count, -1);
-  for (int j = 0; j < node_count; ++j) {
-    neighbours.clear();
+  // Node j's neighbours: the nodes i ≥ j it shares an element with, ascending. Counted, then
+  // written in place, node by node on all cores; `seen` (one per thread) dedupes.
+  tbb::enumerable_thread_specific<std::vector<int>> seen_by_thread(node_count, -1);
+  auto for_each_neighbour = [&](int j, std::vector<int>& seen, auto&& visit) {
     for (int k = incidence_offsets[j]; k < incidence_offsets[j + 1]; ++k) {
       const ElementNodes& term_elements = elements[incidence[k].term];
       const int* nodes = term_elements.begin(incidence[k].element);
       for (int a = 0; a < term_elements.node_count(incidence[k].element); ++a)
         if (nodes[a] >= j && seen[nodes[a]] != j) {
           seen[nodes[a]] = j;
-          neighbours.push_back(nodes[a]);
+          visit(nodes[a]);
         }
     }
-    std::sort(neighbours.begin(), neighbours.end());
-    for (int c = 0; c < 3; ++c) {
-      const int col = 3 * j + c;
-      if (fixed_dof[col] || neighbours.empty()) {
-        inner.push_back(col);
-      } else {
-        for (const int i : neighbours)
-          for (int r = 0; r < 3; ++r)
-            if (3 * i + r >= col && !fixed_dof[3 * i + r]) inner.push_back(3 * i + r);
-      }
-      outer[col + 1] = static_cast<int>(inner.size());
+  };
+  std::vector<int> neighbour_offsets(node_count + 1, 0);
+  for_node_ranges(node_count, [&](int begin, int end) {
+    std::vector<int>& seen = seen_by_thread.local();
+    for (int j = begin; j < end; ++j)
+      for_each_neighbour(j, seen, [&](int) { ++neighbour_offsets[j + 1]; });
+  });
+  for (int j = 0; j < node_count; ++j) neighbour_offsets[j + 1] += neighbour_offsets[j];
+  std::vector<int> neighbours(neighbour_offsets.back());
+  for (auto& seen : seen_by_thread) std::fill(seen.begin(), seen.end(), -1);
+  for_node_ranges(node_count, [&](int begin, int end) {
+    std::vector<int>& seen = seen_by_thread.local();
+    for (int j = begin; j < end; ++j) {
+      int* next = neighbours.data() + neighbour_offsets[j];
+      for_each_neighbour(j, seen, [&](int i) { *next++ = i; });
+      std::sort(neighbours.data() + neighbour_offsets[j], next);
     }
-  }
+  });
+
+  // Column 3j + c holds, for each neighbour i of node j, the rows 3i + r ≥ 3j + c of free dofs;
+  // a fixed dof's column, and an unused node's, only the diagonal.
+  auto column_rows = [&](int col, auto&& visit) {
+    const int j = col / 3;
+    if (fixed_dof[col] || neighbour_offsets[j] == neighbour_offsets[j + 1]) return visit(col);
+    for (int k = neighbour_offsets[j]; k < neighbour_offsets[j + 1]; ++k)
+      for (int row = std::max(3 * neighbours[k], col); row < 3 * neighbours[k] + 3; ++row)
+        if (!fixed_dof[row]) visit(row);
+  };
   pattern.resize(dof_count, dof_count);
   pattern.makeCompressed();
-  pattern.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
-  std::copy(outer.begin(), outer.end(), pattern.outerIndexPtr());
-  std::copy(inner.begin(), inner.end(), pattern.innerIndexPtr());
-  std::fill(pattern.valuePtr(), pattern.valuePtr() + inner.size(), 0.0);
+  int* outer = pattern.outerIndexPtr();
+  outer[0] = 0;
+  for_node_ranges(node_count, [&](int begin, int end) {
+    for (int col = 3 * begin; col < 3 * end; ++col) {
+      int rows = 0;
+      column_rows(col, [&](int) { ++rows; });
+      outer[col + 1] = rows;
+    }
+  });
+  for (int col = 0; col < dof_count; ++col) outer[col + 1] += outer[col];
+  pattern.resizeNonZeros(outer[dof_count]);
+  int* inner = pattern.innerIndexPtr();
+  double* values = pattern.valuePtr();
+  for_node_ranges(node_count, [&](int begin, int end) {
+    for (int col = 3 * begin; col < 3 * end; ++col) {
+      int* next = inner + outer[col];
+      column_rows(col, [&](int row) { *next++ = row; });
+      std::fill(values + outer[col], values + outer[col + 1], 0.0);
+    }
+  });
+  // Where row `row` sits in column `col` (both kept).
+  auto slot = [&](int row, int col) {
+    return static_cast<int>(std::lower_bound(inner + outer[col], inner + outer[col + 1], row) -
+                            inner);
+  };
 
   // Each block entry (row 3i + r, column 3j + c) with i ≥ j and both dofs free lands in
-  // column 3j + c. Between two free nodes the block's rows land contiguously, in each of the
-  // three columns: one start per column (a NodePair) says where. Entries touching a partly held
-  // node are listed one by one (Entry); a fully held node's entries do not land at all.
-  // First how many of each kind each element has, so that the second pass writes them in place.
-  std::vector<int> free_dofs(node_count);
-  for (int i = 0; i < node_count; ++i)
-    free_dofs[i] = 3 - fixed_dof[3 * i] - fixed_dof[3 * i + 1] - fixed_dof[3 * i + 2];
-  pair_offsets_.assign(block_dofs_.size() + 1, 0);
-  entry_offsets_.assign(block_dofs_.size() + 1, 0);
-  bool partly_held = false;
-  for (std::size_t t = 0; t < elements.size(); ++t)
+  // column 3j + c. Between two free nodes the block's rows land contiguously in each of the
+  // three columns (a NodePair). Entries touching a partly held node are listed one by one
+  // (Entry); a fully held node's entries do not land at all. An element lists them by its
+  // node places b, then a. First how many each place has, so that the pass below, node by
+  // node, writes each place's where they go.
+  const int element_count = static_cast<int>(block_dofs_.size());
+  pair_offsets_.assign(element_count + 1, 0);
+  entry_offsets_.assign(element_count + 1, 0);
+  struct Landings {
+    int pairs, entries;  // where the place's first pair and entry go
+  };
+  std::vector<std::vector<Landings>> place_landings(elements.size());
+  Landings next{0, 0};
+  for (std::size_t t = 0; t < elements.size(); ++t) {
+    place_landings[t].resize(elements[t].nodes.size());
     for (std::size_t e = 0; e < elements[t].size(); ++e) {
       const int* nodes = elements[t].begin(e);
-      const int k = elements[t].node_count(e), g = terms_[t].first_element + static_cast<int>(e);
-      for (int b = 0; b < k; ++b)
+      const int k = elements[t].node_count(e);
+      for (int b = 0; b < k; ++b) {
+        place_landings[t][elements[t].offsets[e] + b] = next;
         for (int a = 0; a < k; ++a) {
-          if (nodes[a] < nodes[b]) continue;
-          const int fa = free_dofs[nodes[a]], fb = free_dofs[nodes[b]];
-          if (fa == 3 && fb == 3) ++pair_offsets_[g + 1];
-          else entry_offsets_[g + 1] += nodes[a] == nodes[b] ? fa * (fa + 1) / 2 : fa * fb;
+          const int i = nodes[a], j = nodes[b];
+          if (i < j) continue;
+          const int fi = free_dofs[i], fj = free_dofs[j];
+          if (fi == 3 && fj == 3) ++next.pairs;
+          else next.entries += i == j ? fi * (fi + 1) / 2 : fi * fj;
         }
-      partly_held = partly_held || entry_offsets_[g + 1] > 0;
+      }
+      const int g = terms_[t].first_element + static_cast<int>(e);
+      pair_offsets_[g + 1] = next.pairs;
+      entry_offsets_[g + 1] = next.entries;
     }
-  for (std::size_t g = 0; g < block_dofs_.size(); ++g) {
-    pair_offsets_[g + 1] += pair_offsets_[g];
-    entry_offsets_[g + 1] += entry_offsets_[g];
   }
-  pairs_.reset(new NodePair[pair_offsets_.back()]);  // uninitialised: the pass below writes all
-  entries_.reset(new Entry[entry_offsets_.back()]);
-  std::vector<int> next_pair(pair_offsets_.begin(), pair_offsets_.end() - 1);
-  std::vector<int> next_entry(entry_offsets_.begin(), entry_offsets_.end() - 1);
-  // For node j's columns: where node i's first row sits in column 3j (free nodes), and where
-  // each row sits in each column (`place`, only where some node is partly held).
-  std::vector<int> first_row(node_count, -1);
-  std::vector<int> place(partly_held ? 3 * static_cast<std::size_t>(dof_count) : 0, -1);
-  auto lands = [&](int row, int col) { return row >= col && !fixed_dof[row] && !fixed_dof[col]; };
-  for (int j = 0; j < node_count; ++j) {
-    if (free_dofs[j] == 3)
-      for (int k = outer[3 * j]; k < outer[3 * j + 1]; ++k)
-        if (inner[k] % 3 == 0) first_row[inner[k] / 3] = k;
-    if (partly_held)
-      for (int c = 0; c < 3; ++c)
-        for (int k = outer[3 * j + c]; k < outer[3 * j + c + 1]; ++k) place[3 * inner[k] + c] = k;
-    for (int k = incidence_offsets[j]; k < incidence_offsets[j + 1]; ++k) {
-      const auto [t, e, b] = incidence[k];
-      const ElementNodes& term_elements = elements[t];
-      const int* nodes = term_elements.begin(e);
-      const int g = terms_[t].first_element + e;
-      const int dofs = block_dofs_[g];
-      for (int a = 0; a < term_elements.node_count(e); ++a) {
-        const int i = nodes[a];
-        if (i < j) continue;
-        if (free_dofs[i] == 3 && free_dofs[j] == 3) {
-          NodePair& pair = pairs_[next_pair[g]++];
-          pair.block_column = (3 * b) * dofs + 3 * a;
-          pair.diagonal = i == j;
-          // Column 3j + c holds node j's rows from 3j + c, then node i's three rows.
-          for (int c = 0; c < 3; ++c)
-            pair.start[c] =
-                (i == j ? outer[3 * j + c] : first_row[i] + outer[3 * j + c] - outer[3 * j]) - c;
-          continue;
-        }
-        for (int c = 0; c < 3; ++c)
-          for (int r = 0; r < 3; ++r) {
-            const int row = 3 * i + r, col = 3 * j + c;
-            if (lands(row, col))
-              entries_[next_entry[g]++] = {(3 * b + c) * dofs + 3 * a + r, place[3 * row + c]};
+  pairs_.reset(new NodePair[next.pairs]);  // uninitialised: the pass below writes all
+  entries_.reset(new Entry[next.entries]);
+  // Node by node on all cores, each node j writing the landings of its places in elements.
+  tbb::enumerable_thread_specific<std::vector<int>> first_row_by_thread(node_count, -1);
+  for_node_ranges(node_count, [&](int begin, int end) {
+    std::vector<int>& first_row = first_row_by_thread.local();  // node i's first row in 3j
+    for (int j = begin; j < end; ++j) {
+      if (free_dofs[j] == 3)
+        for (int k = outer[3 * j]; k < outer[3 * j + 1]; ++k)
+          if (inner[k] % 3 == 0) first_row[inner[k] / 3] = k;
+      for (int n = incidence_offsets[j]; n < incidence_offsets[j + 1]; ++n) {
+        const auto [t, e, b] = incidence[n];
+        const int* nodes = elements[t].begin(e);
+        const int k = elements[t].node_count(e), g = terms_[t].first_element + e;
+        const int dofs = block_dofs_[g];
+        const Landings first = place_landings[t][elements[t].offsets[e] + b];
+        NodePair* pair = pairs_.get() + first.pairs;
+        Entry* entry = entries_.get() + first.entries;
+        for (int a = 0; a < k; ++a) {
+          const int i = nodes[a];
+          if (i < j) continue;
+          if (free_dofs[i] == 3 && free_dofs[j] == 3) {
+            *pair++ = {(3 * b) * dofs + 3 * a, first_row[i], outer[3 * j + 1] - outer[3 * j],
+                       i == j};
+            continue;
           }
+          for (int c = 0; c < 3; ++c)
+            for (int r = 0; r < 3; ++r) {
+              const int row = 3 * i + r, col = 3 * j + c;
+              if (row >= col && !fixed_dof[row] && !fixed_dof[col])
+                *entry++ = {(3 * b + c) * dofs + 3 * a + r, slot(row, col)};
+            }
+        }
+        // This place's landings must end where the next place's begin.
+        const Landings last = b + 1 < k ? place_landings[t][elements[t].offsets[e] + b + 1]
+                                        : Landings{pair_offsets_[g + 1], entry_offsets_[g + 1]};
+        if (pair != pairs_.get() + last.pairs || entry != entries_.get() + last.entries)
+          throw std::logic_error("HessianScatter: counted and written entries differ");
       }
     }
-  }
-  // The count above and this pass must agree, element by element.
-  for (std::size_t g = 0; g < next_pair.size(); ++g)
-    if (next_pair[g] != pair_offsets_[g + 1] || next_entry[g] != entry_offsets_[g + 1])
-      throw std::logic_error("HessianScatter: counted and written entries differ");
+  });
   for (int d = 0; d < dof_count; ++d)
     if (fixed_dof[d]) fixed_diagonal_slots_.push_back(outer[d]);
+
+  // The node pattern: node pairs with an entry, i.e. both with a free dof.
+  node_pattern_.resize(node_count, node_count);
+  node_pattern_.makeCompressed();
+  int* node_outer = node_pattern_.outerIndexPtr();
+  node_outer[0] = 0;
+  std::vector<int> node_inner;
+  node_inner.reserve(neighbours.size() + node_count);
+  for (int j = 0; j < node_count; ++j) {
+    node_inner.push_back(j);
+    if (free_dofs[j] > 0)
+      for (int k = neighbour_offsets[j]; k < neighbour_offsets[j + 1]; ++k)
+        if (neighbours[k] > j && free_dofs[neighbours[k]] > 0) node_inner.push_back(neighbours[k]);
+    node_outer[j + 1] = static_cast<int>(node_inner.size());
+  }
+  node_pattern_.resizeNonZeros(static_cast<Eigen::Index>(node_inner.size()));
+  std::copy(node_inner.begin(), node_inner.end(), node_pattern_.innerIndexPtr());
+  std::fill_n(node_pattern_.valuePtr(), node_inner.size(), 0.0);
 }
 
 void HessianScatter::add_blocks(std::size_t term_index, const ElementKernel& kernel,
@@ -239,7 +301,7 @@ void HessianScatter::add_block(int g, const double* block, double* values) const
     const NodePair& pair = pairs_[p];
     for (int c = 0; c < 3; ++c) {
       const double* column = block + pair.block_column + c * dofs;
-      double* to = values + pair.start[c];
+      double* to = values + pair.start + c * pair.column_length - c * (c + 1) / 2;
       for (int r = pair.diagonal ? c : 0; r < 3; ++r) to[r] += column[r];
     }
   }

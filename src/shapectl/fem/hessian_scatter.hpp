@@ -26,6 +26,10 @@ class HessianScatter {
   // Runs `kernel` on every element of term t, colour by colour, the elements of a colour in
   // parallel, and adds each block into `values` (the pattern's value array).
   void add_blocks(std::size_t term, const ElementKernel& kernel, double* values) const;
+  // The pattern's node pairs: (i, j), i ≥ j, where some entry between their dofs lands; every
+  // node's diagonal. nodes × nodes, lower triangle, compressed, zero values (as node_pattern()
+  // in sim/node_pattern.hpp makes it from the dof pattern, for fill-reducing orders).
+  const SparseMatrix& node_pattern() const { return node_pattern_; }
   // Value index of the diagonal entry of each fixed dof.
   const std::vector<int>& fixed_diagonal_slots() const { return fixed_diagonal_slots_; }
 
@@ -42,11 +46,12 @@ class HessianScatter {
   void add_block(int g, const double* block, double* values) const;
   // Where the kept entries of an element's block go. Only entries that land (lower triangle,
   // free dofs) are listed: no test in the hot loop. Between two free nodes i ≥ j, the 3×3 block
-  // whose column c starts at block[block_column + c·3k] adds into values[start[c] + r], rows r
-  // from c on the diagonal (i = j), from 0 below it: 20 bytes for 9 entries.
+  // whose column c starts at block[block_column + c·3k] adds into column 3j + c from rows r = c
+  // on (i = j) or r = 0 (i > j). Node j's columns hold the same rows from the diagonal on, so
+  // column 3j + c is column 3j (column_length entries) shifted: row r of the block goes to
+  // values[start + c·column_length - c(c+1)/2 + r]. 16 bytes for 9 entries.
   struct NodePair {
-    int block_column;
-    int start[3];
+    int block_column, start, column_length;
     bool diagonal;
   };
   // One entry with a partly held node: value index `slot` gets block[entry].
@@ -59,6 +64,7 @@ class HessianScatter {
   std::unique_ptr<NodePair[]> pairs_;
   std::unique_ptr<Entry[]> entries_;
   std::vector<int> fixed_diagonal_slots_;
+  SparseMatrix node_pattern_;
 };
 
 }  // namespace shapectl
