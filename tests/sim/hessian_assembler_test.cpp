@@ -2,12 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <limits>
 #include <random>
 
 #include <shapectl/fem/gravity.hpp>
 #include <shapectl/fem/neo_hookean.hpp>
 #include <shapectl/sim/gripped_object.hpp>
+#include <shapectl/sim/node_pattern.hpp>
 
 #include "support/derivative_check.hpp"
 #include "support/two_arm_scene.hpp"
@@ -118,6 +120,32 @@ TEST(HessianAssembler, KeepsItsPatternForTheSameElementsAndRebuildsItForNewOnes)
   const SparseMatrix& elastic_only = assembler.assemble({&p.elastic}, x2, false);
   EXPECT_EQ(assembler.pattern_version(), 2);
   expect_same_matrix(elastic_only, from_triplets({&p.elastic}, x2, p.fixed_dof, false));
+}
+
+TEST(HessianAssembler, ItsNodePatternIsTheMatrixsWithHeldAndPartlyHeldNodes) {
+  Problem p;
+  int partly = 0;
+  for (int i = 0; i < p.object.node_count(); i += 7)
+    if (!p.fixed_dof[3 * i]) {
+      p.fixed_dof[3 * i + 1 + i % 2] = 1;  // y or z held
+      ++partly;
+    }
+  ASSERT_GT(partly, 3);
+  std::mt19937 rng(5);
+  const Positions x = p.deformed(rng);
+  const GripEnergy grip = p.grip_at(p.object.reference_joints());
+  HessianAssembler assembler(x.size(), p.fixed_dof);
+  const SparseMatrix& H = assembler.assemble({&p.elastic, &p.gravity, &grip}, x, false);
+  expect_same_matrix(H, from_triplets({&p.elastic, &p.gravity, &grip}, x, p.fixed_dof, false));
+  const std::optional<SparseMatrix> expected = node_pattern(H);
+  ASSERT_TRUE(expected);
+  const SparseMatrix& nodes = assembler.node_pattern();
+  ASSERT_EQ(nodes.rows(), expected->rows());
+  ASSERT_EQ(nodes.nonZeros(), expected->nonZeros());
+  EXPECT_TRUE(std::equal(nodes.outerIndexPtr(), nodes.outerIndexPtr() + nodes.cols() + 1,
+                         expected->outerIndexPtr()));
+  EXPECT_TRUE(std::equal(nodes.innerIndexPtr(), nodes.innerIndexPtr() + nodes.nonZeros(),
+                         expected->innerIndexPtr()));
 }
 
 TEST(HessianAssembler, AnInvertedTetLeavesNonFiniteValues) {

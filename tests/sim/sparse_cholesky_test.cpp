@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <random>
 #include <set>
+#include <tuple>
 
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/sim/band_cholesky.hpp>
@@ -156,8 +157,9 @@ TEST(SparseCholesky, CholmodGivenTheChoicesNodeOrderSolvesAsWithItsOwnAnalysis) 
 }
 
 TEST(PermutedCholmod, SolvesInAnyOrderGivenAsInItsOwn) {
-  // P H Pᵀ, gathered by us, factored by our kernels and by CHOLMOD's: in CHOLMOD's own order,
-  // and in a random one (a poor order, but a permutation all the same).
+  // P H Pᵀ, gathered by us, factored by our kernels and by CHOLMOD's: in CHOLMOD's own order of
+  // the dofs, in a random one (a poor order, but a permutation all the same), and in its order
+  // of the nodes (analyze_nodes: whole node blocks).
   const SparseMatrix H = rest_hessian(clamped_box(Vec3(0.2, 0.2, 0.05), {8, 8, 3}));
   const int n = static_cast<int>(H.rows());
   const Eigen::MatrixXd full = SparseMatrix(H.selfadjointView<Eigen::Lower>());
@@ -166,12 +168,17 @@ TEST(PermutedCholmod, SolvesInAnyOrderGivenAsInItsOwn) {
   std::vector<int> shuffled(n);
   for (int i = 0; i < n; ++i) shuffled[i] = i;
   std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(3));
-  for (const std::vector<int>& order : {std::vector<int>{}, shuffled})
+  const std::vector<int> by_nodes{-1};
+  for (const std::vector<int>& order : {std::vector<int>{}, shuffled, by_nodes})
     for (const double own_kernels_below : {PermutedCholmod::kOwnKernelsBelowFlops, 0.0}) {
-      SCOPED_TRACE(testing::Message() << "own order " << order.empty() << ", own kernels below "
-                                      << own_kernels_below << " flops");
+      SCOPED_TRACE(testing::Message() << "order "
+                                      << (order.empty()       ? "CHOLMOD's"
+                                          : order == by_nodes ? "of the nodes"
+                                                              : "random")
+                                      << ", own kernels below " << own_kernels_below << " flops");
       PermutedCholmod cholmod(own_kernels_below);
-      cholmod.analyze(H, order);
+      if (order == by_nodes) cholmod.analyze_nodes(H, *node_pattern(H));
+      else cholmod.analyze(H, order);
       EXPECT_GT(cholmod.flops(), 0);
       EXPECT_EQ(cholmod.own_kernels(), own_kernels_below > 0);
       ASSERT_TRUE(cholmod.factorize(H));
@@ -181,13 +188,24 @@ TEST(PermutedCholmod, SolvesInAnyOrderGivenAsInItsOwn) {
     }
 }
 
-class PermutedCholmodKernels : public testing::TestWithParam<double> {};
+// Our kernels or CHOLMOD's; the analysis of the dofs or of the nodes.
+class PermutedCholmodKernels : public testing::TestWithParam<std::tuple<double, bool>> {
+ protected:
+  PermutedCholmod analysed(const SparseMatrix& H) {
+    const auto [own_kernels_below, by_nodes] = GetParam();
+    PermutedCholmod cholmod(own_kernels_below);
+    if (by_nodes) cholmod.analyze_nodes(H, *node_pattern(H));
+    else cholmod.analyze(H);
+    EXPECT_EQ(cholmod.own_kernels(), own_kernels_below > 0);
+    return cholmod;
+  }
+};
 
 TEST_P(PermutedCholmodKernels, GathersEachNewMatrixAndRefusesAnIndefiniteOrOtherPattern) {
   const SparseMatrix H = bar_hessian();
-  PermutedCholmod cholmod(GetParam());
-  cholmod.analyze(H);
+  PermutedCholmod cholmod = analysed(H);
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(H.rows(), -1, 1);
+  EXPECT_THROW(cholmod.solve(b), std::logic_error) << "no factor yet";
   ASSERT_TRUE(cholmod.factorize(H));
   const Eigen::VectorXd x = cholmod.solve(b);
   ASSERT_TRUE(cholmod.factorize(2 * H));  // same pattern, new values
@@ -196,6 +214,7 @@ TEST_P(PermutedCholmodKernels, GathersEachNewMatrixAndRefusesAnIndefiniteOrOther
   const int middle = static_cast<int>(H.rows()) / 2;
   indefinite.coeffRef(middle, middle) = -H.coeff(middle, middle);
   EXPECT_FALSE(cholmod.factorize(indefinite));
+  EXPECT_THROW(cholmod.solve(b), std::logic_error) << "the failed factor";
   SparseMatrix not_finite = H;
   not_finite.coeffRef(middle + 1, middle) = std::numeric_limits<double>::quiet_NaN();
   EXPECT_FALSE(cholmod.factorize(not_finite));
@@ -204,8 +223,48 @@ TEST_P(PermutedCholmodKernels, GathersEachNewMatrixAndRefusesAnIndefiniteOrOther
   EXPECT_THROW(cholmod.factorize(fewer), std::logic_error);
 }
 
+// A FEM Hessian with partly held nodes too: a held dof keeps only its diagonal, so the node
+// blocks of such a node are not whole.
+TEST_P(PermutedCholmodKernels, SolvesAHessianWithPartlyHeldNodes) {
+  SparseMatrix H = bar_hessian();
+  const std::set<Eigen::Index> held{3 * 30 + 1, 3 * 41, 3 * 41 + 2, 3 * 77 + 2};
+  H.prune([&](Eigen::Index row, Eigen::Index col, double) {
+    return row == col || (!held.count(row) && !held.count(col));
+  });
+  for (const Eigen::Index d : held) H.coeffRef(d, d) = 1;
+  ASSERT_TRUE(node_pattern(H));
+  PermutedCholmod cholmod = analysed(H);
+  ASSERT_TRUE(cholmod.factorize(H));
+  const Eigen::MatrixXd full = SparseMatrix(H.selfadjointView<Eigen::Lower>());
+  const Eigen::MatrixXd rhs = Eigen::MatrixXd::Random(H.rows(), 2);
+  const Eigen::MatrixXd reference = full.llt().solve(rhs);
+  EXPECT_LT((cholmod.solve(rhs) - reference).norm(), 1e-9 * reference.norm());
+}
+
 INSTANTIATE_TEST_SUITE_P(OwnAndCholmods, PermutedCholmodKernels,
-                         testing::Values(PermutedCholmod::kOwnKernelsBelowFlops, 0.0));
+                         testing::Combine(testing::Values(PermutedCholmod::kOwnKernelsBelowFlops,
+                                                          0.0),
+                                          testing::Bool()));
+
+TEST(PermutedCholmod, RefusesANodePatternThatIsNotTheMatrixs) {
+  const SparseMatrix H = bar_hessian();
+  const SparseMatrix nodes = *node_pattern(H);
+  PermutedCholmod cholmod;
+  // A node pair of the matrix missing.
+  SparseMatrix fewer = nodes;
+  fewer.prune([](Eigen::Index row, Eigen::Index col, double) { return row == col; });
+  EXPECT_THROW(cholmod.analyze_nodes(H, fewer), std::logic_error);
+  // A diagonal missing (of a free node, with neighbours).
+  SparseMatrix no_diagonal = nodes;
+  const Eigen::Index middle = nodes.cols() / 2;
+  ASSERT_GT(nodes.col(middle).nonZeros(), 1);
+  no_diagonal.prune(
+      [&](Eigen::Index row, Eigen::Index col, double) { return row != col || row != middle; });
+  EXPECT_THROW(cholmod.analyze_nodes(H, no_diagonal), std::logic_error);
+  // Another size.
+  const SparseMatrix smaller = nodes.topLeftCorner(nodes.rows() - 1, nodes.cols() - 1);
+  EXPECT_THROW(cholmod.analyze_nodes(H, smaller), std::logic_error);
+}
 
 TEST(NodePattern, AFemHessianIsItsNodePatternInBlocks) {
   const SparseMatrix H = bar_hessian();  // clamped: the held dofs keep only their diagonal

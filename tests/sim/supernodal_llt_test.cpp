@@ -58,13 +58,18 @@ class Factor {
     cholmod_finish(&common_);
   }
   cholmod_factor& operator*() const { return *factor_; }
-  void* values() const { return factor_->x; }
+  const SupernodalPattern& pattern() {
+    if (pattern_.count() == 0) pattern_ = supernodal_pattern(*factor_);
+    return pattern_;
+  }
+  double* values() const { return static_cast<double*>(factor_->x); }
   std::size_t value_count() const { return factor_->xsize; }
 
  private:
   SparseMatrix lower_;
   cholmod_common common_{};
   cholmod_factor* factor_ = nullptr;
+  SupernodalPattern pattern_;
 };
 
 // Solves with CHOLMOD's factor, then again after factoring with our own kernels.
@@ -73,17 +78,18 @@ void expect_solves(const SparseMatrix& lower, const char* what) {
   Factor factor(lower, true);
   for (const bool ours : {false, true}) {
     SCOPED_TRACE(ours ? "our factor" : "CHOLMOD's factor");
+    const SupernodalPattern& pattern = factor.pattern();
     if (ours) {
-      std::fill_n(static_cast<double*>(factor.values()), factor.value_count(), 0.0);
-      ASSERT_TRUE(factorize_supernodal(lower, *factor, supernodal_teams(*factor)));
+      std::fill_n(factor.values(), factor.value_count(), 0.0);
+      ASSERT_TRUE(factorize_supernodal(lower, pattern, supernodal_teams(pattern), factor.values()));
     }
     Eigen::VectorXd x = Eigen::VectorXd::LinSpaced(lower.rows(), -1, 2);
     const Eigen::VectorXd expected = full.llt().solve(x);
-    solve_supernodal_in_place(*factor, x);
+    solve_supernodal_in_place(pattern, factor.values(), x);
     EXPECT_LT((x - expected).norm(), 1e-12 * expected.norm()) << what;
     Eigen::MatrixXd X = Eigen::MatrixXd::Random(lower.rows(), 5);
     const Eigen::MatrixXd expected_many = full.llt().solve(X);
-    solve_supernodal_in_place(*factor, X);
+    solve_supernodal_in_place(pattern, factor.values(), X);
     EXPECT_LT((X - expected_many).norm(), 1e-12 * expected_many.norm()) << what;
   }
 }
@@ -142,55 +148,64 @@ SparseMatrix ordered_grid_laplacian(int cells) {
 TEST(SupernodalLlt, FactorsTwoSubtreesAtOnceAsCholmodDoesInOne) {
   const SparseMatrix lower = ordered_grid_laplacian(18);
   Factor factor(lower, true);  // by CHOLMOD
-  const std::vector<int> teams = supernodal_teams(*factor);
-  EXPECT_EQ(supernodal_teams(*Factor(lower, true, false)), teams) << "from the analysis alone";
+  const SupernodalPattern& pattern = factor.pattern();
+  const std::vector<int> teams = supernodal_teams(pattern);
+  EXPECT_EQ(supernodal_teams(Factor(lower, true, false).pattern()), teams)
+      << "from the analysis alone";
   for (const int team : {0, 1, 2})
     EXPECT_GT(std::count(teams.begin(), teams.end(), team), 0) << "no supernode in team " << team;
   const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(lower.rows(), -1, 2);
   Eigen::VectorXd by_cholmod = b, by_ours = b;
-  solve_supernodal_in_place(*factor, by_cholmod);
-  std::fill_n(static_cast<double*>(factor.values()), factor.value_count(), 0.0);
-  ASSERT_TRUE(factorize_supernodal(lower, *factor, teams));
-  solve_supernodal_in_place(*factor, by_ours);
+  solve_supernodal_in_place(pattern, factor.values(), by_cholmod);
+  std::fill_n(factor.values(), factor.value_count(), 0.0);
+  ASSERT_TRUE(factorize_supernodal(lower, pattern, teams, factor.values()));
+  solve_supernodal_in_place(pattern, factor.values(), by_ours);
   EXPECT_LT((by_ours - by_cholmod).norm(), 1e-12 * by_cholmod.norm());
   const Eigen::VectorXd residual = lower.selfadjointView<Eigen::Lower>() * by_ours - b;
   EXPECT_LT(residual.norm(), 1e-12 * b.norm());
   // A pivot that fails in either subtree, or above them, fails the factorization.
   for (const int team : {0, 1, 2}) {
     const int k = static_cast<int>(std::find(teams.begin(), teams.end(), team) - teams.begin());
-    const int column = static_cast<const int*>((*factor).super)[k];
+    const int column = pattern.first_column[k];
     SparseMatrix indefinite = lower;
     indefinite.coeffRef(column, column) = -1;
-    EXPECT_FALSE(factorize_supernodal(indefinite, *factor, teams)) << "team " << team;
+    EXPECT_FALSE(factorize_supernodal(indefinite, pattern, teams, factor.values()))
+        << "team " << team;
   }
 }
 
 TEST(SupernodalLlt, FactorsNoMatrixThatIsNotPositiveDefiniteOrFinite) {
   const SparseMatrix lower = random_spd(200, 3, 9);
-  const Factor factor(lower, true);
-  ASSERT_TRUE(factorize_supernodal(lower, *factor, supernodal_teams(*factor)));
+  Factor factor(lower, true);
+  const SupernodalPattern& pattern = factor.pattern();
+  const std::vector<int> teams = supernodal_teams(pattern);
+  ASSERT_TRUE(factorize_supernodal(lower, pattern, teams, factor.values()));
   SparseMatrix indefinite = lower;
   indefinite.coeffRef(150, 150) = -1;  // a pivot late in the order
-  EXPECT_FALSE(factorize_supernodal(indefinite, *factor, supernodal_teams(*factor)));
+  EXPECT_FALSE(factorize_supernodal(indefinite, pattern, teams, factor.values()));
   for (const double bad :
        {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
     SparseMatrix not_finite = lower;
     not_finite.valuePtr()[not_finite.outerIndexPtr()[10] + 1] = bad;  // below the diagonal
-    EXPECT_FALSE(factorize_supernodal(not_finite, *factor, supernodal_teams(*factor))) << bad;
+    EXPECT_FALSE(factorize_supernodal(not_finite, pattern, teams, factor.values())) << bad;
   }
 }
 
-TEST(SupernodalLlt, RefusesASimplicialFactorOrAnotherSize) {
+TEST(SupernodalLlt, RefusesASimplicialFactorAnotherSizeOrNoValues) {
   const SparseMatrix lower = random_spd(50, 3, 8);
-  Eigen::VectorXd x = Eigen::VectorXd::Ones(50);
-  EXPECT_THROW(solve_supernodal_in_place(*Factor(lower, false), x), std::logic_error);
+  EXPECT_THROW(supernodal_pattern(*Factor(lower, false)), std::logic_error);
+  Factor factor(lower, true);
+  const SupernodalPattern& pattern = factor.pattern();
   Eigen::VectorXd wrong = Eigen::VectorXd::Ones(49);
-  EXPECT_THROW(solve_supernodal_in_place(*Factor(lower, true), wrong), std::logic_error);
-  const Factor factor(lower, true);
-  std::vector<int> too_few = supernodal_teams(*factor);
+  EXPECT_THROW(solve_supernodal_in_place(pattern, factor.values(), wrong), std::logic_error);
+  Eigen::VectorXd x = Eigen::VectorXd::Ones(50);
+  EXPECT_THROW(solve_supernodal_in_place(pattern, nullptr, x), std::logic_error);
+  std::vector<int> too_few = supernodal_teams(pattern);
   too_few.pop_back();
-  EXPECT_THROW(factorize_supernodal(lower, *factor, too_few), std::logic_error);
-  EXPECT_THROW(supernodal_teams(*Factor(lower, false)), std::logic_error);
+  EXPECT_THROW(factorize_supernodal(lower, pattern, too_few, factor.values()), std::logic_error);
+  const SparseMatrix smaller = random_spd(49, 3, 8);
+  EXPECT_THROW(factorize_supernodal(smaller, pattern, supernodal_teams(pattern), factor.values()),
+               std::logic_error);
 }
 
 }  // namespace

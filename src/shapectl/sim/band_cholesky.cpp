@@ -198,9 +198,12 @@ void blocked_band_solve(const BandBlocks& blocks, int n, double* b, int columns)
 }
 }  // namespace
 
-void BandCholesky::analyze(const SparseMatrix& lower) { analyze(lower, node_pattern(lower)); }
+void BandCholesky::analyze(const SparseMatrix& lower) {
+  const std::optional<SparseMatrix> nodes = node_pattern(lower);
+  analyze(lower, nodes ? &*nodes : nullptr);
+}
 
-void BandCholesky::analyze(const SparseMatrix& lower, const std::optional<SparseMatrix>& nodes) {
+void BandCholesky::analyze(const SparseMatrix& lower, const SparseMatrix* nodes) {
   size_ = static_cast<int>(lower.rows());
   // On a FEM Hessian, the ordering of its nodes: the same band at a ninth of the work.
   const std::vector<int> order =

@@ -21,8 +21,8 @@ class BandCholesky {
  public:
   // Ordering and band layout for this pattern (lower triangle, compressed).
   void analyze(const SparseMatrix& lower);
-  // The same with the node pattern of `lower` (node_pattern.hpp) already found, or nullopt.
-  void analyze(const SparseMatrix& lower, const std::optional<SparseMatrix>& nodes);
+  // The same with the node pattern of `lower` (node_pattern.hpp) already found, or null.
+  void analyze(const SparseMatrix& lower, const SparseMatrix* nodes);
   int bandwidth() const { return bandwidth_; }  // sub-diagonals in the band
   // Floating-point operations of one factorization, ~ Σ (column length)².
   double flops() const;

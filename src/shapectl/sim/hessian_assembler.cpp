@@ -26,16 +26,16 @@ class ScatterSink : public ElementHessianSink {
 HessianAssembler::HessianAssembler(int dof_count, std::vector<char> fixed_dof)
     : dof_count_(dof_count), fixed_dof_(std::move(fixed_dof)) {}
 
-void HessianAssembler::learn_pattern(const std::vector<const EnergyTerm*>& terms) {
+int HessianAssembler::learn_pattern(const std::vector<const EnergyTerm*>& terms) {
   asked_.resize(terms.size());
   for (std::size_t t = 0; t < terms.size(); ++t) {
     asked_[t].clear();
     terms[t]->hessian_elements(asked_[t]);
   }
-  if (scatter_ && asked_ == elements_) return;
+  if (scatter_ && asked_ == elements_) return pattern_version_;
   std::swap(elements_, asked_);
   scatter_.emplace(dof_count_, fixed_dof_, elements_, matrix_);
-  ++pattern_version_;
+  return ++pattern_version_;
 }
 
 const SparseMatrix& HessianAssembler::assemble(const std::vector<const EnergyTerm*>& terms,

@@ -22,13 +22,16 @@ class HessianAssembler {
   // How many patterns were built: a Cholesky analysed at another count must analyse again (a
   // flag for the last call alone would be lost to a later call with the same elements).
   int pattern_version() const { return pattern_version_; }
+  // Builds the pattern and scatter map of the terms' elements, if they are new (assemble()
+  // does); the matrix's values are then to be assembled. Returns pattern_version().
+  int learn_pattern(const std::vector<const EnergyTerm*>& terms);
+  // The node pattern of the matrix (HessianScatter::node_pattern), for fill-reducing orders.
+  const SparseMatrix& node_pattern() const { return scatter_->node_pattern(); }
   // The matrix the last assemble() returned.
   const SparseMatrix& matrix() const { return matrix_; }
   const std::vector<char>& fixed_dof() const { return fixed_dof_; }
 
  private:
-  // Builds the pattern and scatter map of the terms' elements, if they are new.
-  void learn_pattern(const std::vector<const EnergyTerm*>& terms);
   int dof_count_;
   std::vector<char> fixed_dof_;
   SparseMatrix matrix_;

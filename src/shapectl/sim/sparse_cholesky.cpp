@@ -40,57 +40,23 @@ struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {
   }
 };
 
-// CHOLMOD's supernodal LLᵀ, for its analysis: the flops and the fill-reducing permutation.
-struct CholmodLlt : Eigen::CholmodSupernodalLLT<SparseMatrix, Eigen::Lower> {
-  // perm[k]: the matrix's row and column that comes k-th.
-  std::vector<int> permutation() const {
-    const int* p = static_cast<const int*>(m_cholmodFactor->Perm);
-    return {p, p + m_cholmodFactor->n};
-  }
-};
-
-constexpr int kCholmodDefault = -1;  // CHOLMOD's own strategy instead of one ordering
-
-// Flops of CHOLMOD's factorization of `lower` with an ordering method; *entries: of the factor,
-// *perm (if given): its permutation.
-double cholmod_flops(const SparseMatrix& lower, int ordering, double* entries,
-                     std::vector<int>* perm = nullptr) {
-  SerialOpenMp serial;
-  CholmodLlt cholmod;
-  cholmod.cholmod().print = 0;
-  if (ordering != kCholmodDefault) {
-    cholmod.cholmod().nmethods = 1;
-    cholmod.cholmod().method[0].ordering = ordering;
-  }
-  cholmod.analyzePattern(lower);
-  *entries = cholmod.cholmod().lnz;
-  if (perm) *perm = cholmod.permutation();
-  return cholmod.cholmod().fl;
-}
-
-// Flops of the sparse factorization CHOLMOD would make, without its analysis of the dofs:
-// found on the node pattern (node_pattern.hpp) by CHOLMOD's own default rule, AMD and then
-// METIS too where AMD's factor is dense (over 500 flops per entry of it and 5 entries per
-// entry of the matrix; on the dofs, each node's ratios are 3x and 1x its own). Within 4 % of
-// the dof analysis on the meshes of docs/benchmarks.md, "the back-end choice, again".
-// *order: the winning ordering of the nodes (reverse_cuthill_mckee's convention).
-double cholmod_flops_by_nodes(const SparseMatrix& nodes, std::vector<int>* order) {
-  double entries = 0;
-  const double amd = 27 * cholmod_flops(nodes, CHOLMOD_AMD, &entries, order);
-  const bool dense = amd >= 500 * 9 * entries && entries >= 5 * nodes.nonZeros();
-  if (!dense) return amd;
-  std::vector<int> metis_order;
-  const double metis = 27 * cholmod_flops(nodes, CHOLMOD_METIS, &entries, &metis_order);
-  if (metis >= amd) return amd;
-  *order = std::move(metis_order);
-  return metis;
-}
-
-// The same for Eigen's LDLᵀ (AMD ordering).
+// Flops of Eigen's LDLᵀ (AMD ordering) of a matrix in node blocks, from its node pattern: a
+// node column of length c stands for three dof columns of about 3c (node_pattern.hpp).
 double ldlt_flops_by_nodes(const SparseMatrix& nodes) {
   CountingLdlt ldlt;
   ldlt.analyzePattern(nodes);
   return 27 * ldlt.flops();
+}
+
+// CHOLMOD's analysis, on the node pattern where `lower` has one (`nodes`, or found here):
+// analysing the dofs orders a nine times larger graph (7 of 12 ms on a 12.8k-tet TetGen bar).
+void analyze_sparse(PermutedCholmod& cholmod, const SparseMatrix& lower,
+                    const SparseMatrix* nodes) {
+  SerialOpenMp serial;
+  std::optional<SparseMatrix> found;
+  if (!nodes && (found = node_pattern(lower))) nodes = &*found;
+  if (nodes) cholmod.analyze_nodes(lower, *nodes);
+  else cholmod.analyze(lower);
 }
 }  // namespace
 
@@ -99,8 +65,7 @@ struct SparseCholesky::Impl {
   BandCholesky band;
   PermutedCholmod cholmod;
   bool cholmod_blas_threads = false;  // see factorize()
-  // From choose(): CHOLMOD's ordering of the nodes, expanded to the dofs; empty: none.
-  std::vector<int> cholmod_order;
+  bool cholmod_analysed = false;      // by choose(): analyze() need not analyse again
 };
 
 SparseCholesky::SparseCholesky(std::optional<Backend> backend)
@@ -112,27 +77,23 @@ SparseCholesky::~SparseCholesky() = default;
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
-void SparseCholesky::analyze(const SparseMatrix& lower) {
-  if (automatic_) backend_ = choose(lower);
+void SparseCholesky::analyze(const SparseMatrix& lower, const SparseMatrix* nodes) {
+  impl_->cholmod_analysed = false;
+  if (automatic_) backend_ = choose(lower, nodes);
   switch (backend_) {
     case Backend::SimplicialLDLT: impl_->ldlt.analyzePattern(lower); break;
     case Backend::Band:
       if (!automatic_) impl_->band.analyze(lower);  // choose() did
       break;
-    case Backend::CholmodSupernodal: {
-      SerialOpenMp serial;
-      // The order the choice found on the nodes (none when the backend is fixed): CHOLMOD's
-      // own analysis of the dofs would order their nine times larger graph again (7 of 12 ms
-      // on a 12.8k-tet TetGen bar).
-      impl_->cholmod.analyze(lower, std::move(impl_->cholmod_order));
-      impl_->cholmod_order.clear();
+    case Backend::CholmodSupernodal:
+      if (!impl_->cholmod_analysed) analyze_sparse(impl_->cholmod, lower, nodes);
       impl_->cholmod_blas_threads = !impl_->cholmod.own_kernels();
       break;
-    }
   }
 }
 
-SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
+SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower,
+                                               const SparseMatrix* nodes) {
   // The band Cholesky after reverse Cuthill–McKee runs at several times the flop rate of the
   // sparse ones (dense kernels), so it is the faster while it does at most a few times their
   // flops. Measured on 2 cores with CHOLMOD on one thread (docs/benchmarks.md, "the back-end
@@ -147,20 +108,21 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
   constexpr int kCholmodFrom = 2500;  // unknowns
   const bool small = lower.rows() < kCholmodFrom;
   // The sparse flops from the node pattern of a FEM Hessian: a fraction of the analysis time.
-  const std::optional<SparseMatrix> nodes = node_pattern(lower);
+  // CHOLMOD's come from its analysis, kept if it wins.
+  std::optional<SparseMatrix> found;
+  if (!nodes && (found = node_pattern(lower))) nodes = &*found;
   double sparse_flops = 0;
   auto estimate_sparse = [&] {
-    if (nodes) {
-      std::vector<int> order;
-      sparse_flops = small ? ldlt_flops_by_nodes(*nodes) : cholmod_flops_by_nodes(*nodes, &order);
-      if (!order.empty()) impl_->cholmod_order = dof_order(order);
+    if (nodes && small) {
+      sparse_flops = ldlt_flops_by_nodes(*nodes);
     } else if (small) {
       CountingLdlt ldlt;
       ldlt.analyzePattern(lower);
       sparse_flops = ldlt.flops();
     } else {
-      double entries = 0;
-      sparse_flops = cholmod_flops(lower, kCholmodDefault, &entries);
+      analyze_sparse(impl_->cholmod, lower, nodes);
+      impl_->cholmod_analysed = true;
+      sparse_flops = impl_->cholmod.flops();
     }
   };
   // The two analyses are independent: one on each core.
@@ -168,8 +130,9 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower) {
   const double allowance = small ? kLdltAllowance : kCholmodAllowance;
   const bool band = impl_->band.flops() <= allowance * sparse_flops &&
                     impl_->band.storage_bytes() <= kBandBytesLimit;
-  if (!band) impl_->band = BandCholesky();  // its layout (an index per entry) is not needed
-  if (band || small) impl_->cholmod_order.clear();
+  if (!band) impl_->band = BandCholesky();       // its layout (an index per entry) is not needed
+  if (band) impl_->cholmod = PermutedCholmod();  // nor CHOLMOD's analysis
+  impl_->cholmod_analysed = impl_->cholmod_analysed && !band;
   return band ? Backend::Band : small ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
 }
 

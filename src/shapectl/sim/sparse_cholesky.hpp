@@ -24,8 +24,9 @@ class SparseCholesky {
   SparseCholesky& operator=(SparseCholesky&&) noexcept;
   // The backend in use (decided by the first analyze() when automatic).
   Backend backend() const { return backend_; }
-  // Symbolic analysis; call again only when the pattern changes.
-  void analyze(const SparseMatrix& lower);
+  // Symbolic analysis; call again only when the pattern changes. `nodes`: the node pattern of
+  // `lower` (node_pattern.hpp), if the caller has it (HessianAssembler does); else it is found.
+  void analyze(const SparseMatrix& lower, const SparseMatrix* nodes = nullptr);
   // Numeric factorization of the lower-triangle matrix. False if it is not (numerically)
   // positive definite; the factor is then unusable.
   bool factorize(const SparseMatrix& lower);
@@ -43,7 +44,7 @@ class SparseCholesky {
 
  private:
   // The automatic choice; leaves the band analyzed.
-  Backend choose(const SparseMatrix& lower);
+  Backend choose(const SparseMatrix& lower, const SparseMatrix* nodes);
   struct Impl;
   bool automatic_;
   Backend backend_;

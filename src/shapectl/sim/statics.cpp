@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <tbb/parallel_invoke.h>
 
 #include <shapectl/sim/rigid_motion.hpp>
 
@@ -116,12 +117,19 @@ const SparseMatrix& assemble_hessian(const EnergyTerms& terms, HessianAssembler&
 
 bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x,
                               bool projected, bool assembled) const {
+  auto analyze = [&] {
+    ws.cholesky.analyze(ws.assembler.matrix(), &ws.assembler.node_pattern());
+    ws.analyzed_pattern = ws.assembler.pattern_version();
+  };
+  if (!assembled && ws.assembler.learn_pattern(terms) != ws.analyzed_pattern) {
+    // A new pattern: its symbolic analysis, which reads the pattern alone, beside the assembly
+    // of the values; the two share the cores.
+    tbb::parallel_invoke(analyze, [&] { assemble_hessian(terms, ws.assembler, x, projected); });
+    assembled = true;
+  }
   const SparseMatrix& H =
       assembled ? ws.assembler.matrix() : assemble_hessian(terms, ws.assembler, x, projected);
-  if (ws.analyzed_pattern != ws.assembler.pattern_version()) {
-    ws.cholesky.analyze(H);
-    ws.analyzed_pattern = ws.assembler.pattern_version();
-  }
+  if (ws.analyzed_pattern != ws.assembler.pattern_version()) analyze();
   const bool ok = ws.cholesky.factorize(H);
   ++total_factorizations;
   ws.has_factor = ok && !projected;

@@ -20,39 +20,28 @@ struct Supernode {
   const int* row_index;  // all `rows` of them, ascending
 };
 
-// CHOLMOD's supernodal factor, read through its arrays.
+// A supernodal pattern with its values (or without, for the structure alone).
 class Supernodes {
  public:
-  // With its values (a numeric factor), or its structure alone.
-  explicit Supernodes(const cholmod_factor& f, bool with_values = true)
-      : super_(static_cast<const int*>(f.super)),
-        row_starts_(static_cast<const int*>(f.pi)),
-        value_starts_(static_cast<const int*>(f.px)),
-        row_index_(static_cast<const int*>(f.s)),
-        values_(static_cast<double*>(f.x)),
-        count_(static_cast<int>(f.nsuper)) {
-    if (!f.is_super || f.itype != CHOLMOD_INT)
-      throw std::logic_error("supernodal LLᵀ: a supernodal factor");
-    if (with_values && (!f.is_ll || f.xtype != CHOLMOD_REAL || !values_))
-      throw std::logic_error("supernodal LLᵀ: a real supernodal LLᵀ factor with its values");
-  }
-  int count() const { return count_; }
+  Supernodes(const SupernodalPattern& pattern, double* values)
+      : pattern_(pattern), values_(values) {}
+  int count() const { return pattern_.count(); }
+  int size() const { return pattern_.size(); }
   Supernode operator[](int k) const {
-    return {super_[k], super_[k + 1] - super_[k], row_starts_[k + 1] - row_starts_[k],
-            values_ + value_starts_[k], row_index_ + row_starts_[k]};
+    return {pattern_.first_column[k], pattern_.columns(k), pattern_.rows(k),
+            values_ + pattern_.value_starts[k], pattern_.row_index.data() + pattern_.row_starts[k]};
   }
-  int most_rows() const { return most(row_starts_); }
-  int most_columns() const { return most(super_); }
+  int most_rows() const { return most(pattern_.row_starts); }
+  int most_columns() const { return most(pattern_.first_column); }
 
  private:
-  int most(const int* starts) const {
+  int most(const std::vector<int>& starts) const {
     int result = 0;
-    for (int k = 0; k < count_; ++k) result = std::max(result, starts[k + 1] - starts[k]);
+    for (int k = 0; k < count(); ++k) result = std::max(result, starts[k + 1] - starts[k]);
     return result;
   }
-  const int *super_, *row_starts_, *value_starts_, *row_index_;
+  const SupernodalPattern& pattern_;
   double* values_;
-  int count_;
 };
 
 using Block = Eigen::Map<Eigen::MatrixXd>;
@@ -61,9 +50,11 @@ Block block_of(const Supernode& s) { return Block(s.values, s.rows, s.columns); 
 // Forward (L y = b, supernodes in order) then backward (Lᵀ x = y, in reverse). A supernode's
 // rows below its diagonal block touch x only through gathers and scatters of those rows.
 template <typename X>
-void forward_backward(const cholmod_factor& factor, X& x) {
-  const Supernodes supernodes(factor);
-  if (x.rows() != static_cast<Eigen::Index>(factor.n))
+void forward_backward(const SupernodalPattern& pattern, const double* values, X& x) {
+  if (!values) throw std::logic_error("supernodal LLᵀ: solve with a factor's values");
+  // Read only: Supernodes hands out writable blocks, which the solve does not write.
+  const Supernodes supernodes(pattern, const_cast<double*>(values));
+  if (x.rows() != static_cast<Eigen::Index>(pattern.size()))
     throw std::logic_error("supernodal LLᵀ: solve as many rows as the factor has");
   std::vector<double> work(static_cast<std::size_t>(supernodes.most_rows()) * x.cols());
   for (int k = 0; k < supernodes.count(); ++k) {
@@ -101,8 +92,7 @@ constexpr int kAboveBoth = 2;  // a team: factored after both subtrees
 // to be worth a second thread.
 std::vector<int> split_in_two(const Supernodes& supernodes) {
   const int count = supernodes.count();
-  std::vector<int> owner(
-      supernodes.count() ? supernodes[count - 1].first + supernodes[count - 1].columns : 0);
+  std::vector<int> owner(supernodes.size());
   for (int k = 0; k < count; ++k)
     for (int c = 0; c < supernodes[k].columns; ++c) owner[supernodes[k].first + c] = k;
   std::vector<int> parent(count, -1);
@@ -254,10 +244,10 @@ class LeftLooking {
 
 }  // namespace
 
-bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor,
-                          const std::vector<int>& team) {
-  const Supernodes supernodes(factor);
-  const int n = static_cast<int>(factor.n);
+bool factorize_supernodal(const SparseMatrix& lower, const SupernodalPattern& pattern,
+                          const std::vector<int>& team, double* values) {
+  const Supernodes supernodes(pattern, values);
+  const int n = pattern.size();
   if (lower.rows() != n || lower.cols() != n || !lower.isCompressed())
     throw std::logic_error("supernodal LLᵀ: factorize a compressed matrix of the factor's size");
   if (team.size() != static_cast<std::size_t>(supernodes.count()))
@@ -283,16 +273,18 @@ bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor,
   return true;
 }
 
-std::vector<int> supernodal_teams(const cholmod_factor& factor) {
-  return split_in_two(Supernodes(factor, false));
+std::vector<int> supernodal_teams(const SupernodalPattern& pattern) {
+  return split_in_two(Supernodes(pattern, nullptr));
 }
 
-void solve_supernodal_in_place(const cholmod_factor& factor, Eigen::VectorXd& x) {
-  forward_backward(factor, x);
+void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
+                               Eigen::VectorXd& x) {
+  forward_backward(pattern, values, x);
 }
 
-void solve_supernodal_in_place(const cholmod_factor& factor, Eigen::MatrixXd& x) {
-  forward_backward(factor, x);
+void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
+                               Eigen::MatrixXd& x) {
+  forward_backward(pattern, values, x);
 }
 
 }  // namespace shapectl

@@ -1,6 +1,6 @@
 #pragma once
-// The numeric supernodal LLᵀ on a pattern CHOLMOD has analysed, and solves with it: our own
-// kernels on CHOLMOD's symbolic factor (its supernodes, their rows, where their values go).
+// The numeric supernodal LLᵀ on a supernodal pattern (supernodal_pattern.hpp: found by
+// CHOLMOD's analysis, of the dofs or of the nodes), and solves with it: our own kernels.
 //
 // Why not cholmod_factorize and cholmod_solve2: they make a few BLAS calls per supernode, and
 // our factors are many small supernodes (a 12.8k-tet TetGen bar: 1,321 of 7.8 columns on
@@ -11,9 +11,9 @@
 // stay with CHOLMOD (permuted_cholmod.hpp). The solves need no cholmod_common, so threads may
 // share a factor.
 #include <Eigen/Core>
-#include <cholmod.h>
 #include <vector>
 
+#include <shapectl/sim/supernodal_pattern.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {
@@ -21,21 +21,22 @@ namespace shapectl {
 // Which thread factorize_supernodal gives each supernode: 0 or 1 for the supernodes of two
 // disjoint subtrees of the elimination tree, factored at once; 2 for those above both, after
 // them. All 0 where the tree does not split into two teams of a tenth of the work or more, or
-// the factorization is small. Depends on the analysis only: find it once per pattern.
-// `factor`: supernodal, symbolic or numeric (else std::logic_error).
-std::vector<int> supernodal_teams(const cholmod_factor& factor);
+// the factorization is small. Depends on the pattern only: find it once per analysis.
+std::vector<int> supernodal_teams(const SupernodalPattern& pattern);
 
-// Left-looking supernodal Cholesky of `lower` (lower triangle, compressed, of the pattern
-// `factor` was analysed for, in its natural order) into factor.x, on two threads as `teams`
-// (supernodal_teams of this factor) says. `factor`: supernodal, LLᵀ, real, its values
-// allocated (cholmod_change_factor). False if `lower` is not (numerically) positive definite
-// (a pivot ≤ 0) or not finite; the factor is then unusable.
-bool factorize_supernodal(const SparseMatrix& lower, cholmod_factor& factor,
-                          const std::vector<int>& teams);
+// Left-looking supernodal Cholesky of `lower` (lower triangle, compressed, within `pattern`'s
+// structure, in its natural order) into `values` (pattern.value_count() of them), on two
+// threads as `teams` (supernodal_teams of this pattern) says. False if `lower` is not
+// (numerically) positive definite (a pivot ≤ 0) or not finite; the factor is then unusable.
+bool factorize_supernodal(const SparseMatrix& lower, const SupernodalPattern& pattern,
+                          const std::vector<int>& teams, double* values);
 
-// Solves L Lᵀ x = b in place, in the factor's order. `factor`: numeric, supernodal, LLᵀ, real
-// (else std::logic_error).
-void solve_supernodal_in_place(const cholmod_factor& factor, Eigen::VectorXd& x);
-void solve_supernodal_in_place(const cholmod_factor& factor, Eigen::MatrixXd& x);
+// Solves L Lᵀ x = b in place, in the factor's order, with the factor's `values` (ours, or
+// CHOLMOD's numeric supernodal LLᵀ with its pattern). Rows other than pattern.size() or no
+// values: std::logic_error.
+void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
+                               Eigen::VectorXd& x);
+void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
+                               Eigen::MatrixXd& x);
 
 }  // namespace shapectl
