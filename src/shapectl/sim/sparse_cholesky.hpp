@@ -13,6 +13,11 @@
 
 namespace shapectl {
 
+// The flops of Eigen's LDLᵀ (as Σ_j (|L_j| + 1)² over its columns, diagonal included) of a
+// matrix in node blocks, estimated from its node pattern (node_pattern.hpp) ordered by AMD: a
+// node column of length c stands for three dof columns of about 3c, so ~27x its flops.
+double ldlt_flops_by_nodes(const SparseMatrix& nodes);
+
 class SparseCholesky {
  public:
   using Backend = CholeskyBackend;
