@@ -174,6 +174,29 @@ TEST(SupernodalLlt, FactorsTwoSubtreesAtOnceAsCholmodDoesInOne) {
   }
 }
 
+TEST(SupernodalLlt, SolvesTwoSubtreesAtOnceAsInOne) {
+  // The teams' solve: the two subtrees on two threads, the rows above both collected from each
+  // and added after. It must give the one-thread solve's answer, one and many right-hand sides.
+  const SparseMatrix lower = ordered_grid_laplacian(18);
+  Factor factor(lower, true);
+  const SupernodalPattern& pattern = factor.pattern();
+  const std::vector<int> teams = supernodal_teams(pattern);
+  ASSERT_GT(std::count(teams.begin(), teams.end(), 1), 0);
+  ASSERT_GT(std::count(teams.begin(), teams.end(), 2), 0);
+  ASSERT_TRUE(factorize_supernodal(lower, pattern, teams, factor.values()));
+  const Eigen::VectorXd b = Eigen::VectorXd::LinSpaced(lower.rows(), -1, 2);
+  Eigen::VectorXd one_thread = b, two = b;
+  solve_supernodal_in_place(pattern, factor.values(), one_thread);
+  solve_supernodal_in_place(pattern, factor.values(), two, teams);
+  EXPECT_LT((two - one_thread).norm(), 1e-13 * one_thread.norm());
+  EXPECT_LT((lower.selfadjointView<Eigen::Lower>() * two - b).norm(), 1e-12 * b.norm());
+  const Eigen::MatrixXd B = Eigen::MatrixXd::Random(lower.rows(), 4);
+  Eigen::MatrixXd many_one_thread = B, many_two = B;
+  solve_supernodal_in_place(pattern, factor.values(), many_one_thread);
+  solve_supernodal_in_place(pattern, factor.values(), many_two, teams);
+  EXPECT_LT((many_two - many_one_thread).norm(), 1e-13 * many_one_thread.norm());
+}
+
 TEST(SupernodalLlt, FactorsNoMatrixThatIsNotPositiveDefiniteOrFinite) {
   const SparseMatrix lower = random_spd(200, 3, 9);
   Factor factor(lower, true);
@@ -203,6 +226,7 @@ TEST(SupernodalLlt, RefusesASimplicialFactorAnotherSizeOrNoValues) {
   std::vector<int> too_few = supernodal_teams(pattern);
   too_few.pop_back();
   EXPECT_THROW(factorize_supernodal(lower, pattern, too_few, factor.values()), std::logic_error);
+  EXPECT_THROW(solve_supernodal_in_place(pattern, factor.values(), x, too_few), std::logic_error);
   const SparseMatrix smaller = random_spd(49, 3, 8);
   EXPECT_THROW(factorize_supernodal(smaller, pattern, supernodal_teams(pattern), factor.values()),
                std::logic_error);

@@ -295,13 +295,14 @@ namespace {
 // scattered back.
 template <typename Matrix>
 Matrix solve_permuted(const SupernodalPattern& pattern, const double* values,
-                      const std::vector<int>& order, const Matrix& rhs) {
+                      const std::vector<int>& teams, const std::vector<int>& order,
+                      const Matrix& rhs) {
   const Eigen::Index n = rhs.rows();
   if (n != static_cast<Eigen::Index>(order.size()))
     throw std::logic_error("PermutedCholmod: solve as many rows as the matrix has");
   Matrix y(n, rhs.cols());
   for (Eigen::Index k = 0; k < n; ++k) y.row(k) = rhs.row(order[k]);
-  solve_supernodal_in_place(pattern, values, y);
+  solve_supernodal_in_place(pattern, values, y, teams);
   Matrix x(n, rhs.cols());
   for (Eigen::Index k = 0; k < n; ++k) x.row(order[k]) = y.row(k);
   return x;
@@ -313,14 +314,14 @@ Eigen::MatrixXd PermutedCholmod::solve(const Eigen::MatrixXd& rhs) const {
   const Impl& m = *impl_;
   if (!m.factored)
     throw std::logic_error("PermutedCholmod: solve after a successful factorization");
-  return solve_permuted(m.pattern, m.factor_values(), m.order, rhs);
+  return solve_permuted(m.pattern, m.factor_values(), m.teams, m.order, rhs);
 }
 
 Eigen::VectorXd PermutedCholmod::solve(const Eigen::VectorXd& rhs) const {
   const Impl& m = *impl_;
   if (!m.factored)
     throw std::logic_error("PermutedCholmod: solve after a successful factorization");
-  return solve_permuted(m.pattern, m.factor_values(), m.order, rhs);
+  return solve_permuted(m.pattern, m.factor_values(), m.teams, m.order, rhs);
 }
 
 }  // namespace shapectl

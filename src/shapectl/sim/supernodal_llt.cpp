@@ -47,17 +47,15 @@ class Supernodes {
 using Block = Eigen::Map<Eigen::MatrixXd>;
 Block block_of(const Supernode& s) { return Block(s.values, s.rows, s.columns); }
 
-// Forward (L y = b, supernodes in order) then backward (Lᵀ x = y, in reverse). A supernode's
-// rows below its diagonal block touch x only through gathers and scatters of those rows.
+constexpr int kAboveBoth = 2;  // a team: factored after both subtrees
+
+// L y = b over the supernodes of team `t` (all where `team` is empty), in order. A supernode's
+// rows below its diagonal block touch x only through a scatter of those rows.
 template <typename X>
-void forward_backward(const SupernodalPattern& pattern, const double* values, X& x) {
-  if (!values) throw std::logic_error("supernodal LLᵀ: solve with a factor's values");
-  // Read only: Supernodes hands out writable blocks, which the solve does not write.
-  const Supernodes supernodes(pattern, const_cast<double*>(values));
-  if (x.rows() != static_cast<Eigen::Index>(pattern.size()))
-    throw std::logic_error("supernodal LLᵀ: solve as many rows as the factor has");
+void forward(const Supernodes& supernodes, const std::vector<int>& team, int t, X& x) {
   std::vector<double> work(static_cast<std::size_t>(supernodes.most_rows()) * x.cols());
   for (int k = 0; k < supernodes.count(); ++k) {
+    if (!team.empty() && team[k] != t) continue;
     const Supernode s = supernodes[k];
     const Block block = block_of(s);
     auto diagonal = x.middleRows(s.first, s.columns);
@@ -68,7 +66,15 @@ void forward_backward(const SupernodalPattern& pattern, const double* values, X&
     update.noalias() = block.bottomRows(below) * diagonal;
     for (int i = 0; i < below; ++i) x.row(s.row_index[s.columns + i]) -= update.row(i);
   }
+}
+
+// Lᵀ x = y over the supernodes of team `t` (all where `team` is empty), in reverse; a gather of
+// the rows below each diagonal block.
+template <typename X>
+void backward(const Supernodes& supernodes, const std::vector<int>& team, int t, X& x) {
+  std::vector<double> work(static_cast<std::size_t>(supernodes.most_rows()) * x.cols());
   for (int k = supernodes.count() - 1; k >= 0; --k) {
+    if (!team.empty() && team[k] != t) continue;
     const Supernode s = supernodes[k];
     const Block block = block_of(s);
     auto diagonal = x.middleRows(s.first, s.columns);
@@ -83,7 +89,42 @@ void forward_backward(const SupernodalPattern& pattern, const double* values, X&
   }
 }
 
-constexpr int kAboveBoth = 2;  // a team: factored after both subtrees
+// Forward then backward; with two teams (supernodal_teams), their subtrees at once. A subtree
+// writes its own rows and those above both, never the other's: forward, team 1 works on a
+// copy whose rows above both start at zero and collect its updates, added to x's after both
+// teams (the same sums on every run); backward, both read the rows above, already solved.
+template <typename X>
+void forward_backward(const SupernodalPattern& pattern, const std::vector<int>& team,
+                      const double* values, X& x) {
+  if (!values) throw std::logic_error("supernodal LLᵀ: solve with a factor's values");
+  // Read only: Supernodes hands out writable blocks, which the solve does not write.
+  const Supernodes supernodes(pattern, const_cast<double*>(values));
+  if (x.rows() != static_cast<Eigen::Index>(pattern.size()))
+    throw std::logic_error("supernodal LLᵀ: solve as many rows as the factor has");
+  if (!team.empty() && team.size() != static_cast<std::size_t>(supernodes.count()))
+    throw std::logic_error("supernodal LLᵀ: a team for each supernode (supernodal_teams)");
+  if (std::find(team.begin(), team.end(), 1) == team.end()) {
+    forward(supernodes, {}, 0, x);
+    backward(supernodes, {}, 0, x);
+    return;
+  }
+  auto rows_of = [&](int k, X& m) {
+    return m.middleRows(supernodes[k].first, supernodes[k].columns);
+  };
+  X other = x;
+  for (int k = 0; k < supernodes.count(); ++k)
+    if (team[k] == kAboveBoth) rows_of(k, other).setZero();
+  tbb::parallel_invoke([&] { forward(supernodes, team, 0, x); },
+                       [&] { forward(supernodes, team, 1, other); });
+  for (int k = 0; k < supernodes.count(); ++k) {
+    if (team[k] == 1) rows_of(k, x) = rows_of(k, other);
+    if (team[k] == kAboveBoth) rows_of(k, x) += rows_of(k, other);
+  }
+  forward(supernodes, team, kAboveBoth, x);
+  backward(supernodes, team, kAboveBoth, x);
+  tbb::parallel_invoke([&] { backward(supernodes, team, 0, x); },
+                       [&] { backward(supernodes, team, 1, x); });
+}
 
 // Team 0 or 1 for each supernode in one of two disjoint subtrees, kAboveBoth for the rest: from
 // the roots down, the subtree with most of the work is replaced by its children while it has
@@ -278,13 +319,13 @@ std::vector<int> supernodal_teams(const SupernodalPattern& pattern) {
 }
 
 void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
-                               Eigen::VectorXd& x) {
-  forward_backward(pattern, values, x);
+                               Eigen::VectorXd& x, const std::vector<int>& teams) {
+  forward_backward(pattern, teams, values, x);
 }
 
 void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
-                               Eigen::MatrixXd& x) {
-  forward_backward(pattern, values, x);
+                               Eigen::MatrixXd& x, const std::vector<int>& teams) {
+  forward_backward(pattern, teams, values, x);
 }
 
 }  // namespace shapectl

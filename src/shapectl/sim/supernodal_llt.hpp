@@ -32,11 +32,12 @@ bool factorize_supernodal(const SparseMatrix& lower, const SupernodalPattern& pa
                           const std::vector<int>& teams, double* values);
 
 // Solves L Lᵀ x = b in place, in the factor's order, with the factor's `values` (ours, or
-// CHOLMOD's numeric supernodal LLᵀ with its pattern). Rows other than pattern.size() or no
-// values: std::logic_error.
+// CHOLMOD's numeric supernodal LLᵀ with its pattern); with `teams` (supernodal_teams of the
+// pattern), the two subtrees on two threads. Rows other than pattern.size(), no values or a
+// teams list of another size: std::logic_error.
 void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
-                               Eigen::VectorXd& x);
+                               Eigen::VectorXd& x, const std::vector<int>& teams = {});
 void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
-                               Eigen::MatrixXd& x);
+                               Eigen::MatrixXd& x, const std::vector<int>& teams = {});
 
 }  // namespace shapectl
