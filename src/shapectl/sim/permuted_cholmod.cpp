@@ -31,7 +31,7 @@ struct PermutedCholmod::Impl {
   std::vector<int> slot;      // entry k of the analysed matrix's values goes to permuted's slot[k]
   std::vector<int> order;     // order[k]: the analysed matrix's row that is permuted's row k
   SupernodalPattern pattern;  // the factor's structure (our kernels', or CHOLMOD's copied)
-  std::vector<int> teams;     // supernodal_teams of the pattern, for our kernels
+  std::vector<int> teams;     // supernodal_teams of the pattern: our factorization and solves
   std::unique_ptr<double[]> values;  // our kernels' factor
   bool factored = false;             // by the last factorize()
 
@@ -259,8 +259,8 @@ void PermutedCholmod::analyze_nodes(const SparseMatrix& lower, const SparseMatri
 
 void PermutedCholmod::finish_analysis() {
   Impl& m = *impl_;
-  m.teams = own_kernels() ? supernodal_teams(m.pattern) : std::vector<int>();
-  if (own_kernels()) m.free_factor();  // its structure is copied into the pattern
+  m.teams = supernodal_teams(m.pattern);  // our solves use them with CHOLMOD's factor too
+  if (own_kernels()) m.free_factor();     // its structure is copied into the pattern
   m.values.reset();
   m.factored = false;
 }

@@ -50,7 +50,7 @@ class PermutedCholmod {
 
  private:
   struct Impl;
-  // Supernodal structure and teams for our kernels, or CHOLMOD's analysis of the gathered matrix.
+  // The teams (for our factorization and every solve); CHOLMOD's factor freed for our kernels.
   void finish_analysis();
   std::unique_ptr<Impl> impl_;
   double flops_ = 0;
