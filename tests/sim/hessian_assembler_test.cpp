@@ -122,6 +122,21 @@ TEST(HessianAssembler, KeepsItsPatternForTheSameElementsAndRebuildsItForNewOnes)
   expect_same_matrix(elastic_only, from_triplets({&p.elastic}, x2, p.fixed_dof, false));
 }
 
+TEST(HessianAssembler, AssemblesTheValuesOfTheLearnedPatternAndNothingBeforeIt) {
+  Problem p;
+  std::mt19937 rng(5);
+  const Positions x = p.deformed(rng);
+  const GripEnergy grip = p.grip_at(p.object.reference_joints());
+  const std::vector<const EnergyTerm*> terms{&p.elastic, &p.gravity, &grip};
+  HessianAssembler assembler(x.size(), p.fixed_dof);
+  EXPECT_THROW(assembler.assemble_values(terms, x, false), std::logic_error);
+  EXPECT_EQ(assembler.learn_pattern(terms), 1);
+  expect_same_matrix(assembler.assemble_values(terms, x, false),
+                     from_triplets(terms, x, p.fixed_dof, false));
+  EXPECT_THROW(assembler.assemble_values({&p.elastic}, x, false), std::logic_error)
+      << "terms other than the learned ones";
+}
+
 TEST(HessianAssembler, ItsNodePatternIsTheMatrixsWithHeldAndPartlyHeldNodes) {
   Problem p;
   int partly = 0;

@@ -41,7 +41,6 @@ std::vector<int> greedy_colours(const ElementNodes& elements, int node_count) {
 }
 
 constexpr std::size_t kColourGrain = 32;
-constexpr int kPatternElementGrain = 512;
 constexpr int kPatternNodeGrain = 256;
 
 // Runs f(begin, end) over ranges of [0, node_count) on all cores.

@@ -1,6 +1,7 @@
 #include <shapectl/sim/hessian_assembler.hpp>
 
 #include <algorithm>
+#include <stdexcept>
 
 namespace shapectl {
 
@@ -41,6 +42,13 @@ int HessianAssembler::learn_pattern(const std::vector<const EnergyTerm*>& terms)
 const SparseMatrix& HessianAssembler::assemble(const std::vector<const EnergyTerm*>& terms,
                                                const Positions& x, bool project_psd) {
   learn_pattern(terms);
+  return assemble_values(terms, x, project_psd);
+}
+
+const SparseMatrix& HessianAssembler::assemble_values(const std::vector<const EnergyTerm*>& terms,
+                                                      const Positions& x, bool project_psd) {
+  if (!scatter_ || terms.size() != elements_.size())
+    throw std::logic_error("HessianAssembler: assemble_values before learn_pattern of the terms");
   double* values = matrix_.valuePtr();
   std::fill(values, values + matrix_.nonZeros(), 0.0);
   for (std::size_t t = 0; t < terms.size(); ++t) {

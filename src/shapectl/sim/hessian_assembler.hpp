@@ -25,6 +25,10 @@ class HessianAssembler {
   // Builds the pattern and scatter map of the terms' elements, if they are new (assemble()
   // does); the matrix's values are then to be assembled. Returns pattern_version().
   int learn_pattern(const std::vector<const EnergyTerm*>& terms);
+  // assemble() without asking the terms for their elements again: for a caller that has just
+  // called learn_pattern(terms) (asking is a pass over every element, compared with the last).
+  const SparseMatrix& assemble_values(const std::vector<const EnergyTerm*>& terms,
+                                      const Positions& x, bool project_psd);
   // The node pattern of the matrix (HessianScatter::node_pattern), for fill-reducing orders.
   const SparseMatrix& node_pattern() const { return scatter_->node_pattern(); }
   // The matrix the last assemble() returned.

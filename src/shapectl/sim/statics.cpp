@@ -108,7 +108,7 @@ double StaticsSolver::max_force(const Eigen::VectorXd& g) const {
 }
 
 namespace {
-// Every Hessian the solver uses (Newton, Krylov, hessian()) is assembled here.
+// Every Hessian the solver uses (Krylov, hessian()) is assembled here; Newton's in factor_at.
 const SparseMatrix& assemble_hessian(const EnergyTerms& terms, HessianAssembler& assembler,
                                      const Positions& x, bool projected) {
   return assembler.assemble(terms, x, projected);
@@ -121,14 +121,15 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
     ws.cholesky.analyze(ws.assembler.matrix(), &ws.assembler.node_pattern());
     ws.analyzed_pattern = ws.assembler.pattern_version();
   };
-  if (!assembled && ws.assembler.learn_pattern(terms) != ws.analyzed_pattern) {
+  if (!assembled) {
+    auto assemble = [&] { ws.assembler.assemble_values(terms, x, projected); };
     // A new pattern: its symbolic analysis, which reads the pattern alone, beside the assembly
     // of the values; the two share the cores.
-    tbb::parallel_invoke(analyze, [&] { assemble_hessian(terms, ws.assembler, x, projected); });
-    assembled = true;
+    if (ws.assembler.learn_pattern(terms) != ws.analyzed_pattern)
+      tbb::parallel_invoke(analyze, assemble);
+    else assemble();
   }
-  const SparseMatrix& H =
-      assembled ? ws.assembler.matrix() : assemble_hessian(terms, ws.assembler, x, projected);
+  const SparseMatrix& H = ws.assembler.matrix();
   if (ws.analyzed_pattern != ws.assembler.pattern_version()) analyze();
   const bool ok = ws.cholesky.factorize(H);
   ++total_factorizations;
