@@ -29,7 +29,8 @@ struct Shape {
 
 [[noreturn]] void refuse_type(const std::string& what, const Shape& shape,
                               const std::string& found) {
-  throw py::type_error(InputError(what, "", shape.text + " of real numbers", found).what());
+  throw py::type_error(
+      InputError(what, "", "real numbers (int or float) in " + shape.text, found).what());
 }
 
 std::string type_name(const py::handle& value) {

@@ -139,12 +139,15 @@ def test_a_centerline_is_refused_for_every_bad_dtype_shape_and_value(bar, contro
 def test_joints_and_warm_starts_are_refused_for_every_bad_dtype_shape_and_value(bar):
     rng = np.random.default_rng(2)
     obj = shapectl.GrippedObject(bar)
+    paused = shapectl.Controller(bar, start=False)
+    paused.pause()
     joints = bar.reference_joints
     calls = {
         "statics": lambda v: shapectl.statics(bar, v),
         "kinematics of the scene": lambda v: shapectl.kinematics(bar, v),
         "kinematics of the robot": lambda v: shapectl.kinematics(bar.robot, v),
         "GrippedObject.solve": lambda v: obj.solve(joints=v),
+        "Controller.jog": lambda v: paused.jog(v),
     }
     count = 0
     for label, value in bad_arrays(joints, rng):
@@ -159,6 +162,7 @@ def test_joints_and_warm_starts_are_refused_for_every_bad_dtype_shape_and_value(
     # The stacked (3n,) form is a form of positions, the same values.
     assert obj.solve(warm_start=bar.rest_positions.ravel(), max_iterations=1).positions.shape == (NODES, 3)
     assert count > 200
+    paused.close()
 
 
 SCALAR_STRANGERS = [("True", True), ("None", None), ("a str", "0.1"), ("complex", 1 + 1j),
