@@ -139,8 +139,14 @@ Eigen::VectorXd real_values(const py::handle& value, const std::string& what, co
     append_list(py::reinterpret_borrow<py::sequence>(value), what, s, values);
   else
     refuse_type(what, s, "a value of type " + type_name(value));
-  for (const double v : values)
-    if (!std::isfinite(v)) throw InputError(what, "", "finite numbers", "a non-finite value");
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (std::isfinite(values[i])) continue;
+    const auto columns = static_cast<std::size_t>(std::max<py::ssize_t>(s.columns, 1));
+    std::ostringstream found;
+    found << values[i] << " at " << (s.columns ? "row " : "index ") << i / columns;
+    if (s.columns) found << ", column " << i % columns;
+    throw InputError(what, "", "finite numbers", found.str());
+  }
   return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
 }
 

@@ -121,6 +121,10 @@ def test_a_centerline_is_refused_for_every_bad_dtype_shape_and_value(bar, contro
                         (valid.astype(object), TypeError), ([[1, 2, "3"]] * 5, TypeError),
                         (valid * np.nan, ValueError), (valid[:, :2], ValueError)):
         assert isinstance(refused(lambda: controller.set_centerline(value), "centerline"), kind)
+    infinite = valid.copy()
+    infinite[3, 1] = -np.inf
+    assert str(refused(lambda: controller.set_centerline(infinite), "centerline")) == \
+        "centerline: expected finite numbers, got -inf at row 3, column 1"
     # The protocol's bounds: 2 to 2000 points, within 10 m of the origin.
     controller.set_centerline(centerline(bar, MAX_CENTERLINE_POINTS))
     controller.set_centerline(centerline(bar, 2).tolist())
