@@ -27,6 +27,8 @@
 #include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/sim/gripped_object.hpp>
 
+#include "strict_scalars.hpp"
+
 namespace shapectl::python {
 
 namespace py = pybind11;

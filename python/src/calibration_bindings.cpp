@@ -60,7 +60,7 @@ bool finite(const CalibrationResult& r) {
 }
 
 Calibration run_calibrate(const SceneHandle& s, const py::object& observations_in,
-                          const py::object& fit_in, int max_iterations) {
+                          const py::object& fit_in, Integer max_iterations) {
   const Scene& scene = *s.scene;
   const FitSelection fit = fit_from(fit_in.is_none() ? py::str(default_fit(scene)) : fit_in);
   if (max_iterations < 1 || max_iterations > 1000)

@@ -282,7 +282,7 @@ void bind_controller(py::module_& m) {
           "The latest ControllerSnapshot.")
       .def(
           "wait_for_snapshot",
-          [](const H& h, std::uint64_t after, double timeout) {
+          [](const H& h, std::uint64_t after, Real timeout) {
             std::shared_ptr<const ControllerSnapshot> s;
             {
               py::gil_scoped_release r;

@@ -244,6 +244,29 @@ def test_the_controller_takes_the_protocols_bounds_from_a_dict_too(bar, controll
     assert shapectl.solve(bar, {"centerline": line}, max_iterations=1).target_nodes.size > 0
 
 
+def test_number_arguments_refuse_bools_strings_and_complex_numbers(bar, controller):
+    targets = {"targets": [{"node": 3, "position": bar.rest_positions[3] + [0, 0, 0.01]}]}
+    obj = shapectl.GrippedObject(bar)
+    integers = {"solve max_iterations": lambda v: shapectl.solve(bar, targets, max_iterations=v),
+                "GrippedObject.solve max_iterations": lambda v: obj.solve(max_iterations=v),
+                "calibrate max_iterations": lambda v: shapectl.calibrate(bar, {"frames": []}, max_iterations=v)}
+    reals = {"solve max_seconds": lambda v: shapectl.solve(bar, targets, max_iterations=1, max_seconds=v),
+             "solve tolerance": lambda v: shapectl.solve(bar, targets, max_iterations=1, tolerance=v),
+             "wait_for_snapshot timeout": lambda v: controller.wait_for_snapshot(0, timeout=v)}
+    strangers = [True, False, np.bool_(True), "1", b"1", 1 + 0j, np.complex64(1), None, [1], np.array([1]),
+                 fractions.Fraction(1, 2)]
+    for calls, extra in ((integers, [1.0, 1.5, np.float64(2), 2 ** 40]), (reals, [10 ** 400])):
+        for name, call in calls.items():
+            for value in strangers + extra:
+                with pytest.raises(TypeError, match="incompatible function arguments"):
+                    call(value)
+    # numpy scalars of the right kind are numbers, and an int is a float.
+    assert obj.solve(max_iterations=np.int64(1)).statics.iterations <= 1
+    assert shapectl.solve(bar, targets, max_iterations=np.int32(1), tolerance=np.float32(0.5),
+                          max_seconds=30).status == "reached"
+    controller.wait_for_snapshot(0, timeout=np.float64(0.01))
+
+
 def test_fit_lists_hold_names_only(bar):
     for fit in (["youngs_modulus", 3], [b"youngs_modulus"], 3, {"youngs_modulus": 1}):
         refused(lambda: shapectl.calibrate(bar, {"frames": []}, fit=fit), "fit")
