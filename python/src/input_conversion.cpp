@@ -137,8 +137,7 @@ Eigen::VectorXd real_values(const py::handle& value, const std::string& what, co
     append_array(py::reinterpret_borrow<py::array>(value), what, s, values);
   else if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value))
     append_list(py::reinterpret_borrow<py::sequence>(value), what, s, values);
-  else
-    refuse_type(what, s, "a value of type " + type_name(value));
+  else refuse_type(what, s, "a value of type " + type_name(value));
   for (std::size_t i = 0; i < values.size(); ++i) {
     if (std::isfinite(values[i])) continue;
     const auto columns = static_cast<std::size_t>(std::max<py::ssize_t>(s.columns, 1));
@@ -164,13 +163,13 @@ Positions positions_from(const py::handle& array, int node_count, const std::str
 
 std::vector<Vec3> points_from(const py::handle& array, const std::string& what,
                               std::size_t min_points, std::size_t max_points) {
-  const Eigen::VectorXd values = real_values(
-      array, what,
-      {.min_rows = static_cast<py::ssize_t>(min_points),
-       .max_rows = static_cast<py::ssize_t>(max_points),
-       .columns = 3,
-       .text = "an array of shape (k, 3) with k from " + std::to_string(min_points) + " to " +
-               std::to_string(max_points)});
+  const Eigen::VectorXd values =
+      real_values(array, what,
+                  {.min_rows = static_cast<py::ssize_t>(min_points),
+                   .max_rows = static_cast<py::ssize_t>(max_points),
+                   .columns = 3,
+                   .text = "an array of shape (k, 3) with k from " + std::to_string(min_points) +
+                           " to " + std::to_string(max_points)});
   std::vector<Vec3> points;
   for (Eigen::Index i = 0; i < values.size(); i += 3) points.push_back(values.segment<3>(i));
   return points;
@@ -184,9 +183,10 @@ Eigen::VectorXd joints_from(const py::handle& joints, const RobotModel& robot,
                                  "joints"),
                        robot, defaults);
   const py::ssize_t m = robot.active_count();
-  return real_values(
-      joints, "joints",
-      {.min_rows = m, .max_rows = m, .text = "an array of shape (" + std::to_string(m) + ",)"});
+  return real_values(joints, "joints",
+                     {.min_rows = m,
+                      .max_rows = m,
+                      .text = "an array of shape (" + std::to_string(m) + ",)"});
 }
 
 nlohmann::json json_from(const py::handle& value, const std::string& source,
@@ -212,9 +212,9 @@ nlohmann::json json_from(const py::handle& value, const std::string& source,
                             " values");
     return o.attr("tolist")();
   });
-  const py::object encoder = py::module_::import("json").attr("JSONEncoder")(
-      py::arg("default") = to_list, py::arg("allow_nan") = false,
-      py::arg("separators") = py::make_tuple(",", ":"));
+  const py::object encoder = py::module_::import("json").attr(
+      "JSONEncoder")(py::arg("default") = to_list, py::arg("allow_nan") = false,
+                     py::arg("separators") = py::make_tuple(",", ":"));
   std::string text;
   try {
     // Chunk by chunk, so the text stops growing at the limit.

@@ -31,8 +31,7 @@ TargetsInput read_targets_from(const py::handle& targets, int node_count, std::s
                                std::size_t max_dict_bytes) {
   if (py::isinstance<py::dict>(targets)) {
     source = "targets";
-    return read_targets(JsonInput(json_from(targets, source, max_dict_bytes), source),
-                        node_count);
+    return read_targets(JsonInput(json_from(targets, source, max_dict_bytes), source), node_count);
   }
   const auto path = path_from(targets, "targets", "a TARGETS.json path or a dict of its schema");
   source = path.string();

@@ -24,7 +24,8 @@ inline bool integer_value(pybind11::handle src, long long& out) {
   const bool numpy_integer =
       pybind11::isinstance(src, pybind11::module_::import("numpy").attr("integer"));
   if (PyBool_Check(src.ptr()) || !(PyLong_Check(src.ptr()) || numpy_integer)) return false;
-  const pybind11::object index = pybind11::reinterpret_steal<pybind11::object>(PyNumber_Index(src.ptr()));
+  const pybind11::object index =
+      pybind11::reinterpret_steal<pybind11::object>(PyNumber_Index(src.ptr()));
   if (!index) {
     PyErr_Clear();
     return false;

@@ -334,7 +334,8 @@ TEST(AuthorCli, Utf16UrdfIsExitOneNamingTheEncodingAndTheFile) {
   a.dir.write("arms.urdf", utf16);
   const auto run = run_cli(author_args(a));
   EXPECT_EQ(run.exit_code, 1) << run.err;
-  EXPECT_NE(run.err.find(a.urdf.string() + ": URDF must be UTF-8 text; found UTF-16 (little-endian)"),
+  EXPECT_NE(run.err.find(a.urdf.string() +
+                         ": URDF must be UTF-8 text; found UTF-16 (little-endian)"),
             std::string::npos)
       << run.err;
   EXPECT_FALSE(std::filesystem::exists(a.scene));

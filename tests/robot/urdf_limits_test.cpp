@@ -97,7 +97,8 @@ TEST(UrdfLimits, FifoAndOversizeFilesAreRefused) {
 }
 
 // `text` (ASCII) in UTF-16 or UTF-32, little- or big-endian, after `bom`.
-std::string widened(const std::string& text, int width, bool little_endian, const std::string& bom) {
+std::string widened(const std::string& text, int width, bool little_endian,
+                    const std::string& bom) {
   std::string out = bom;
   for (const char c : text) {
     std::string unit(static_cast<std::size_t>(width), '\0');
@@ -109,7 +110,8 @@ std::string widened(const std::string& text, int width, bool little_endian, cons
 
 TEST(UrdfLimits, Utf16AndUtf32AreRefusedNamingTheEncodingAndTheFile) {
   const test::TempDir dir;
-  const std::string urdf = "<?xml version=\"1.0\"?>\n<robot name=\"r\"><link name=\"a\"/></robot>\n";
+  const std::string urdf =
+      "<?xml version=\"1.0\"?>\n<robot name=\"r\"><link name=\"a\"/></robot>\n";
   ASSERT_NO_THROW(RobotModel::load_urdf_file(dir.write("plain.urdf", urdf)));
   struct Case {
     std::string file, bytes, found;
@@ -133,10 +135,11 @@ TEST(UrdfLimits, Utf16AndUtf32AreRefusedNamingTheEncodingAndTheFile) {
             bare.string() +
                 ":1: URDF must be UTF-8 text; found a NUL byte (UTF-16 or UTF-32 without a byte "
                 "order mark?)");
-  const std::string nul_in_line_2 = "<robot name=\"r\">\n<link name=\"a" + std::string(1, '\0') +
-                                    "\"/></robot>";
-  EXPECT_EQ(error_of([&] { RobotModel::from_urdf_string(nul_in_line_2, "nul.urdf"); }).rfind(
-                "nul.urdf:2: URDF must be UTF-8 text; found a NUL byte", 0),
+  const std::string nul_in_line_2 =
+      "<robot name=\"r\">\n<link name=\"a" + std::string(1, '\0') + "\"/></robot>";
+  EXPECT_EQ(error_of([&] {
+              RobotModel::from_urdf_string(nul_in_line_2, "nul.urdf");
+            }).rfind("nul.urdf:2: URDF must be UTF-8 text; found a NUL byte", 0),
             0u);
   // UTF-8's own byte order mark is UTF-8.
   EXPECT_NO_THROW(RobotModel::from_urdf_string("\xEF\xBB\xBF" + urdf, "bom.urdf"));

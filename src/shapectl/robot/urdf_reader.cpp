@@ -152,7 +152,8 @@ const std::string& checked_text(const std::string& xml, const std::string& sourc
     throw InputError(
         source + ":" +
             std::to_string(1 + std::count(xml.begin(), xml.begin() + static_cast<long>(nul), '\n')),
-        "", "URDF must be UTF-8 text; found a NUL byte (UTF-16 or UTF-32 without a byte order mark?)");
+        "",
+        "URDF must be UTF-8 text; found a NUL byte (UTF-16 or UTF-32 without a byte order mark?)");
   if (const std::size_t at = xml_too_deep_at(xml, max_xml_depth); at != std::string_view::npos)
     throw InputError(
         source + ":" +

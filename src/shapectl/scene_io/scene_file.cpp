@@ -64,7 +64,8 @@ Eigen::Isometry3d read_pose(const JsonInput& j) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   if (j.has("position"))
     T.translation() = j.at("position").vec3_within(max_distance, "a position", "m");
-  if (j.has("rpy")) T.linear() = rotation_from_rpy(j.at("rpy").vec3_within(max_scene_angle, "angles", "rad"));
+  if (j.has("rpy"))
+    T.linear() = rotation_from_rpy(j.at("rpy").vec3_within(max_scene_angle, "angles", "rad"));
   return T;
 }
 
