@@ -267,6 +267,21 @@ Eigen::Isometry3d pose_from(const std::vector<double>& v) {
   return T;
 }
 
+// --object-pose X,Y,Z[,ROLL,PITCH,YAW] within the bounds a scene file's pose has.
+Eigen::Isometry3d object_pose_from(const std::string& text) {
+  const std::string expected = "X,Y,Z or X,Y,Z,ROLL,PITCH,YAW (m, rad)";
+  const std::vector<double> v = numbers(text, "--object-pose", expected, {3, 6});
+  const bool angles_in_range =
+      std::all_of(v.begin() + 3, v.end(), [](double a) { return std::abs(a) <= max_scene_angle; });
+  if (!(Vec3(v[0], v[1], v[2]).norm() <= max_scene_distance) || !angles_in_range) {
+    std::ostringstream range;
+    range << expected << " with the position within " << max_scene_distance
+          << " m of the origin and each angle within ±" << max_scene_angle << " rad";
+    throw InputError("command line", "--object-pose", range.str(), bounded_preview(text));
+  }
+  return pose_from(v);
+}
+
 // Default placement: the object's longest bounding-box axis along the line between the first
 // two tools, its box centre midway between them, pulled a fifth of the way towards the robot's
 // root in the horizontal plane: tools at full stretch (a zero pose often is) cannot reach further.
@@ -432,8 +447,7 @@ void run(const AuthorOptions& o) {
 
   Eigen::Isometry3d T_world_object;
   if (!o.object_pose.empty()) {
-    T_world_object = pose_from(
-        numbers(o.object_pose, "--object-pose", "X,Y,Z or X,Y,Z,ROLL,PITCH,YAW (m, rad)", {3, 6}));
+    T_world_object = object_pose_from(o.object_pose);
   } else {
     if (ees.size() < 2 || (tools[0] - tools[1]).norm() < 1e-3)
       throw InputError(

@@ -8,7 +8,9 @@ Many independent solves on a Dask cluster: shapectl.batch (imported on its own; 
 
 Arrays are float64 numpy arrays: positions (n, 3) in metres, world frame, mesh node order;
 joints (m,) in radians, in the scene's active-joint order; sensitivities (3n, m).
-Bad input raises ValueError with the CLI's message; a computation that fails raises SolverError.
+Bad input raises ValueError with the CLI's message, or TypeError for a value of the wrong type
+(a bool, str, complex number, object or masked array: nothing is coerced); a computation that
+fails raises SolverError.
 Long computations release the GIL, so other Python threads run meanwhile.
 
     import shapectl

@@ -20,11 +20,14 @@
 
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/io/input_file.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/joint_limits.hpp>
 #include <shapectl/robot/robot_model.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/sim/gripped_object.hpp>
+
+#include "strict_scalars.hpp"
 
 namespace shapectl::python {
 
@@ -70,10 +73,15 @@ struct Pose {
 
 // Stacked 3n positions as an (n, 3) array.
 py::array_t<double> positions_array(const Positions& x);
-// An (n, 3) or (3n,) array of finite numbers as stacked positions; InputError naming `what`.
+// Arrays in (input_conversion.cpp): a numpy array of integer or floating dtype, or a list or
+// tuple (of rows) of ints and floats; dtype, shape and size are checked before anything is
+// copied. TypeError for a wrong type (bool, str, complex, object, masked), ValueError (an
+// InputError naming `what`) for a wrong shape or size or a non-finite value.
+// An (n, 3) or (3n,) array as stacked positions.
 Positions positions_from(const py::handle& array, int node_count, const std::string& what);
-// A (k, 3) array of finite points.
-std::vector<Vec3> points_from(const py::handle& array, const std::string& what);
+// A (k, 3) array of points, k from min_points to max_points.
+std::vector<Vec3> points_from(const py::handle& array, const std::string& what,
+                              std::size_t min_points, std::size_t max_points);
 // θ from None (→ defaults), a {name: rad} dict (others keep `defaults`, names checked as in
 // JOINTS.json) or an (m,) array.
 Eigen::VectorXd joints_from(const py::handle& joints, const RobotModel& robot,
@@ -82,10 +90,16 @@ Eigen::VectorXd joints_from(const py::handle& joints, const RobotModel& robot,
 std::filesystem::path path_from(const py::handle& value, const std::string& what,
                                 const std::string& expected);
 // A TARGETS.json path (str or os.PathLike) or a dict of its schema, read as the CLI reads the
-// file; `source` receives the name messages use (the path, or "targets" for a dict).
-TargetsInput read_targets_from(const py::handle& targets, int node_count, std::string& source);
-// A Python value (dicts, lists, numbers, numpy arrays) as JSON, parsed strictly as `source`.
-nlohmann::json json_from(const py::handle& value, const std::string& source);
+// file (a dict's JSON at most `max_dict_bytes`); `source` receives the name messages use (the
+// path, or "targets" for a dict).
+TargetsInput read_targets_from(const py::handle& targets, int node_count, std::string& source,
+                               std::size_t max_dict_bytes = max_json_file_bytes);
+// A Python value (dicts, lists, numbers, numpy arrays) as JSON, parsed strictly as `source`:
+// at most `max_bytes` of JSON text (a file's limit by default), stopped as soon as it is over
+// (numpy arrays checked against the bytes left before they are converted); NaN, complex
+// numbers, object arrays, masked arrays and other types refused.
+nlohmann::json json_from(const py::handle& value, const std::string& source,
+                         std::size_t max_bytes = max_json_file_bytes);
 
 // Each end effector's tool pose at θ (the CLI's "tools").
 std::map<std::string, Pose> tool_poses(const Scene& scene, const Eigen::VectorXd& joints);

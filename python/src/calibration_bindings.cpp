@@ -31,11 +31,17 @@ FitSelection fit_from(const py::handle& fit) {
   std::string list;
   if (py::isinstance<py::str>(fit)) {
     list = py::cast<std::string>(fit);
-  } else {
+  } else if (py::isinstance<py::list>(fit) || py::isinstance<py::tuple>(fit)) {
     for (const auto& name : fit) {
+      if (!py::isinstance<py::str>(name))
+        throw py::type_error("fit: expected a list of parameter names, got one holding a " +
+                             std::string(py::str(py::type::of(name).attr("__name__"))));
       if (!list.empty()) list += ',';
       list += py::cast<std::string>(name);
     }
+  } else {
+    throw py::type_error("fit: expected a str or a list of parameter names, got a " +
+                         std::string(py::str(py::type::of(fit).attr("__name__"))));
   }
   try {
     return parse_fit_selection(list);
@@ -54,7 +60,7 @@ bool finite(const CalibrationResult& r) {
 }
 
 Calibration run_calibrate(const SceneHandle& s, const py::object& observations_in,
-                          const py::object& fit_in, int max_iterations) {
+                          const py::object& fit_in, Integer max_iterations) {
   const Scene& scene = *s.scene;
   const FitSelection fit = fit_from(fit_in.is_none() ? py::str(default_fit(scene)) : fit_in);
   if (max_iterations < 1 || max_iterations > 1000)

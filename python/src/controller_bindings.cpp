@@ -3,6 +3,7 @@
 #include <optional>
 
 #include <shapectl/control/controller.hpp>
+#include <shapectl/server/protocol.hpp>
 
 #include "bindings.hpp"
 
@@ -46,12 +47,38 @@ ControllerHandle open(const SceneHandle& s, const std::string& optimizer,
   return h;
 }
 
+// The controller takes from Python what it takes from a GUI client (server/protocol.hpp): a
+// dict of at most a message's bytes, at most max_centerline_points points, every point within
+// max_coordinate of the origin.
+void check_protocol_point(const Vec3& p, const std::string& source, const std::string& where) {
+  if (!(p.norm() <= server::max_coordinate))
+    throw InputError(source, where,
+                     "a point within " + std::to_string(static_cast<int>(server::max_coordinate)) +
+                         " m of the origin (the GUI protocol's bound)",
+                     "one " + std::to_string(p.norm()) + " m from it");
+}
+
+std::vector<Vec3> protocol_centerline(std::vector<Vec3> points, const std::string& source) {
+  if (points.size() > server::max_centerline_points)
+    throw InputError(source, "centerline",
+                     "at most " + std::to_string(server::max_centerline_points) + " points",
+                     points.size());
+  for (std::size_t k = 0; k < points.size(); ++k)
+    check_protocol_point(points[k], source, "centerline[" + std::to_string(k) + "]");
+  return points;
+}
+
 // Targets as solve takes them: a TARGETS.json path or a dict of its schema; a centre-line goes
 // to set_centerline.
 void set_targets(const ControllerHandle& h, const py::object& targets) {
   Controller& c = h.get();
   std::string source;
-  TargetsInput input = read_targets_from(targets, c.mesh().node_count(), source);
+  TargetsInput input =
+      read_targets_from(targets, c.mesh().node_count(), source, server::max_message_bytes);
+  input.centerline = protocol_centerline(std::move(input.centerline), source);
+  for (int k = 0; k < input.targets.size(); ++k)
+    check_protocol_point(input.targets.positions[static_cast<std::size_t>(k)], source,
+                         "targets[" + std::to_string(k) + "].position");
   py::gil_scoped_release release;
   if (input.centerline.empty()) c.set_targets(std::move(input.targets));
   else c.set_centerline(std::move(input.centerline));
@@ -194,16 +221,22 @@ void bind_controller(py::module_& m) {
           "is due.")
       .def("set_targets", &set_targets, py::arg("targets"),
            "New targets: a TARGETS.json path or a dict of its schema (node targets or a "
-           "centre-line). "
-           "ValueError for bad input, nothing changed then.")
+           "centre-line) within the GUI protocol's bounds (a dict of at most 1 MB as JSON, at "
+           "most 2000 centre-line points, every point within 10 m of the origin). TypeError "
+           "or ValueError for bad input, nothing changed then.")
       .def(
           "set_centerline",
           [](const H& h, const py::object& points) {
-            std::vector<Vec3> polyline = points_from(points, "centerline");
+            std::vector<Vec3> polyline = protocol_centerline(
+                points_from(points, "centerline", 2, server::max_centerline_points), "centerline");
             py::gil_scoped_release r;
             h.get().set_centerline(std::move(polyline));
           },
-          py::arg("points"), "A sketched centre-line, array of shape (k, 3), world frame.")
+          py::arg("points"),
+          "A sketched centre-line, world frame, m: an array (or list of rows) of shape (k, 3), k "
+          "from 2 to 2000, every point within 10 m of the origin (the GUI protocol's bounds). "
+          "TypeError for a non-real dtype or a masked array, ValueError for a wrong shape, a "
+          "non-finite value or a point out of bounds; nothing changed then.")
       .def(
           "clear_targets",
           [](const H& h) {
@@ -249,7 +282,7 @@ void bind_controller(py::module_& m) {
           "The latest ControllerSnapshot.")
       .def(
           "wait_for_snapshot",
-          [](const H& h, std::uint64_t after, double timeout) {
+          [](const H& h, std::uint64_t after, Real timeout) {
             std::shared_ptr<const ControllerSnapshot> s;
             {
               py::gil_scoped_release r;

@@ -58,7 +58,7 @@ ShapeTargets resolve(const TargetsInput& in, const std::string& source,
 
 SolveResult solve(const SceneHandle& s, const py::object& targets_in,
                   const std::string& optimizer_name, const std::string& gradient_name,
-                  int max_iterations, double max_seconds, double tolerance) {
+                  Integer max_iterations, Real max_seconds, Real tolerance) {
   if (!s.scene->robot)
     throw InputError(s.scene->source.string(), "robot", "a robot to optimize (missing key)");
   const GrippedObject& object = *s.object;

@@ -53,7 +53,7 @@ struct StateHandle {
 };
 
 StateHandle solve_state(const ObjectHandle& o, const py::object& joints_in,
-                        const py::object& warm_start, int max_iterations) {
+                        const py::object& warm_start, Integer max_iterations) {
   const SceneHandle& s = o.scene;
   const GrippedObject& object = s.gripped();
   const Eigen::VectorXd joints = joints_from(joints_in, object.robot(), object.reference_joints());

@@ -294,6 +294,11 @@ TEST(AuthorCli, BadInputIsExitOneNamingTheFieldAndLeavesAnExistingSceneAlone) {
       {{"--mesh", (a.dir.path() / "absent.obj").string()}, "absent.obj"},
       {{"--object-pose", "2,0,0.1"}, "--object-pose: "},
       {{"--object-pose", "0.3,0,zero"}, "--object-pose: expected X,Y,Z or X,Y,Z,ROLL,PITCH,YAW"},
+      // Finite but absurd: the option and its range are named (once blamed --grip-radius).
+      {{"--object-pose", "1e300,0,0"},
+       "--object-pose: expected X,Y,Z or X,Y,Z,ROLL,PITCH,YAW (m, rad) with the position within "
+       "1000 m of the origin and each angle within ±1000 rad, got 1e300,0,0"},
+      {{"--object-pose", "0.3,0,0.1,0,0,-1e5"}, "--object-pose: expected X,Y,Z or X,Y,Z,ROLL,"},
       {{"--grip-region", "left=1,1,1,2,2,2"},
        "--grip-region: expected a grip region for end effector 'left'"},
       {{"--tool-offset", "middle=0,0,0"},
@@ -319,6 +324,21 @@ TEST(AuthorCli, BadInputIsExitOneNamingTheFieldAndLeavesAnExistingSceneAlone) {
   auto args = author_args(a);
   args.insert(args.end(), {"--object-pose", "2,0,0.1"});
   EXPECT_NE(run_cli(args).err.find("inverse kinematics: goals not reached"), std::string::npos);
+}
+
+TEST(AuthorCli, Utf16UrdfIsExitOneNamingTheEncodingAndTheFile) {
+  Authored a;
+  write_inputs(a);
+  std::string utf16 = "\xFF\xFE";
+  for (const char c : urdf()) utf16 += std::string{c, '\0'};
+  a.dir.write("arms.urdf", utf16);
+  const auto run = run_cli(author_args(a));
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find(a.urdf.string() +
+                         ": URDF must be UTF-8 text; found UTF-16 (little-endian)"),
+            std::string::npos)
+      << run.err;
+  EXPECT_FALSE(std::filesystem::exists(a.scene));
 }
 
 }  // namespace

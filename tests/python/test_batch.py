@@ -24,7 +24,7 @@ def test_every_task_has_its_row_even_when_it_raises_something_unexpected(bar_sce
     assert [r["task"] for r in rows] == [0, 1, 2, 3]
     assert [r["status"] for r in rows] == ["done", "failed", "failed", "done"]
     # An exception the task does not catch comes back through Dask: still one row, with it.
-    assert rows[1]["error"].startswith("TypeError: not JSON serializable")
+    assert rows[1]["error"].startswith("TypeError: targets: not JSON serializable: set")
     assert rows[2]["error"].startswith("ValueError: targets: targets[0].node: expected")
     assert rows[0]["error_mean"] < 1e-3 and rows[0]["joints"] == rows[3]["joints"]
     lines = progress.getvalue().split("\n")  # not a terminal: a line per count, no \r

@@ -96,5 +96,54 @@ TEST(UrdfLimits, FifoAndOversizeFilesAreRefused) {
             std::string::npos);
 }
 
+// `text` (ASCII) in UTF-16 or UTF-32, little- or big-endian, after `bom`.
+std::string widened(const std::string& text, int width, bool little_endian,
+                    const std::string& bom) {
+  std::string out = bom;
+  for (const char c : text) {
+    std::string unit(static_cast<std::size_t>(width), '\0');
+    unit[little_endian ? 0 : unit.size() - 1] = c;
+    out += unit;
+  }
+  return out;
+}
+
+TEST(UrdfLimits, Utf16AndUtf32AreRefusedNamingTheEncodingAndTheFile) {
+  const test::TempDir dir;
+  const std::string urdf =
+      "<?xml version=\"1.0\"?>\n<robot name=\"r\"><link name=\"a\"/></robot>\n";
+  ASSERT_NO_THROW(RobotModel::load_urdf_file(dir.write("plain.urdf", urdf)));
+  struct Case {
+    std::string file, bytes, found;
+  };
+  const std::vector<Case> cases{
+      {"utf16le.urdf", widened(urdf, 2, true, "\xFF\xFE"), "UTF-16 (little-endian)"},
+      {"utf16be.urdf", widened(urdf, 2, false, "\xFE\xFF"), "UTF-16 (big-endian)"},
+      {"utf32le.urdf", widened(urdf, 4, true, std::string("\xFF\xFE\0\0", 4)),
+       "UTF-32 (little-endian)"},
+      {"utf32be.urdf", widened(urdf, 4, false, std::string("\0\0\xFE\xFF", 4)),
+       "UTF-32 (big-endian)"},
+  };
+  for (const auto& c : cases) {
+    const auto file = dir.write(c.file, c.bytes);
+    EXPECT_EQ(error_of([&] { RobotModel::load_urdf_file(file); }),
+              file.string() + ": URDF must be UTF-8 text; found " + c.found);
+  }
+  // Without a byte order mark: the first NUL byte, with its line.
+  const auto bare = dir.write("bare.urdf", widened(urdf, 2, true, ""));
+  EXPECT_EQ(error_of([&] { RobotModel::load_urdf_file(bare); }),
+            bare.string() +
+                ":1: URDF must be UTF-8 text; found a NUL byte (UTF-16 or UTF-32 without a byte "
+                "order mark?)");
+  const std::string nul_in_line_2 =
+      "<robot name=\"r\">\n<link name=\"a" + std::string(1, '\0') + "\"/></robot>";
+  EXPECT_EQ(error_of([&] {
+              RobotModel::from_urdf_string(nul_in_line_2, "nul.urdf");
+            }).rfind("nul.urdf:2: URDF must be UTF-8 text; found a NUL byte", 0),
+            0u);
+  // UTF-8's own byte order mark is UTF-8.
+  EXPECT_NO_THROW(RobotModel::from_urdf_string("\xEF\xBB\xBF" + urdf, "bom.urdf"));
+}
+
 }  // namespace
 }  // namespace shapectl

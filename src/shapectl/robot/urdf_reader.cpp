@@ -132,8 +132,28 @@ std::map<std::string, int> element_lines(const std::string& xml, const std::stri
   return lines;
 }
 
-// The XML must nest no deeper than max_xml_depth before TinyXML parses it.
-const std::string& checked_depth(const std::string& xml, const std::string& source) {
+// The encoding a byte order mark announces ("UTF-16 (little-endian)"), or "" for none or UTF-8's.
+std::string bom_encoding(std::string_view text) {
+  const auto starts = [&](std::string_view bom) { return text.substr(0, bom.size()) == bom; };
+  using namespace std::string_view_literals;
+  if (starts("\xFF\xFE\0\0"sv)) return "UTF-32 (little-endian)";
+  if (starts("\0\0\xFE\xFF"sv)) return "UTF-32 (big-endian)";
+  if (starts("\xFF\xFE"sv)) return "UTF-16 (little-endian)";
+  if (starts("\xFE\xFF"sv)) return "UTF-16 (big-endian)";
+  return "";
+}
+
+// The text must be UTF-8 and nest no deeper than max_xml_depth before TinyXML parses it. UTF-16
+// or UTF-32 would otherwise be scanned as bytes, its NULs hiding every closing tag.
+const std::string& checked_text(const std::string& xml, const std::string& source) {
+  if (const std::string encoding = bom_encoding(xml); !encoding.empty())
+    throw InputError(source, "", "URDF must be UTF-8 text; found " + encoding);
+  if (const std::size_t nul = xml.find('\0'); nul != std::string::npos)
+    throw InputError(
+        source + ":" +
+            std::to_string(1 + std::count(xml.begin(), xml.begin() + static_cast<long>(nul), '\n')),
+        "",
+        "URDF must be UTF-8 text; found a NUL byte (UTF-16 or UTF-32 without a byte order mark?)");
   if (const std::size_t at = xml_too_deep_at(xml, max_xml_depth); at != std::string_view::npos)
     throw InputError(
         source + ":" +
@@ -153,7 +173,7 @@ class UrdfReader {
  public:
   UrdfReader(const std::string& xml, const std::string& source)
       : source_(source),
-        joint_lines_(element_lines(checked_depth(xml, source), "joint", true, source)),
+        joint_lines_(element_lines(checked_text(xml, source), "joint", true, source)),
         link_lines_(element_lines(xml, "link", false, source)) {}
 
   RobotModel read(const std::string& xml) {

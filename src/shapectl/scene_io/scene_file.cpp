@@ -25,7 +25,7 @@ namespace shapectl {
 namespace {
 
 // Generous bounds on scene numbers: finite but absurd values (gravity 1e300) are typos.
-constexpr double max_distance = 1e3;    // m, positions and sizes
+constexpr double max_distance = max_scene_distance;  // m, positions and sizes
 constexpr double max_gravity = 1e3;     // m/s^2 (100 g)
 constexpr double max_stiffness = 1e12;  // N/m, and the barrier stiffnesses
 constexpr double max_weight = 1e12;     // objective weights
@@ -64,7 +64,8 @@ Eigen::Isometry3d read_pose(const JsonInput& j) {
   Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
   if (j.has("position"))
     T.translation() = j.at("position").vec3_within(max_distance, "a position", "m");
-  if (j.has("rpy")) T.linear() = rotation_from_rpy(j.at("rpy").vec3_within(1e3, "angles", "rad"));
+  if (j.has("rpy"))
+    T.linear() = rotation_from_rpy(j.at("rpy").vec3_within(max_scene_angle, "angles", "rad"));
   return T;
 }
 

@@ -12,6 +12,11 @@ namespace shapectl {
 
 class JsonInput;
 
+// Bounds on a scene's poses (read_pose): the position within max_scene_distance of the origin,
+// roll, pitch and yaw each within ±max_scene_angle.
+inline constexpr double max_scene_distance = 1e3;  // m
+inline constexpr double max_scene_angle = 1e3;     // rad
+
 // Reads and validates a scene, then runs check_scene (sim/scene_checks.hpp) on it: throws
 // InputError naming the file and field for bad or implausible input, fills `warnings`.
 // A mesh file may give "units" ("m", "cm", "mm") or "scale" (a factor): its nodes are scaled to
