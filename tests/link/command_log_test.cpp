@@ -137,6 +137,22 @@ TEST(CommandLogCheck, AnOptimizerResultBeforeTheJointsAreNamedIsAnError) {
       << check_error(log);
 }
 
+// serve's scene switch may change the robot: the optimizer results after it have its joints.
+TEST(CommandLogCheck, ASceneSwitchNamesTheJointsOfTheOptimizerResultsAfterIt) {
+  auto log = good_log();
+  log.push_back(
+      {{"t", 0.02}, {"event", "scene"}, {"scene", "b.json"}, {"joint_names", {"x", "y", "z"}}});
+  log.push_back({{"t", 0.03}, {"event", "optimizer"}, {"joints", {0.1, 0.2, 0.3}}});
+  CommandLogCheck check;
+  ASSERT_EQ(check_error(log, &check), "no error");
+  EXPECT_EQ(check.optimizer_results.back().joints.size(), 3);
+  EXPECT_EQ(check.scene, "s.json") << "the session's scene";
+  log.push_back({{"t", 0.04}, {"event", "optimizer"}, {"joints", {0.1, 0.2}}});
+  EXPECT_NE(check_error(log).find("log.jsonl:8: joints: expected an array of 3 numbers, got"),
+            std::string::npos)
+      << check_error(log);
+}
+
 // A null joint (a NaN the link would have refused) is a limit violation, not a malformed log.
 TEST(CommandLogCheck, ANonFiniteCommandIsAViolation) {
   auto log = good_log();

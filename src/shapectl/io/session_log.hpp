@@ -3,7 +3,7 @@
 // was opened) and "event" (what happened), written and flushed as it happens so a crash loses
 // at most the line being written. Any thread may write. A log has a size cap: a line that would
 // take the file past it first moves the file to FILE.1 (FILE.1 to FILE.2, ..., the oldest of
-// `keep` dropped) and starts FILE again with the header events ("session", "link"), so every
+// `keep` dropped) and starts FILE again with the header events (write_header), so every
 // file, the current one included, can be read on its own.
 //
 //   {"t":0.000,"event":"session","scene":"bar.json", ...}

@@ -123,8 +123,9 @@ CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
   };
   for (const auto& e : events) {
     const JsonInput f(e.fields, source + ":" + std::to_string(e.line));
-    if (e.event == "session") {
-      if (f.has("scene")) check.scene = f.at("scene").string();
+    if (e.event == "session" || e.event == "scene") {
+      const std::string scene = f.has("scene") ? f.at("scene").string() : "";
+      if (e.event == "session" && !scene.empty()) check.scene = scene;
       if (f.has("joint_names")) joint_count = joint_names_count(f.at("joint_names"));
     } else if (e.event == "link") {
       ++check.links;
