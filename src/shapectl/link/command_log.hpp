@@ -52,7 +52,8 @@ struct CommandLogCheck {
 // "connect" event restarts that channel's sequence (the governor is reset to the measured
 // position then). Every field it reads is checked first, its size against the joint count the
 // log names ("joint_names" of the "link" event before, for optimizer results also of a
-// "session" or "scene" event): a malformed field is an InputError "<source>:<line>: <field>: expected ...".
+// "session" or "scene" event): a malformed field is an InputError "<source>:<line>: <field>:
+// expected ...".
 CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
                                   const std::string& source);
 
