@@ -26,8 +26,11 @@ Eigen::VectorXd logged_vector(const JsonInput& j, int n, std::optional<double> n
   if (!j.is_array() || j.size() != static_cast<std::size_t>(n)) j.fail(expected);
   Eigen::VectorXd v(n);
   for (int i = 0; i < n; ++i) {
-    const JsonInput x = j.at(static_cast<std::size_t>(i));
-    v[i] = null_value && x.raw().is_null() ? *null_value : x.number();
+    const nlohmann::json& x = j.raw()[static_cast<std::size_t>(i)];
+    // The common case without building a JsonInput (a path string) per element.
+    if (x.is_number() && std::isfinite(x.get<double>())) v[i] = x.get<double>();
+    else
+      v[i] = null_value && x.is_null() ? *null_value : j.at(static_cast<std::size_t>(i)).number();
   }
   return v;
 }
