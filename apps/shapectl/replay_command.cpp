@@ -11,7 +11,6 @@
 #include <nlohmann/json.hpp>
 
 #include <shapectl/io/input_error.hpp>
-#include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/session_log.hpp>
 #include <shapectl/link/command_log.hpp>
 #include <shapectl/link/make_robot_link.hpp>
@@ -34,11 +33,8 @@ struct ReplayArgs {
 };
 
 // Re-streams the logged optimizer results; returns why the link disarmed, or empty.
-std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& events) {
-  std::string scene_file = args.scene;
-  for (const auto& e : events)
-    if (scene_file.empty() && e.event == "session" && e.fields.contains("scene"))
-      scene_file = e.fields["scene"].get<std::string>();
+std::string restream(const ReplayArgs& args, const CommandLogCheck& check) {
+  const std::string scene_file = args.scene.empty() ? check.scene : args.scene;
   if (scene_file.empty())
     throw InputError(args.log, "", "names no scene (no \"session\" event); pass --scene");
   const Scene scene = load_scene(scene_file);
@@ -61,16 +57,15 @@ std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& eve
   }
   const int n = scene.robot->model->active_count();
   int sent = 0;
-  for (const auto& e : events) {
-    if (e.event != "optimizer" || stop_signal_received()) continue;
-    const Eigen::VectorXd joints = vector_from_json(e.fields.at("joints"));
-    if (joints.size() != n)
-      throw InputError(args.log + ":" + std::to_string(e.line), "joints",
-                       std::to_string(n) + " values for " + scene_file, joints.size());
+  for (const auto& r : check.optimizer_results) {
+    if (stop_signal_received()) break;
+    if (r.joints.size() != n)
+      throw InputError(args.log + ":" + std::to_string(r.line), "joints",
+                       std::to_string(n) + " values for " + scene_file, r.joints.size());
     std::this_thread::sleep_until(start +
                                   std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                      std::chrono::duration<double>(e.t / args.speed)));
-    link->set_target(joints, e.fields.value("safe", false));
+                                      std::chrono::duration<double>(r.t / args.speed)));
+    link->set_target(r.joints, r.safe);
     ++sent;
   }
   // Let the robot finish the last target.
@@ -89,10 +84,18 @@ std::string restream(const ReplayArgs& args, const std::vector<LoggedEvent>& eve
 }
 
 void replay(const ReplayArgs& args) {
-  if (!(args.speed > 0)) throw InputError("replay", "--speed", "a positive number", args.speed);
+  // Bounded: a logged time (at most 1e9 s) over the speed stays a duration we can sleep until.
+  if (!(args.speed >= 1e-3 && args.speed <= 1e3))
+    throw InputError("replay", "--speed", "a number from 0.001 to 1000", args.speed);
   int truncated = 0;
   const auto events = read_session_log(args.log, &truncated);
+  if (events.empty())
+    throw InputError(args.log, "", "an empty log: expected JSON lines with \"t\" and \"event\"");
   const CommandLogCheck check = check_command_log(events, args.log);
+  if (check.commands == 0 && check.optimizer_results.empty() && check.ok())
+    throw InputError(args.log, "",
+                     "nothing to check: expected \"command\" or \"optimizer\" events, got " +
+                         std::to_string(events.size()) + " other events");
   std::map<std::string, int> counts;
   for (const auto& e : events) ++counts[e.event];
   nlohmann::json summary = {{"events", events.size()},
@@ -104,7 +107,7 @@ void replay(const ReplayArgs& args) {
                             {"acceleration_ratio", check.acceleration_ratio},
                             {"violations", check.violations}};
   std::string failure;
-  if (!args.robot.empty()) failure = restream(args, events);
+  if (!args.robot.empty()) failure = restream(args, check);
   if (!failure.empty()) summary["replay_failure"] = failure;
   std::cout << summary.dump(2) << "\n";
   if (!check.ok()) throw SolverFailure(check.violations.front());

@@ -37,6 +37,7 @@
 #include "link_options.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
+#include "session_log_options.hpp"
 
 namespace shapectl::cli {
 
@@ -49,6 +50,7 @@ struct RunArgs {
   std::string scene;
   std::string targets;
   std::string log;
+  SessionLogLimits log_limits;  // --log-max-mb, --log-keep
   bool arm = false;
   bool until_settled = false;
   double timeout = 0;         // s; 0: none
@@ -150,12 +152,12 @@ RunInputs load_run_inputs(RunArgs& args) {
 // The session log if --log names one, opened with a "session" event; else null.
 std::shared_ptr<SessionLog> open_session_log(const RunArgs& args, const Scene& scene) {
   if (args.log.empty()) return nullptr;
-  auto log = std::make_shared<SessionLog>(args.log);
-  log->write("session", {{"command", "run"},
-                         {"scene", std::filesystem::absolute(args.scene).string()},
-                         {"targets_file", args.targets},
-                         {"robot", to_string(args.link.kind)},
-                         {"joint_names", scene.robot->model->active_joint_names()}});
+  auto log = std::make_shared<SessionLog>(args.log, args.log_limits);
+  log->write_header("session", {{"command", "run"},
+                                {"scene", std::filesystem::absolute(args.scene).string()},
+                                {"targets_file", args.targets},
+                                {"robot", to_string(args.link.kind)},
+                                {"joint_names", scene.robot->model->active_joint_names()}});
   return log;
 }
 
@@ -415,6 +417,7 @@ void add_run_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("--arm", args->arm, "arm the link: let the robot move (otherwise it holds)");
   cmd->add_option("--log", args->log, "session log to write (JSON lines)");
+  add_session_log_options(*cmd, args->log_limits);
   cmd->add_flag("--until-settled", args->until_settled,
                 "exit 0 once the targets are reached and the robot arrived; exit 2 with the "
                 "reason if that cannot happen (best effort: the targets are unreachable)");

@@ -17,6 +17,7 @@
 #include "link_options.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
+#include "session_log_options.hpp"
 
 namespace shapectl::cli {
 
@@ -29,6 +30,7 @@ struct ServeArgs {
   std::string robot = "none";
   LinkArgs link;
   std::string log;
+  SessionLogLimits log_limits;  // --log-max-mb, --log-keep
   std::string web_root;
   std::string scenes_dir;
   double rate = 30;
@@ -43,11 +45,11 @@ std::shared_ptr<SessionLog> open_serve_log(const ServeArgs& args,
                                            const std::filesystem::path& scene,
                                            const Scene& description) {
   if (args.log.empty()) return nullptr;
-  auto log = std::make_shared<SessionLog>(args.log);
-  log->write("session", {{"command", "serve"},
-                         {"scene", std::filesystem::absolute(scene).string()},
-                         {"robot", args.robot},
-                         {"joint_names", description.robot->model->active_joint_names()}});
+  auto log = std::make_shared<SessionLog>(args.log, args.log_limits);
+  log->write_header("session", {{"command", "serve"},
+                                {"scene", std::filesystem::absolute(scene).string()},
+                                {"robot", args.robot},
+                                {"joint_names", description.robot->model->active_joint_names()}});
   return log;
 }
 
@@ -137,6 +139,7 @@ void add_serve_command(CLI::App& app) {
   add_link_options(*cmd, args->link);
   cmd->add_option("--log", args->log,
                   "session log to write (JSON lines, as `run --log`; `shapectl replay` reads it)");
+  add_session_log_options(*cmd, args->log_limits);
   cmd->add_option("--web-root", args->web_root,
                   "Directory with index.html (default: the repository's web/)");
   cmd->add_option("--scenes-dir", args->scenes_dir,

@@ -5,9 +5,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include <shapectl/io/session_log.hpp>
+#include <shapectl/link/command_log.hpp>
+#include <shapectl/server/session.hpp>
+
+#include "io/text_mutator.hpp"
 #include "support/test_support.hpp"
 
 namespace shapectl {
@@ -26,6 +33,18 @@ std::filesystem::path small_yumi_scene(const TempDir& dir) {
 std::filesystem::path lift_targets(const TempDir& dir) {
   return dir.write("targets.json",
                    R"({"centerline": [[0.39047, -0.15, 0.28], [0.39047, 0.15, 0.28]]})");
+}
+
+// `run` with the simulated robot, armed, until settled, writing the session log `log`.
+test::CliRun run_sim_with_log(const TempDir& dir, const std::filesystem::path& log,
+                              const std::vector<std::string>& more = {}) {
+  std::vector<std::string> args = {"run",       small_yumi_scene(dir).string(),
+                                   "--targets", lift_targets(dir).string(),
+                                   "--arm",     "--until-settled",
+                                   "--timeout", "60",
+                                   "--log",     log.string()};
+  args.insert(args.end(), more.begin(), more.end());
+  return run_cli(args);
 }
 
 // A CLI process running in the background; stdout goes to a file.
@@ -60,9 +79,7 @@ int free_port_pair_base() {
 TEST(RunCli, SimRobotSettlesAndTheLogReplaysWithinTheLimits) {
   TempDir dir;
   const auto log = dir.path() / "session.jsonl";
-  const auto run =
-      run_cli({"run", small_yumi_scene(dir).string(), "--targets", lift_targets(dir).string(),
-               "--arm", "--until-settled", "--timeout", "60", "--log", log.string()});
+  const auto run = run_sim_with_log(dir, log);
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const auto result = nlohmann::json::parse(run.out);
   EXPECT_TRUE(result["settled"].get<bool>());
@@ -169,6 +186,152 @@ TEST(ReplayCli, AMalformedLogIsBadInputNamingTheLine) {
   const auto run = run_cli({"replay", log.string()});
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("m.jsonl:2:"), std::string::npos) << run.err;
+}
+
+// issue 32: replay of an empty log exited 0 having checked nothing.
+TEST(ReplayCli, AnEmptyLogOrOneWithNothingToCheckIsBadInput) {
+  TempDir dir;
+  for (const char* text : {"", "\n\n", "{\"t\":0,\"event\":\"sess"}) {
+    const auto run = run_cli({"replay", dir.write("e.jsonl", text).string()});
+    EXPECT_EQ(run.exit_code, 1) << text;
+    EXPECT_NE(run.err.find("e.jsonl: an empty log: expected JSON lines"), std::string::npos)
+        << run.err;
+  }
+  const auto run =
+      run_cli({"replay", dir.write("s.jsonl", R"({"t":0,"event":"session","scene":"a.json"})"
+                                              "\n")
+                             .string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("s.jsonl: nothing to check: expected \"command\" or \"optimizer\" "
+                         "events, got 1 other events"),
+            std::string::npos)
+      << run.err;
+}
+
+// issue 32: an empty limit array segfaulted, a command without a channel was exit 3.
+TEST(ReplayCli, MalformedFieldsAreBadInputNamingLineAndField) {
+  TempDir dir;
+  const std::string link =
+      R"({"t":0,"event":"link","kind":"sim","joint_names":["a"],"channels":[{"name":"robot","joints":[0]}],"period":0.004,"lower":[-1],"upper":[1],"velocity":[0.5],"acceleration":[]})"
+      "\n";
+  auto run = run_cli({"replay", dir.write("a.jsonl", link).string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find(
+                "a.jsonl:1: acceleration: expected an array of 1 numbers or nulls, got []"),
+            std::string::npos)
+      << run.err;
+  std::string fixed = link;
+  fixed.replace(fixed.find("[]"), 2, "[1]");
+  run = run_cli(
+      {"replay",
+       dir.write("c.jsonl",
+                 fixed + R"({"t":0.004,"event":"command","seq":1,"joints":[0],"measured":[0]})"
+                         "\n")
+           .string()});
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("c.jsonl:2: channel: missing key"), std::string::npos) << run.err;
+}
+
+// The log's size cap: `run` past it rotates the file; each file within the cap, the current
+// one replays on its own.
+TEST(RunCli, TheSessionLogStaysWithinItsCapAndTheCurrentFileReplays) {
+  TempDir dir;
+  const auto log = dir.path() / "session.jsonl";
+  const auto run = run_sim_with_log(dir, log, {"--log-max-mb", "0.05", "--log-keep", "2"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const std::uintmax_t cap = 52428;  // 0.05 MiB
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "session.jsonl.3"));
+  for (const char* name : {"session.jsonl", "session.jsonl.1", "session.jsonl.2"}) {
+    ASSERT_TRUE(std::filesystem::exists(dir.path() / name)) << name;
+    EXPECT_LE(std::filesystem::file_size(dir.path() / name), cap) << name;
+  }
+  const auto replay = run_cli({"replay", log.string()});
+  ASSERT_EQ(replay.exit_code, 0) << replay.err << replay.out;
+  const auto summary = nlohmann::json::parse(replay.out);
+  EXPECT_GT(summary["commands_checked"].get<int>(), 0);
+  EXPECT_EQ(summary["counts"]["link"], 1);
+  EXPECT_EQ(summary["counts"]["session"], 1);
+
+  const auto bad =
+      run_cli({"run", small_yumi_scene(dir).string(), "--targets", lift_targets(dir).string(),
+               "--log", log.string(), "--log-max-mb", "0"});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("--log-max-mb"), std::string::npos) << bad.err;
+}
+
+// The first `count` lines of a log (a seed small enough to mutate often).
+std::string first_lines(const std::string& text, int count) {
+  std::size_t end = 0;
+  for (int k = 0; k < count && end != std::string::npos; ++k) end = text.find('\n', end + 1);
+  return text.substr(0, end == std::string::npos ? end : end + 1);
+}
+
+const test::TextMutator kLogMutator({"{",  "[",     "]",     "}",          ",",     ":",
+                                     "\"", "\n",    "1e999", "-1e308",     "1e300", "-1",
+                                     "0",  "-0",    "null",  "true",       "\"x\"", "[]",
+                                     "{}", "[0.1]", "1e-13", "2147483648", "\xff",  "NaN"});
+
+// issue 32 (item 3): seeded mutations of real logs, one written by `run --log` (the simulated
+// robot's link, its commands) and one by the server's optimizer log. Checked in-process as
+// `replay` checks them (1000 cases): each is read or refused with an InputError, nothing else;
+// then 60 through the CLI: exit 0, 1 or 2, never a signal or 3, and exit 1 names the file.
+TEST(ReplayFuzz, MutatedRealLogsAreCheckedOrRefusedNamingTheirLine) {
+  TempDir dir;
+  const auto run_log = dir.path() / "run.jsonl";
+  const auto run = run_sim_with_log(dir, run_log);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto serve_log = dir.path() / "serve.jsonl";
+  {
+    const auto names = read_session_log(run_log).front().fields.at("joint_names");
+    SessionLog log(serve_log);
+    log.write_header("session", {{"scene", "scene.json"}, {"joint_names", names}});
+    ControllerSnapshot s;
+    s.joints = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(names.size()));
+    for (int k = 0; k < 5; ++k, s.joints.array() += 0.01) server::log_snapshot(log, s);
+  }
+  // The run log's first 60 lines, its header (session, link, connect) with 3 commands, so that
+  // mutations often reach the link event, and the optimizer log.
+  const std::string run_text = test::read_text(run_log);
+  const auto header_lines =
+      std::count(run_text.begin(), run_text.begin() + run_text.find("\"event\":\"command\""), '\n');
+  const std::vector<std::string> seeds = {first_lines(run_text, 60),
+                                          first_lines(run_text, static_cast<int>(header_lines) + 3),
+                                          test::read_text(serve_log)};
+  for (const auto& seed : seeds) {  // the seeds themselves are good logs
+    const auto file = dir.write("seed.jsonl", seed);
+    const CommandLogCheck check = check_command_log(read_session_log(file), "seed");
+    EXPECT_TRUE(check.ok()) << check.violations.front();
+    EXPECT_GT(check.commands + check.optimizer_results.size(), 2u);
+  }
+
+  const auto file = dir.path() / "fuzz.jsonl";
+  const test::FuzzCounts counts =
+      test::fuzz_parser(seeds, kLogMutator, 1000, 20261128, [&](const std::string& text) {
+        dir.write("fuzz.jsonl", text);
+        check_command_log(read_session_log(file), file.string());
+      });
+  std::cout << "checked: " << counts.parsed << ", refused: " << counts.refused << "\n";
+  EXPECT_GT(counts.refused, 250);
+  EXPECT_GT(counts.parsed, 100);
+
+  std::mt19937 rng(20261129);
+  int exits[3] = {0, 0, 0};
+  for (std::size_t c = 0; c < 60; ++c) {
+    dir.write("fuzz.jsonl", kLogMutator.mutate(seeds[c % seeds.size()], rng));
+    std::vector<std::string> command = {"timeout", "-s", "KILL", "20"};
+    for (const auto& word : test::cli_command({"replay", file.string()})) command.push_back(word);
+    const auto err = dir.path() / "err.txt";
+    const int code = test::wait_for_exit(test::start_process(command, dir.path() / "out.txt", err));
+    const std::string message = test::read_text(err);
+    ASSERT_TRUE(code == 0 || code == 1 || code == 2) << "case " << c << ": exit " << code << "\n"
+                                                     << message.substr(0, 600);
+    ++exits[code];
+    if (code == 1) {
+      EXPECT_NE(message.find("error: " + file.string()), std::string::npos) << message;
+    }
+  }
+  std::cout << "CLI exit 0: " << exits[0] << ", 1: " << exits[1] << ", 2: " << exits[2] << "\n";
+  EXPECT_GT(exits[1], 10);
 }
 
 }  // namespace

@@ -323,6 +323,7 @@ TEST(SessionLog, ASceneSwitchIsLogged) {
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].event, "scene");
   EXPECT_EQ(events[0].fields["scene"], test::source_path("scenes/yumi_frame.json").string());
+  EXPECT_EQ(events[0].fields["joint_names"].size(), 14u);  // replay checks optimizer results
 }
 
 }  // namespace

@@ -25,6 +25,14 @@ void log_command(SessionLog& log, const std::string& channel, std::uint64_t seq,
                  const Eigen::VectorXd& joints, const Eigen::VectorXd& measured,
                  const FeedbackStep& step = {.send = true, .advanced = true});
 
+// An optimizer result the log holds ("optimizer" events of `serve`), for replaying it.
+struct LoggedOptimizerResult {
+  int line = 0;
+  double t = 0;            // s
+  Eigen::VectorXd joints;  // rad, the log's joint count
+  bool safe = false;
+};
+
 struct CommandLogCheck {
   int links = 0;     // "link" events (a log may hold several sessions)
   int commands = 0;  // "command" events checked
@@ -32,6 +40,8 @@ struct CommandLogCheck {
   double velocity_ratio = 0;
   double acceleration_ratio = 0;
   std::vector<std::string> violations;  // "log.jsonl:120: left joint 3: ..." (first 20)
+  std::string scene;                    // of the last "session" event naming one, or empty
+  std::vector<LoggedOptimizerResult> optimizer_results;
   bool ok() const { return violations.empty(); }
 };
 
@@ -40,7 +50,10 @@ struct CommandLogCheck {
 // governor step of dt apart; a "hold" is skipped; "from_rest" means the
 // previous step counts as zero), and position inside the band unless holding still. A
 // "connect" event restarts that channel's sequence (the governor is reset to the measured
-// position then).
+// position then). Every field it reads is checked first, its size against the joint count the
+// log names ("joint_names" of the "link" event before, for optimizer results also of a
+// "session" or "scene" event): a malformed field is an InputError "<source>:<line>: <field>:
+// expected ...".
 CommandLogCheck check_command_log(const std::vector<LoggedEvent>& events,
                                   const std::string& source);
 

@@ -429,8 +429,10 @@ void Session::apply(const Command& c) {
       const auto it = std::find_if(scenes_.begin(), scenes_.end(),
                                    [&](const SceneEntry& e) { return e.name == c.scene; });
       load(*it);  // parse_command admitted only known names
-      // The optimizer events that follow belong to this scene.
-      if (log_) log_->write("scene", {{"scene", std::filesystem::absolute(it->path).string()}});
+      // The optimizer events that follow belong to this scene (and have its joints).
+      if (log_)
+        log_->write_header("scene", {{"scene", std::filesystem::absolute(it->path).string()},
+                                     {"joint_names", controller_->robot().active_joint_names()}});
       break;
     }
     case T::Arm: {
