@@ -37,7 +37,7 @@ struct FeedbackOptions {
   double retarget_threshold = 0.0002;
   // Authority, per node: the largest correction (m) and how fast it may change (m/s). A
   // model within tens of percent and grips off by millimetres err by ~20 mm (the closed-loop
-  // tests' world: 17-20 mm); the loop settles in ~1 s at this rate.
+  // tests' world: 17-20 mm); that loop never had an update held to this rate.
   double max_correction = 0.03;
   double max_correction_rate = 0.02;
   int neighbours = 4;  // observed nodes an unobserved node's estimate comes from
