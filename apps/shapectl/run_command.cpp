@@ -251,7 +251,9 @@ void log_observation(SessionLog* log, const ObservationFrame& frame, double time
                           {"markers", frame.markers.size()},
                           {"points", frame.points.size()},
                           {"observed_error", snap.observed_error},
-                          {"model_error", snap.model_error}};
+                          {"model_error", snap.model_error},
+                          {"gate", server::gate_json(snap.gate)},
+                          {"authority", server::authority_json(snap.authority)}};
   if (world) event["true_error"] = world->true_error(snap.targets);
   log->write("observation", event);
 }
@@ -357,9 +359,11 @@ nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_sta
                             {"p99", l.p99_us},
                             {"max", l.max_us}};
   }
-  if (snap.observations > 0) {
+  if (snap.observations > 0 || snap.gate.frames_checked > 0 || snap.observations_ignored > 0) {
     result["observations"] = snap.observations;
     result["observations_ignored"] = snap.observations_ignored;
+    result["gate"] = server::gate_json(snap.gate);
+    result["authority"] = server::authority_json(snap.authority);
     result["feedback"] = snap.feedback;
     result["model_error"] = snap.model_error;
     result["observed_error"] =

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
 #include <random>
 
 #include <shapectl/calib/joint_path.hpp>
@@ -114,7 +116,7 @@ TEST(ModelErrorFeedback, AModelChangeMovesTheEstimateSoThatTheBelievedShapeStays
   Positions observed = before, after = before;
   observed.segment<3>(0) += Vec3(0.003, 0, 0);
   after.segment<3>(0) += Vec3(0.002, 0.001, 0);
-  feedback.observe({{0, observed.segment<3>(0)}}, before);
+  feedback.observe({{0, observed.segment<3>(0)}}, before, 0.001, 0);
   feedback.model_changed(before, after);
   // x̂ + ê is what the loop believes the object's shape is: unchanged by the new model.
   EXPECT_LT((after.segment<3>(0) + feedback.estimate(0) - observed.segment<3>(0)).norm(), 1e-15);
@@ -194,6 +196,79 @@ TEST_F(OnlineCalibrationTest, AFitOfNothingIdentifiableIsNotApplied) {
   EXPECT_NE(c.error.find("no parameter is identifiable"), std::string::npos) << c.error;
   controller.step_once();
   EXPECT_EQ(controller.snapshot()->model_updates, 0u);
+}
+
+// Lying frames in the window (issue 32): a fit of them must not reach the controller.
+class LyingWindowTest : public OnlineCalibrationTest {
+ protected:
+  // Calibrates three frames at distinct poses, each marker moved by `lie(k)`; the status.
+  OnlineCalibrationStatus calibrate_lies(const std::function<Vec3(std::size_t)>& lie) {
+    OnlineCalibration calibration(controller, model, {.automatic = false});
+    for (int pose = 0; pose < 3; ++pose) {
+      Eigen::VectorXd joints = model.robot->reference_joints;
+      joints[0] -= 0.01 * pose, joints[7] += 0.01 * pose;
+      ObservationFrame frame = look(joints);
+      for (std::size_t k = 0; k < frame.markers.size(); ++k) frame.markers[k].position += lie(k);
+      calibration.observe(frame);
+    }
+    EXPECT_TRUE(calibration.start());
+    calibration.wait();
+    calibration.poll(0);
+    controller.step_once();
+    EXPECT_EQ(controller.snapshot()->model_updates, 0u);
+    return calibration.status();
+  }
+  Controller controller{model};
+};
+
+TEST_F(LyingWindowTest, AFitOfMarkersFiveToThreeHundredMillimetresOffIsNotApplied) {
+  std::mt19937 lies(32);
+  std::uniform_real_distribution<double> log_size(std::log(0.005), std::log(0.3));
+  std::normal_distribution<double> normal;
+  std::vector<Vec3> offsets;
+  for (std::size_t k = 0; k < targets.nodes.size(); ++k)
+    offsets.push_back(std::exp(log_size(lies)) *
+                      Vec3(normal(lies), normal(lies), normal(lies)).normalized());
+  const OnlineCalibrationStatus c = calibrate_lies([&](std::size_t k) { return offsets[k]; });
+  EXPECT_EQ(c.runs, 1u);
+  EXPECT_FALSE(c.applied);
+  EXPECT_NE(c.error.find("not applied: the fit leaves chi2/dof"), std::string::npos) << c.error;
+}
+
+// A lie a model can explain: every marker 3 cm to the side is both grips holding the bar 3 cm
+// off. The fit explains it to the noise, and is refused for the jump.
+TEST_F(LyingWindowTest, AFitThatExplainsTheLieByAnImplausibleModelIsNotApplied) {
+  const OnlineCalibrationStatus c = calibrate_lies([](std::size_t) { return Vec3(0, 0.03, 0); });
+  ASSERT_TRUE(c.result) << c.error;
+  EXPECT_LT(c.result->rms_after, c.result->rms_before);
+  EXPECT_FALSE(c.applied);
+  EXPECT_NE(c.error.find("not applied: beyond the bounds from the scene's values: grip_offsets["),
+            std::string::npos)
+      << c.error;
+}
+
+TEST(ModelBounds, AValueBeyondItsBoundIsNamedWithItsNumbers) {
+  PhysicalParameters a;
+  a.youngs_modulus = 1e5, a.poisson_ratio = 0.3, a.density = 40;
+  a.grip_offsets = {Eigen::Isometry3d::Identity()};
+  EXPECT_EQ(beyond_bounds(a, a, {}), "");
+  PhysicalParameters b = a;
+  b.youngs_modulus = 2.5e5;
+  EXPECT_EQ(beyond_bounds(a, b, {}), "youngs_modulus 2.5e+05 Pa is 2.50x 1e+05 Pa (at most 2x)");
+  b = a, b.youngs_modulus = 0.45e5;  // a factor 2.2 down
+  EXPECT_NE(beyond_bounds(a, b, {}).find("youngs_modulus"), std::string::npos);
+  b = a, b.density = 70;
+  EXPECT_NE(beyond_bounds(a, b, {}).find("density"), std::string::npos);
+  b = a, b.poisson_ratio = 0.45;
+  EXPECT_EQ(beyond_bounds(a, b, {}), "poisson_ratio 0.450 is +0.150 from 0.300 (at most 0.1)");
+  b = a,
+  b.grip_offsets[0] = Eigen::Translation3d(0, 0.009, 0) * Eigen::AngleAxisd(0.09, Vec3::UnitZ());
+  EXPECT_EQ(beyond_bounds(a, b, {}), "");
+  b.grip_offsets[0] = Eigen::AngleAxisd(0.12, Vec3::UnitZ());
+  EXPECT_EQ(beyond_bounds(a, b, {}),
+            "grip_offsets[0] moved 0.0 mm and 0.120 rad (at most 10.0 mm, 0.100 rad)");
+  b = a, b.youngs_modulus = NAN;
+  EXPECT_NE(beyond_bounds(a, b, {}), "");
 }
 
 TEST(ObservationReceiver, GoodDatagramsBecomeFramesAndBadOnesAreCountedWithTheirReason) {

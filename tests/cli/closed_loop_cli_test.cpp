@@ -87,12 +87,17 @@ TEST_F(ClosedLoopCli, FeedbackBringsTheWorldToTargetsTheOpenLoopMisses) {
   EXPECT_LT(closed["true_error"].get<double>(), 1e-3);
   EXPECT_LT(closed["observed_error"].get<double>(), 1e-3);
   EXPECT_GT(closed["model_error"].get<double>(), 2e-3);  // the model stays wrong; the loop copes
+  // The gate judged the frames and the authority bound is reported (docs/calibration.md, Safety).
+  EXPECT_GT(closed["gate"]["frames_checked"].get<int>(), 0) << closed.dump();
+  EXPECT_EQ(closed["authority"]["max_correction"].get<double>(), 0.03);
+  EXPECT_LE(closed["authority"]["largest"].get<double>(), 0.03);
 
   // The world's true error is logged as it goes (how long it takes is a measurement, in
   // docs/benchmarks.md, not an assertion: the sim robot runs on the wall clock).
   const auto observations = log_events(log, "observation");
   ASSERT_GT(observations.size(), 5u);
   EXPECT_LT(observations.back()["true_error"].get<double>(), 1e-3);
+  EXPECT_EQ(observations.back()["authority"]["max_correction_rate"].get<double>(), 0.02);
 
   // Every command the link sent stayed within the governor's velocity and acceleration
   // limits, checked per governor step as `shapectl replay` checks a log (held steps, when real

@@ -103,6 +103,52 @@ TEST_F(SessionTest, ObserveFeedsTheClosedLoopAndBadObservationsChangeNothing) {
   EXPECT_EQ(state["observed_markers"][0][0], 5);
 }
 
+// A lying frame (a marker 1 m off the model) is refused by the plausibility gate: counted in
+// the state, said why, logged, and no correction applied (docs/calibration.md, Safety).
+TEST(SessionGate, AFrameOutsideTheGateIsCountedInTheStateAndLogged) {
+  test::TempDir dir;
+  const auto file = dir.path() / "session.jsonl";
+  nlohmann::json state;
+  {
+    SessionLog log(file);
+    Session session(test::source_path("scenes/yumi_bar.json"), {});
+    session.set_log(&log);
+    const auto first = session.controller().snapshot();
+    nlohmann::json joints = nlohmann::json::object();
+    for (std::size_t j = 0; j < first->joint_names.size(); ++j)
+      joints[first->joint_names[j]] = first->joints[j];
+    const Vec3 lie = first->positions.segment<3>(15) + Vec3(0, 0, 1);
+    const nlohmann::json frame = {{"joints", joints},
+                                  {"markers",
+                                   {{{"node", 5}, {"position", {lie.x(), lie.y(), lie.z()}}}}}};
+    ASSERT_TRUE(session.handle(R"({"type":"set_feedback","on":true})").ok);
+    ASSERT_TRUE(session.handle(nlohmann::json{{"type", "observe"}, {"frame", frame}}.dump()).ok);
+    const auto s =
+        wait_until(session, [](const ControllerSnapshot& s) { return s.gate.frames_checked > 0; });
+    EXPECT_EQ(s->gate.frames_rejected, 1u);
+    session.tick();
+    state = nlohmann::json::parse(session.state_message(1));
+  }
+  EXPECT_EQ(state["observations"], 0);
+  EXPECT_EQ(state["gate"]["markers_checked"], 1);
+  EXPECT_EQ(state["gate"]["markers_rejected"], 1);
+  EXPECT_EQ(state["gate"]["frames_rejected"], 1);
+  EXPECT_EQ(state["authority"]["max_correction"], 0.03);
+  EXPECT_EQ(state["authority"]["max_correction_rate"], 0.02);
+  EXPECT_EQ(state["authority"]["largest"], 0);
+  EXPECT_NE(state["observation_problem"].get<std::string>().find(
+                "observation gated: 1 of 1 markers outside the gate (largest innovation 1000.0 mm"),
+            std::string::npos)
+      << state["observation_problem"];
+  const auto events = read_session_log(file);
+  const auto gate = std::find_if(events.begin(), events.end(),
+                                 [](const LoggedEvent& e) { return e.event == "gate"; });
+  ASSERT_NE(gate, events.end());
+  EXPECT_EQ(gate->fields["gate"]["frames_rejected"], 1);
+  EXPECT_EQ(gate->fields["authority"]["max_correction"], 0.03);
+  EXPECT_NE(gate->fields["problem"].get<std::string>().find("outside the gate"), std::string::npos);
+}
+
 TEST_F(SessionTest, ObservedFramesFeedTheCalibrationWhichTheClientsCanRunAndFollow) {
   const auto first = session.controller().snapshot();
   nlohmann::json joints = nlohmann::json::object();

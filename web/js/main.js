@@ -196,9 +196,16 @@ function onState(state) {
   }
 }
 
-// The Real object panel's line: observations, the errors, and why the newest was ignored.
+// The Real object panel's line: observations, the errors, what the gate refused and why the
+// newest was ignored or gated (docs/calibration.md, Safety).
 function observedLine(state) {
-  const ignored = state.observation_problem ? `${state.observations_ignored} ignored: ${state.observation_problem}` : '';
+  const g = state.gate;
+  const gated = g && (g.markers_rejected || g.frames_rejected) ?
+    `gate rejected ${g.markers_rejected} of ${g.markers_checked} markers, ${g.frames_rejected} frames · ` +
+    `correction ${mm(state.authority.largest)} of at most ${mm(state.authority.max_correction)} mm` : '';
+  const problem = state.observation_problem ?
+    (state.observations_ignored ? `${state.observations_ignored} ignored · ` : '') + state.observation_problem : '';
+  const ignored = [gated, problem].filter(Boolean).join(' · ');
   if (!state.observations) return ignored || 'no observations yet';
   const truth = state.true_error === null || state.true_error === undefined ? '' : ` · true error (simulated world) ${mm(state.true_error)} mm`;
   return `${state.observations} observations · model error ${mm(state.model_error)} mm · observed error ${mm(state.observed_error)} mm` +

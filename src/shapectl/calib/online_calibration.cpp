@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include <shapectl/calib/live_observation.hpp>
 
@@ -30,9 +31,49 @@ bool same_pose(const Eigen::VectorXd& a, const Eigen::VectorXd& b, double tolera
 }
 }  // namespace
 
+std::string beyond_bounds(const PhysicalParameters& from, const PhysicalParameters& to,
+                          const ModelBounds& bounds) {
+  char text[160];
+  const auto factor = [&](const char* name, const char* unit, double a, double b, double most) {
+    const double f = std::max(b / a, a / b);
+    if (!(f <= most))
+      std::snprintf(text, sizeof text, "%s %.3g %s is %.2fx %.3g %s (at most %gx)", name, b, unit,
+                    b / a, a, unit, most);
+    return !(f <= most);
+  };
+  const auto moved = [&](const std::string& name, const Eigen::Isometry3d& a,
+                         const Eigen::Isometry3d& b) {
+    const double t = (b.translation() - a.translation()).norm();
+    const double r = Eigen::AngleAxisd(a.linear().transpose() * b.linear()).angle();
+    if (!(t <= bounds.grip_translation && r <= bounds.grip_rotation))
+      std::snprintf(text, sizeof text, "%s moved %.1f mm and %.3f rad (at most %.1f mm, %.3f rad)",
+                    name.c_str(), t * 1e3, r, bounds.grip_translation * 1e3, bounds.grip_rotation);
+    return !(t <= bounds.grip_translation && r <= bounds.grip_rotation);
+  };
+  if (factor("youngs_modulus", "Pa", from.youngs_modulus, to.youngs_modulus,
+             bounds.stiffness_factor) ||
+      factor("density", "kg/m^3", from.density, to.density, bounds.density_factor))
+    return text;
+  if (!(std::abs(to.poisson_ratio - from.poisson_ratio) <= bounds.poisson_ratio)) {
+    std::snprintf(text, sizeof text, "poisson_ratio %.3f is %+.3f from %.3f (at most %g)",
+                  to.poisson_ratio, to.poisson_ratio - from.poisson_ratio, from.poisson_ratio,
+                  bounds.poisson_ratio);
+    return text;
+  }
+  for (std::size_t g = 0; g < from.grip_offsets.size() && g < to.grip_offsets.size(); ++g)
+    if (moved("grip_offsets[" + std::to_string(g) + "]", from.grip_offsets[g], to.grip_offsets[g]))
+      return text;
+  if (moved("object_pose", from.object_pose, to.object_pose)) return text;
+  return "";
+}
+
 OnlineCalibration::OnlineCalibration(Controller& controller, const Scene& model,
                                      OnlineCalibrationOptions options)
-    : controller_(controller), model_(model), options_(options), period_(options.period) {
+    : controller_(controller),
+      scene_values_(PhysicalParameters::of(model)),
+      model_(model),
+      options_(options),
+      period_(options.period) {
   status_.automatic = options_.automatic;
 }
 
@@ -124,13 +165,31 @@ void OnlineCalibration::poll(double time) {
   }
 }
 
-bool OnlineCalibration::worth_applying(const CalibrationResult& result, std::string* why) {
+bool OnlineCalibration::worth_applying(const CalibrationResult& result, std::string* why) const {
   bool fitted = false;
   for (const FittedParameter& p : result.parameters) fitted = fitted || !p.held;
-  if (!fitted) *why = "not applied: no parameter is identifiable from the frames in the window";
-  else if (!(result.rms_after < result.rms_before))
+  if (!fitted) {
+    *why = "not applied: no parameter is identifiable from the frames in the window";
+  } else if (!(result.rms_after < result.rms_before)) {
     *why = "not applied: the fit did not lower the residuals (" + result.reason + ")";
-  else return true;
+  } else if (!(result.chi_squared_per_dof <= options_.max_chi_squared_per_dof)) {
+    char text[200];
+    std::snprintf(text, sizeof text,
+                  "not applied: the fit leaves chi2/dof %.3g (RMS %.1f mm, at most %g): the "
+                  "window holds frames the model cannot explain",
+                  result.chi_squared_per_dof, result.rms_after * 1e3,
+                  options_.max_chi_squared_per_dof);
+    *why = text;
+  } else if (const std::string total = beyond_bounds(scene_values_, result.fitted, options_.bounds);
+             !total.empty()) {
+    *why = "not applied: beyond the bounds from the scene's values: " + total;
+  } else if (const std::string step =
+                 beyond_bounds(PhysicalParameters::of(model_), result.fitted, options_.bounds);
+             !step.empty()) {
+    *why = "not applied: a jump beyond the bounds from the current model: " + step;
+  } else {
+    return true;
+  }
   return false;
 }
 

@@ -28,6 +28,23 @@
 
 namespace shapectl {
 
+// How far the online calibration may take the model: from the scene's values in total, and from
+// the current model in one fit. A fit beyond is not applied (a calibration from lying frames
+// must not hand the optimizer an implausible model). The defaults are the uncertainties of
+// docs/calibration.md: stiffness known to ±50 %, density to ±10 %, grips millimetres and
+// degrees off; twice that and more.
+struct ModelBounds {
+  double stiffness_factor = 2;     // E within [E₀/2, 2E₀]
+  double density_factor = 1.5;     // ρ within [ρ₀/1.5, 1.5ρ₀]
+  double poisson_ratio = 0.1;      // |ν − ν₀|
+  double grip_translation = 0.01;  // m, per grip offset (and the object's pose)
+  double grip_rotation = 0.1;      // rad, per grip offset (and the object's pose)
+};
+// The first value of `to` outside `bounds` around `from`, in words ("youngs_modulus 3.1e5 Pa is
+// 2.4x 1.3e5 Pa"); empty when every value is within.
+std::string beyond_bounds(const PhysicalParameters& from, const PhysicalParameters& to,
+                          const ModelBounds& bounds);
+
 struct OnlineCalibrationOptions {
   FitSelection fit{.youngs_modulus = true,
                    .poisson_ratio = false,
@@ -44,6 +61,10 @@ struct OnlineCalibrationOptions {
   double same_pose = 0.005;  // rad (m for prismatic joints), largest joint difference
   CalibrationOptions calibration{.max_iterations = 8};
   std::size_t max_drawn_points = 1000;  // of the newest cloud, for a GUI to draw
+  ModelBounds bounds = {};
+  // A fit whose residuals stay above this χ²/dof (RMS 10σ) does not explain its window: frames
+  // the model cannot explain at any parameters (lies, a slipped grip) are in it. Not applied.
+  double max_chi_squared_per_dof = 100;
 };
 
 struct OnlineCalibrationStatus {
@@ -86,9 +107,10 @@ class OnlineCalibration {
  private:
   void finish();  // the worker's result to the controller (worker joined)
   // Whether `result` should replace the current model; the reason in `why` if not.
-  static bool worth_applying(const CalibrationResult& result, std::string* why);
+  bool worth_applying(const CalibrationResult& result, std::string* why) const;
 
   Controller& controller_;
+  const PhysicalParameters scene_values_;  // as loaded: the bounds' centre
   Scene model_;  // the controller's model: the scene with every applied fit
   OnlineCalibrationOptions options_;
   std::deque<ObservationFrame> window_;

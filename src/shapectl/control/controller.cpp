@@ -298,14 +298,20 @@ bool Controller::State::take(const ShapeObservation& observation) {
         "observation ignored: no equilibrium at its joints (" + predicted.statics.reason + ")";
     return false;
   }
-  observation_problem.clear();
-  feedback->observe(observation.markers, predicted.positions);
-  observed_markers = observation.markers;
+  const double now = std::chrono::duration<double>(Clock::now() - started).count();
+  const GateVerdict gate =
+      feedback->observe(observation.markers, predicted.positions, observation.sigma, now);
+  observation_problem = gate.reason.empty() ? "" : "observation gated: " + gate.reason;
+  if (gate.frame_rejected) return false;
+  // What the loop shows and judges by: the markers the gate let through.
+  observed_markers.clear();
+  for (std::size_t k = 0; k < observation.markers.size(); ++k)
+    if (gate.inside[k]) observed_markers.push_back(observation.markers[k]);
   last_observation = observation;
   ++observations;
   double sum = 0;
   int count = 0;
-  for (const auto& [node, y] : observation.markers)
+  for (const auto& [node, y] : observed_markers)
     for (int k = 0; k < user_targets.size(); ++k)
       if (user_targets.nodes[k] == node) sum += (y - user_targets.positions[k]).norm(), ++count;
   observed_error = count ? sum / count : NAN;
@@ -412,6 +418,8 @@ void Controller::State::publish() {
   s->model_updates = model_updates;
   s->observations_ignored = observations_ignored;
   s->observation_problem = observation_problem;
+  s->gate = feedback->gate_counts();
+  s->authority = feedback->authority();
   s->status = status();
   s->tolerance = options.tolerance;
   s->jog_refused_links = jog_refused_links;

@@ -102,10 +102,13 @@ struct ControllerSnapshot {
   double model_error = 0;
   double observed_error = 0;
   std::uint64_t observations = 0;
-  // Observations the model could not predict (no equilibrium at their joints), and why the
-  // newest was ignored (empty when it was taken).
+  // Observations the model could not predict (no equilibrium at their joints), and what was
+  // wrong with the newest (ignored, or markers outside the plausibility gate; empty when fine).
+  // `observations` counts the frames taken: not those ignored or rejected by the gate.
   std::uint64_t observations_ignored = 0;
   std::string observation_problem;
+  GateCounts gate;              // the plausibility gate's counts (control/observation_gate.hpp)
+  FeedbackAuthority authority;  // the feedback's bounds and what it applies now
   // The model the optimizer works with: the scene's values until set_model replaces them.
   Material material;
   std::vector<Eigen::Isometry3d> grip_offsets;  // one per grip

@@ -236,6 +236,31 @@ void log_snapshot(SessionLog& log, const ControllerSnapshot& s) {
                           {"iterations", s.iterations}});
 }
 
+nlohmann::json gate_json(const GateCounts& g) {
+  return {{"markers_checked", g.markers_checked},
+          {"markers_rejected", g.markers_rejected},
+          {"frames_checked", g.frames_checked},
+          {"frames_rejected", g.frames_rejected}};
+}
+
+nlohmann::json authority_json(const FeedbackAuthority& a) {
+  return {{"max_correction", a.max_correction},
+          {"max_correction_rate", a.max_correction_rate},
+          {"largest", a.largest},
+          {"rate_limited", a.rate_limited},
+          {"clamped", a.clamped}};
+}
+
+void log_gate(SessionLog& log, const ControllerSnapshot& s, GateCounts& logged) {
+  if (s.gate.markers_rejected == logged.markers_rejected &&
+      s.gate.frames_rejected == logged.frames_rejected)
+    return;
+  logged = s.gate;
+  log.write("gate", {{"gate", gate_json(s.gate)},
+                     {"authority", authority_json(s.authority)},
+                     {"problem", s.observation_problem}});
+}
+
 std::vector<SceneEntry> find_bundled_scenes(const std::filesystem::path& directory) {
   std::vector<SceneEntry> scenes;
   std::error_code ec;
@@ -309,6 +334,7 @@ void Session::load(const SceneEntry& entry) {
   last_edit_time_ = -1e9;
   snapshot_ = controller_->snapshot();
   logged_sequence_ = 0;
+  logged_gate_ = {};  // a new controller counts from zero
   // Only an armed link has something to say about it (at start-up it is disarmed already).
   if (link_ && link_->status().armed) link_->disarm("scene changed to " + entry.name);
   robot_meshes_ = find_visual_meshes(*scene.robot->model, package_paths_);
@@ -494,6 +520,7 @@ void Session::tick() {
   if (log_ && snapshot_->sequence != logged_sequence_) {
     logged_sequence_ = snapshot_->sequence;
     log_snapshot(*log_, *snapshot_);
+    log_gate(*log_, *snapshot_, logged_gate_);
   }
   if (world_ && link_) observe_world(t);
   calibration_->poll(t);
@@ -603,6 +630,8 @@ std::string Session::state_message(int clients) const {
       {"observations", s.observations},
       {"observations_ignored", s.observations_ignored},
       {"observation_problem", s.observation_problem},
+      {"gate", gate_json(s.gate)},
+      {"authority", authority_json(s.authority)},
       // null until something was observed: 0 would claim a perfect model and object.
       {"model_error", s.observations ? finite_or_null(s.model_error) : nlohmann::json()},
       {"observed_error", s.observations ? finite_or_null(s.observed_error) : nlohmann::json()},

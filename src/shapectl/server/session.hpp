@@ -29,6 +29,13 @@ namespace shapectl::server {
 
 // Appends `s` as an "optimizer" event: what the robot link was sent (`run`, `serve --log`).
 void log_snapshot(SessionLog& log, const ControllerSnapshot& s);
+// The plausibility gate's counts and the feedback's authority: the states' "gate" and
+// "authority" (docs/gui.md).
+nlohmann::json gate_json(const GateCounts& g);
+nlohmann::json authority_json(const FeedbackAuthority& a);
+// Appends a "gate" event (counts, authority, the newest problem) when the gate rejected a marker
+// or a frame since `logged`, which then takes the snapshot's counts.
+void log_gate(SessionLog& log, const ControllerSnapshot& s, GateCounts& logged);
 
 struct SceneEntry {
   std::string name;  // what clients ask for, e.g. "yumi_bar.json"
@@ -130,6 +137,7 @@ class Session {
   double true_error_ = NAN;  // the world's, at the last tick (NaN without a world or targets)
   SessionLog* log_ = nullptr;
   std::uint64_t logged_sequence_ = 0;  // of the last snapshot written to log_
+  GateCounts logged_gate_;             // the gate's counts last written to log_
 };
 
 }  // namespace shapectl::server
