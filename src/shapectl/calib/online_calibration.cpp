@@ -34,9 +34,11 @@ OnlineCalibration::OnlineCalibration(Controller& controller, const Scene& model,
                                      OnlineCalibrationOptions options)
     : controller_(controller), model_(model), options_(options), period_(options.period) {
   status_.automatic = options_.automatic;
+  options_.calibration.cancel = &cancel_;
 }
 
 OnlineCalibration::~OnlineCalibration() {
+  cancel();
   if (worker_.joinable()) worker_.join();
 }
 
@@ -79,6 +81,7 @@ bool OnlineCalibration::start(std::string* why) {
   Observations observations{{window_.begin(), window_.end()}};
   frames_since_start_ = 0;
   done_ = false;
+  cancel_ = false;
   {
     std::lock_guard lock(mutex_);
     status_.running = true;
