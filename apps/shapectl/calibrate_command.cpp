@@ -1,7 +1,10 @@
 // shapectl calibrate SCENE.json --observations OBS.json --out CALIBRATED.json
 //   [--fit youngs_modulus,poisson_ratio,density,grip_offsets,object_pose] [--report REPORT.json]
+//   [--max-iterations N] [--max-seconds S]
 // Fits the scene's physical parameters to observed frames of the real object
 // (docs/calibration.md) and writes the scene with the fitted values.
+#include <algorithm>
+#include <chrono>
 #include <iostream>
 
 #include <shapectl/calib/calibration.hpp>
@@ -23,6 +26,7 @@ struct CalibrateArgs {
   std::string scene, observations, out, report;
   std::string fit;  // default: default_fit(scene)
   int max_iterations = 30;
+  double max_seconds = 300;  // the whole command
 };
 
 // The parameters to fit; --fit names one the scene does not have → InputError naming --fit.
@@ -99,6 +103,16 @@ void print_summary(const CalibrationResult& r) {
 }
 
 void run_calibrate(const CalibrateArgs& args) {
+  // --max-seconds bounds the whole command; the fit checks it between pieces that cannot be
+  // cut (a Newton iteration, a factorization, a sensitivity solve), so it aims at 90 %.
+  const auto started = std::chrono::steady_clock::now();
+  const auto remaining = [&] {
+    const std::chrono::duration<double> spent = std::chrono::steady_clock::now() - started;
+    return std::max(0.0, 0.9 * args.max_seconds - spent.count());
+  };
+  if (!(args.max_seconds > 0))
+    throw InputError("calibrate", "--max-seconds", "a positive number of seconds",
+                     args.max_seconds);
   const Scene scene = load_scene(args.scene);
   print_scene_notes(scene, args.package_paths);
   const FitSelection fit = fit_selection(args, scene);
@@ -108,9 +122,11 @@ void run_calibrate(const CalibrateArgs& args) {
                          .robot = scene.robot ? scene.robot->model.get() : nullptr});
   CalibrationResult result;
   try {
-    result = calibrate(scene, observations, fit, {.max_iterations = args.max_iterations});
+    result = calibrate(scene, observations, fit,
+                       {.max_iterations = args.max_iterations, .max_seconds = remaining()});
   } catch (const std::runtime_error& e) {
-    throw SolverFailure(std::string("calibrate: ") + e.what());
+    throw SolverFailure(std::string("calibrate: ") + e.what() +
+                        (remaining() > 0 ? "" : " (--max-seconds reached)"));
   }
   const nlohmann::ordered_json report = report_json(result);
   require_finite(report, "calibrate", result.reason);
@@ -121,6 +137,7 @@ void run_calibrate(const CalibrateArgs& args) {
   print_summary(result);
   if (!result.converged)
     throw SolverFailure("calibrate: not converged (" + result.reason +
+                        (remaining() > 0 ? "" : ", --max-seconds reached") +
                         "); the best values so far are written");
 }
 
@@ -145,6 +162,9 @@ void add_calibrate_command(CLI::App& app) {
                   "REPORT.json: values, standard deviations, residuals, identifiability");
   cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")
       ->check(CLI::Range(1, 1000));
+  cmd->add_option("--max-seconds", args->max_seconds,
+                  "time limit of the whole command: the fit stops with the best values so far")
+      ->capture_default_str();
   add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] { run_calibrate(*args); });
 }

@@ -402,6 +402,7 @@ void run(RunArgs args) {
   const RunClock clock;
   if (args.arm) arm_when_ready(*link, clock);  // throws if it cannot
   const RunOutcome outcome = follow_optimizer(args, controller, *link, log.get(), clock, observers);
+  calibration.cancel();  // a fit still running would hold both cores while the rest stops
   const LinkStatus final_status = stop_run(*link, controller, outcome.failure);
   const nlohmann::json result = run_result(outcome, final_status, *link, observers);
   if (log) log->write("end", {{"settled", outcome.settled}, {"reason", outcome.failure}});

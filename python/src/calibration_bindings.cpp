@@ -60,18 +60,20 @@ bool finite(const CalibrationResult& r) {
 }
 
 Calibration run_calibrate(const SceneHandle& s, const py::object& observations_in,
-                          const py::object& fit_in, Integer max_iterations) {
+                          const py::object& fit_in, Integer max_iterations, Real max_seconds) {
   const Scene& scene = *s.scene;
   const FitSelection fit = fit_from(fit_in.is_none() ? py::str(default_fit(scene)) : fit_in);
   if (max_iterations < 1 || max_iterations > 1000)
     throw InputError("max_iterations", "", "a number from 1 to 1000", max_iterations);
+  if (!(max_seconds > 0)) throw InputError("max_seconds", "", "a positive number", max_seconds);
   const Observations observations = observations_from(observations_in, scene);
 
   py::gil_scoped_release release;
   Calibration out;
   try {
     static_cast<CalibrationResult&>(out) =
-        calibrate(scene, observations, fit, {.max_iterations = max_iterations});
+        calibrate(scene, observations, fit,
+                  {.max_iterations = max_iterations, .max_seconds = max_seconds.value});
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const std::runtime_error& e) {  // a frame's equilibrium not found
@@ -150,16 +152,17 @@ void bind_calibration(py::module_& m) {
       .def_readonly("frames", &CalibrationResult::frames, "One FrameFit per observed frame.");
 
   m.def("calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
-        py::arg("fit") = py::none(), py::arg("max_iterations") = 30,
+        py::arg("fit") = py::none(), py::arg("max_iterations") = 30, py::arg("max_seconds") = 300.0,
         "Fits the scene's physical parameters to observations of the real object, as `shapectl "
         "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
         "of its schema (numpy arrays allowed; a points_file relative to the current "
         "directory). fit: a comma-separated string or a list of youngs_modulus, poisson_ratio, "
         "density, grip_offsets, object_pose (default: youngs_modulus and grip_offsets with a "
-        "robot, youngs_modulus and object_pose without). Raises ValueError for bad input (the "
-        "CLI's message; a dict is "
-        "named 'observations'), SolverError when a frame's equilibrium cannot be found. Releases "
-        "the GIL while it runs.");
+        "robot, youngs_modulus and object_pose without). max_seconds: the fit's time budget; "
+        "spent, it stops with the best values so far (converged False). Raises ValueError for bad "
+        "input (the CLI's message; a dict is named 'observations'), SolverError when a frame's "
+        "equilibrium cannot be found or the budget is spent before a first fit. Releases the GIL "
+        "while it runs.");
 }
 
 }  // namespace shapectl::python

@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <random>
+#include <string>
+#include <thread>
 
 #include <shapectl/calib/joint_path.hpp>
 #include <shapectl/calib/simulated_camera.hpp>
@@ -94,6 +98,54 @@ TEST(Calibration, StiffnessAndDensityFromShapeAloneAreReportedUnidentifiable) {
       calibrate(study.model, observations, parse_fit_selection("youngs_modulus,density"));
   EXPECT_EQ(r.parameters.size(), 2u);
   test::expect_density_held_for_stiffness(r);
+}
+
+// Seconds `f` took.
+template <class F>
+double seconds_of(F&& f) {
+  const auto started = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+}
+
+// Fine path steps make every frame's walk from the reference joints long (the default study
+// takes seconds so): the budget must reach into the walk, not wait for it, and a cancel too.
+TEST(Calibration, ATimeBudgetOrACancelStopsTheFitInsideTheWalkToAFrame) {
+  const SyntheticStudy study;
+  SimulatedCamera camera;
+  camera.marker_nodes = spread_nodes(study.model.object_mesh->node_count(), 15, 7);
+  const Observations observations = study.observe(camera, 11);
+  const FitSelection fit = parse_fit_selection("youngs_modulus");
+  std::string error;
+  const auto stopped_fit = [&](const CalibrationOptions& options) {
+    try {
+      calibrate(study.model, observations, fit, options);
+    } catch (const std::runtime_error& e) {
+      error = e.what();
+    }
+  };
+  const double budgeted =
+      seconds_of([&] { stopped_fit({.path_step = 0.001, .max_seconds = 0.3}); });
+  EXPECT_EQ(error, "time limit of 0.3 s reached before the model was evaluated");
+  EXPECT_LT(budgeted, 2.0);
+
+  std::atomic<bool> cancel{false};
+  std::thread canceller([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    cancel = true;
+  });
+  const double cancelled =
+      seconds_of([&] { stopped_fit({.path_step = 0.001, .cancel = &cancel}); });
+  canceller.join();
+  EXPECT_EQ(error, "cancelled before the model was evaluated");
+  EXPECT_LT(cancelled, 2.0);
+  // The same walk unbounded takes longer than both bounds above.
+  Observations far_frame{{observations.frames[1]}};
+  error.clear();
+  EXPECT_GT(seconds_of([&] {
+              calibrate(study.model, far_frame, fit, {.max_iterations = 1, .path_step = 0.001});
+            }),
+            2.0);
 }
 
 }  // namespace

@@ -140,6 +140,25 @@ TEST(Observations, JointsMustNameEveryActiveJointAndNoOther) {
             "obs.json: frames[0].joints: expected an object of joint values, got [0,0]");
 }
 
+// A frame with a joint at 1e6 rad once made calibrate walk the model there for hours (issue 32).
+TEST(Observations, JointsOutsideTheirLimitsBeyondTheMarginAreRefusedNamingJointAndLimits) {
+  const RobotModel robot = two_joint_robot();  // both joints in [-2, 2]
+  const ObservationContext context{.node_count = 8, .robot = &robot};
+  auto with_a2 = [](double a2) {
+    return R"({"frames": [{"points": [[0, 0, 0]], "joints": {"a1": 0, "a2": )" +
+           nlohmann::json(a2).dump() + "}}]}";
+  };
+  EXPECT_EQ(error_of(with_a2(1e6), context),
+            "obs.json: frames[0].joints.a2: expected a value within the joint's limits [-2, 2] "
+            "give or take 0.01, got 1000000.0");
+  EXPECT_NE(error_of(with_a2(2 + 1.5 * observation_joint_margin), context), "");
+  EXPECT_NE(error_of(with_a2(-2 - 1.5 * observation_joint_margin), context), "");
+  // Within the margin: a measured joint may read a little past its limit.
+  EXPECT_EQ(parse(with_a2(2 + 0.5 * observation_joint_margin), context).frames[0].joints[1],
+            2 + 0.5 * observation_joint_margin);
+  EXPECT_EQ(parse(with_a2(-2), context).frames[0].joints[1], -2);
+}
+
 TEST(Observations, UnreadablePointsFilesNameTheFrameAndTheFile) {
   TempDir dir;
   const ObservationContext context{.node_count = 8};

@@ -4,9 +4,11 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <random>
+#include <thread>
 
 #include <shapectl/calib/joint_path.hpp>
 #include <shapectl/calib/observation_receiver.hpp>
@@ -271,6 +273,37 @@ TEST(ModelBounds, AValueBeyondItsBoundIsNamedWithItsNumbers) {
   EXPECT_NE(beyond_bounds(a, b, {}), "");
 }
 
+// A session must never stay "calibrating" (issue 32): cancel() stops a long fit at its next
+// check, the status says so, and the next calibration may start.
+TEST_F(OnlineCalibrationTest, CancelStopsARunningCalibrationAtItsNextCheck) {
+  Controller controller(model);
+  OnlineCalibrationOptions options{.fit = {.youngs_modulus = true,
+                                           .poisson_ratio = false,
+                                           .density = false,
+                                           .grip_offsets = false},
+                                   .automatic = false};
+  options.calibration.path_step = 0.00005;  // 600 steps to the frame's joints: seconds
+  OnlineCalibration calibration(controller, model, options);
+  Eigen::VectorXd arched = model.robot->reference_joints;
+  arched[0] -= 0.03, arched[7] += 0.03;
+  calibration.observe(look(arched));
+  ASSERT_TRUE(calibration.start());
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  ASSERT_TRUE(calibration.status().running);
+  const auto cancelled = std::chrono::steady_clock::now();
+  calibration.cancel();
+  calibration.wait();
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - cancelled).count(),
+            1.0);
+  calibration.poll(0);
+  const OnlineCalibrationStatus c = calibration.status();
+  EXPECT_FALSE(c.running);
+  EXPECT_EQ(c.runs, 1u);
+  EXPECT_FALSE(c.applied);
+  EXPECT_NE(c.error.find("cancelled"), std::string::npos) << c.error;
+  EXPECT_TRUE(calibration.start());  // the destructor cancels this one
+}
+
 TEST(ObservationReceiver, GoodDatagramsBecomeFramesAndBadOnesAreCountedWithTheirReason) {
   const Scene scene = load_scene(test::source_path("scenes/yumi_bar.json"));
   ObservationReceiver receiver("127.0.0.1", 0,
@@ -294,11 +327,12 @@ TEST(ObservationReceiver, GoodDatagramsBecomeFramesAndBadOnesAreCountedWithTheir
                                               points_file.dump(), too_deep,    good.dump()};
   for (const std::string& datagram : datagrams) ASSERT_TRUE(sender.send_to(datagram, to));
   std::vector<ObservationFrame> frames;
-  for (int k = 0; k < 200 && receiver.received() < 6; ++k) {  // loopback: at once, in order
+  // Loopback: at once, in order.
+  for (int k = 0; k < 200 && receiver.received() + receiver.rejected() < 6; ++k) {
     for (ObservationFrame& f : receiver.receive()) frames.push_back(std::move(f));
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
-  ASSERT_EQ(receiver.received(), 6u);
+  ASSERT_EQ(receiver.received(), 2u);  // each datagram counts once: received or rejected
   ASSERT_EQ(frames.size(), 2u);
   EXPECT_EQ(frames[0].markers.at(0).node, 3);
   EXPECT_EQ(frames[0].time, 1.5);
@@ -306,6 +340,36 @@ TEST(ObservationReceiver, GoodDatagramsBecomeFramesAndBadOnesAreCountedWithTheir
   // The last rejection names the sender and what was wrong.
   EXPECT_NE(receiver.last_rejection().find("udp 127.0.0.1:"), std::string::npos);
   EXPECT_NE(receiver.last_rejection().find("nested deeper"), std::string::npos)
+      << receiver.last_rejection();
+}
+
+// `run --observations-udp` once took such a frame as received (issue 32): calibration then
+// walked the model from the reference joints towards 1e6 rad for hours.
+TEST(ObservationReceiver, AFrameWithAJointAtAMillionRadiansIsRejectedNotReceived) {
+  const Scene scene = load_scene(test::source_path("scenes/yumi_bar.json"));
+  ObservationReceiver receiver("127.0.0.1", 0,
+                               {.node_count = scene.object_mesh->node_count(),
+                                .robot = scene.robot->model.get()});
+  nlohmann::json joints = nlohmann::json::object();
+  const auto& names = scene.robot->model->active_joint_names();
+  for (std::size_t j = 0; j < names.size(); ++j)
+    joints[names[j]] = scene.robot->reference_joints[static_cast<Eigen::Index>(j)];
+  joints[names[2]] = 1e6;
+  const nlohmann::json far = {{"joints", joints},
+                              {"markers", {{{"node", 3}, {"position", {0.4, 0.0, 0.3}}}}}};
+  UdpSocket sender("127.0.0.1", 0, "test sender");
+  ASSERT_TRUE(sender.send_to(far.dump(), ipv4_address("127.0.0.1", receiver.port(), "test")));
+  std::vector<ObservationFrame> frames;
+  for (int k = 0; k < 200 && receiver.rejected() == 0; ++k) {
+    for (ObservationFrame& f : receiver.receive()) frames.push_back(std::move(f));
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  EXPECT_TRUE(frames.empty());
+  EXPECT_EQ(receiver.received(), 0u);
+  EXPECT_EQ(receiver.rejected(), 1u);
+  EXPECT_NE(receiver.last_rejection().find("joints." + names[2] +
+                                           ": expected a value within the joint's limits"),
+            std::string::npos)
       << receiver.last_rejection();
 }
 

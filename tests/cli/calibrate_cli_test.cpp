@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <chrono>
 #include <random>
 
 #include <shapectl/calib/joint_path.hpp>
@@ -120,6 +121,10 @@ TEST_F(CalibrateCli, BadObservationsExitOneNamingTheField) {
        "yumi_joint_3_l"},
       {"joint unknown", [](nlohmann::json& o) { o["frames"][2]["joints"]["elbow"] = 0.1; },
        "elbow"},
+      // Issue 32: calibrate walked the model from the reference joints towards it for hours.
+      {"joint at a million radians",
+       [](nlohmann::json& o) { o["frames"][1]["joints"]["yumi_joint_3_l"] = 1e6; },
+       "frames[1].joints.yumi_joint_3_l: expected a value within the joint's limits"},
       {"unreadable points file",
        [](nlohmann::json& o) { o["frames"][0]["points_file"] = "missing.ply"; }, "missing.ply"},
   };
@@ -132,6 +137,36 @@ TEST_F(CalibrateCli, BadObservationsExitOneNamingTheField) {
     EXPECT_EQ(run.exit_code, 1) << c.what << ": " << run.err;
     EXPECT_NE(run.err.find(c.field), std::string::npos) << c.what << ": " << run.err;
     EXPECT_FALSE(std::filesystem::exists(out)) << c.what << ": nothing written";
+  }
+}
+
+// Issue 32: `calibrate` on any input ends within its deadline. Thousands of frames at a pose
+// within the limits but away from the reference joints: each is walked to from there, and the
+// fit's first evaluation alone would take minutes.
+TEST_F(CalibrateCli, AHostileInputEndsWithinMaxSeconds) {
+  const nlohmann::json good = nlohmann::json::parse(test::read_text(observations));
+  nlohmann::json many = {{"frames", nlohmann::json::array()}};
+  for (int k = 0; k < 3000; ++k) many["frames"].push_back(good["frames"][1]);
+  const auto file = dir.write("many.json", many.dump());
+  const auto started = std::chrono::steady_clock::now();
+  const auto run = run_cli({"calibrate", kCantilever.string(), "--observations", file.string(),
+                            "--out", out, "--max-seconds", "2"});
+  const std::chrono::duration<double> took = std::chrono::steady_clock::now() - started;
+  EXPECT_EQ(run.exit_code, 2) << run.err;
+  EXPECT_NE(run.err.find("time limit"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("--max-seconds reached"), std::string::npos) << run.err;
+  EXPECT_LT(took.count(), 2.5) << "the process's start and reading the files come on top";
+  EXPECT_FALSE(std::filesystem::exists(out)) << "stopped before a first fit: nothing written";
+}
+
+TEST_F(CalibrateCli, MaxSecondsMustBeAPositiveNumber) {
+  for (const char* seconds : {"0", "-1", "nan"}) {
+    const auto run = run_cli({"calibrate", kCantilever.string(), "--observations",
+                              observations.string(), "--out", out, "--max-seconds", seconds});
+    EXPECT_EQ(run.exit_code, 1) << seconds << ": " << run.err;
+    EXPECT_NE(run.err.find("--max-seconds: expected a positive number of seconds"),
+              std::string::npos)
+        << run.err;
   }
 }
 

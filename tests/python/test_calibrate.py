@@ -90,6 +90,9 @@ def test_matches_the_cli_on_the_same_file(cli, write_json, tmp_path, model):
     (lambda o: o["frames"][0]["markers"][0].update(node=500), "frames[0].markers[0].node"),
     (lambda o: o["frames"][1]["joints"].pop("yumi_joint_3_l"), "frames[1].joints"),
     (lambda o: o["frames"][2].update(sigma=-1), "frames[2].sigma"),
+    # Issue 32: a joint at 1e6 rad made calibrate walk there for hours; outside its limits now.
+    (lambda o: o["frames"][1]["joints"].update(yumi_joint_3_l=1e6),
+     "frames[1].joints.yumi_joint_3_l: expected a value within the joint's limits"),
 ])
 def test_bad_observations_raise_the_clis_message(cli, write_json, model, change, field):
     observations = as_json(synthetic_observations(model))
@@ -120,6 +123,9 @@ def test_bad_options_and_a_scene_without_robot_are_named(cli, write_json, model)
         shapectl.calibrate(model, observations["frames"])
     with pytest.raises(ValueError, match="max_iterations: expected a number from 1 to 1000, got 0"):
         shapectl.calibrate(model, observations, max_iterations=0)
+    for seconds in (0, -1, float("nan")):
+        with pytest.raises(ValueError, match="max_seconds: expected a positive number"):
+            shapectl.calibrate(model, observations, max_seconds=seconds)
     # Frames with joints for a scene without a robot (a clamped bar).
     clamped = SOURCE_DIR / "scenes" / "foam_bar_clamped.json"
     run = cli("calibrate", clamped, "--observations", path)

@@ -20,77 +20,18 @@
 #include <utility>
 #include <vector>
 
-#include <boost/asio.hpp>
-#include <boost/beast.hpp>
 #include <gtest/gtest.h>
 
+#include "server/serve_process.hpp"
 #include "support/test_support.hpp"
 
 namespace shapectl::test {
 namespace {
 
-namespace beast = boost::beast;
-namespace websocket = beast::websocket;
-namespace net = boost::asio;
-using tcp = net::ip::tcp;
 using namespace std::chrono_literals;
 
 constexpr rlim_t server_open_file_limit = 128;
 constexpr int attackers = 300;
-
-// `shapectl serve` as a child process with a lowered open-file limit; stdout and stderr go to
-// files in `dir`. Killed (SIGTERM, then SIGKILL) when the object dies.
-class ServeProcess {
- public:
-  ServeProcess(const TempDir& dir, const std::vector<std::string>& args, rlim_t open_file_limit)
-      : out_(dir.path() / "stdout"), err_(dir.path() / "stderr") {
-    pid_ = test::start_process(test::cli_command(args), out_, err_, [open_file_limit] {
-      const rlimit limit{open_file_limit, open_file_limit};
-      if (setrlimit(RLIMIT_NOFILE, &limit) != 0) _exit(126);
-    });
-  }
-  ~ServeProcess() { stop(); }
-
-  // The port from "open http://127.0.0.1:PORT/", or 0 if the server did not print it in time.
-  int wait_for_port(std::chrono::seconds limit) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < deadline) {
-      const std::string out = read_text(out_);
-      const auto at = out.find("open http://127.0.0.1:");
-      if (at != std::string::npos && out.find('/', at + 22) != std::string::npos)
-        return std::stoi(out.substr(at + 22));
-      if (waitpid(pid_, nullptr, WNOHANG) == pid_) {
-        pid_ = -1;
-        return 0;
-      }
-      std::this_thread::sleep_for(50ms);
-    }
-    return 0;
-  }
-
-  // True if the server was still running (and then stopped by SIGTERM in time).
-  bool stop() {
-    if (pid_ <= 0) return false;
-    kill(pid_, SIGTERM);
-    bool exited = false;
-    for (int k = 0; k < 200 && !exited; ++k) {
-      exited = waitpid(pid_, nullptr, WNOHANG) == pid_;
-      if (!exited) std::this_thread::sleep_for(50ms);
-    }
-    if (!exited) {
-      kill(pid_, SIGKILL);
-      waitpid(pid_, nullptr, 0);
-    }
-    pid_ = -1;
-    return exited;
-  }
-  std::string log() const { return read_text(err_); }
-  pid_t pid() const { return pid_; }
-
- private:
-  std::filesystem::path out_, err_;
-  pid_t pid_ = -1;
-};
 
 // A loopback TCP connection (plain descriptor, so the test controls every wait).
 int connect_loopback(int port) {
@@ -136,44 +77,6 @@ std::optional<std::string> http_get(int port, const std::string& target,
   close(fd);
   return response;
 }
-
-// A page's WebSocket, read with deadlines.
-class Watcher {
- public:
-  explicit Watcher(int port) {
-    beast::get_lowest_layer(ws_).connect(
-        tcp::endpoint(net::ip::address_v4::loopback(), static_cast<unsigned short>(port)));
-    ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws");
-  }
-  void send(const std::string& text) { ws_.write(net::buffer(text)); }
-  // The next text message that contains `needle`, or nullopt if none came within `limit`.
-  std::optional<std::string> next(const std::string& needle, std::chrono::seconds limit) {
-    const auto deadline = std::chrono::steady_clock::now() + limit;
-    while (std::chrono::steady_clock::now() < deadline) {
-      beast::error_code result = net::error::timed_out;
-      buffer_.clear();
-      ws_.async_read(buffer_, [&](beast::error_code ec, std::size_t) { result = ec; });
-      ioc_.restart();
-      ioc_.run_until(deadline);
-      if (!ioc_.stopped()) {  // the deadline passed with the read pending
-        beast::get_lowest_layer(ws_).cancel();
-        ioc_.restart();
-        ioc_.run();
-        return std::nullopt;
-      }
-      if (result) return std::nullopt;
-      if (!ws_.got_text()) continue;
-      std::string text = beast::buffers_to_string(buffer_.data());
-      if (text.find(needle) != std::string::npos) return text;
-    }
-    return std::nullopt;
-  }
-
- private:
-  net::io_context ioc_;
-  websocket::stream<beast::tcp_stream> ws_{ioc_};
-  beast::flat_buffer buffer_;
-};
 
 std::size_t count_lines(const std::string& text) {
   return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n'));

@@ -149,6 +149,31 @@ TEST(SessionGate, AFrameOutsideTheGateIsCountedInTheStateAndLogged) {
   EXPECT_NE(gate->fields["problem"].get<std::string>().find("outside the gate"), std::string::npos);
 }
 
+// Issue 32: such a frame once went into the calibration window, whose fit then walked the model
+// towards 1e6 rad for hours and left the session "calibrating".
+TEST_F(SessionTest, AnObservationWithAJointAtAMillionRadiansIsRejectedCountedAndNamed) {
+  const auto first = session.controller().snapshot();
+  nlohmann::json joints = nlohmann::json::object();
+  for (std::size_t j = 0; j < first->joint_names.size(); ++j)
+    joints[first->joint_names[j]] = first->joints[j];
+  joints[first->joint_names[3]] = 1e6;
+  const nlohmann::json frame = {{"joints", joints},
+                                {"markers", {{{"node", 5}, {"position", {0.4, 0.0, 0.3}}}}}};
+  const auto r = session.handle(nlohmann::json{{"type", "observe"}, {"frame", frame}}.dump());
+  EXPECT_FALSE(r.ok);
+  const std::string field =
+      "frame.joints." + first->joint_names[3] + ": expected a value within the joint's limits";
+  EXPECT_NE(reply_json(r)["message"].get<std::string>().find(field), std::string::npos) << r.text;
+  EXPECT_NE(r.log.find(field), std::string::npos) << r.log;  // the server's log line
+  EXPECT_FALSE(session.handle(R"({"type":"remove_target","node":-1})").ok);  // not an observation
+  session.tick();
+  const auto state = nlohmann::json::parse(session.state_message(1));
+  EXPECT_EQ(state["observations_rejected"], 1);
+  EXPECT_NE(state["observation_rejection"].get<std::string>().find(field), std::string::npos);
+  EXPECT_EQ(state["calibration"]["frames"], 0);
+  EXPECT_EQ(state["observations"], 0);
+}
+
 TEST_F(SessionTest, ObservedFramesFeedTheCalibrationWhichTheClientsCanRunAndFollow) {
   const auto first = session.controller().snapshot();
   nlohmann::json joints = nlohmann::json::object();

@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include <Eigen/SVD>
 
@@ -57,11 +60,13 @@ struct FitPoint {
 class CalibrationProblem {
  public:
   CalibrationProblem(const Scene& scene, const Observations& observations,
-                     const ParameterSpace& space, const CalibrationOptions& options)
+                     const ParameterSpace& space, const CalibrationOptions& options,
+                     StopRequest stop)
       : scene_(scene),
         observations_(observations),
         space_(space),
         options_(options),
+        stop_(std::move(stop)),
         surface_(scene.object_mesh->surface_triangles()) {}
 
   // The fit at p. Equilibria start from `warm`'s (see frame_equilibria). New cut-offs are
@@ -69,9 +74,10 @@ class CalibrationProblem {
   FitPoint evaluate(const PhysicalParameters& p, const Equilibria* warm,
                     const std::vector<double>& cutoffs, bool with_jacobian) {
     FitPoint out;
-    out.equilibria =
-        frame_equilibria(scene_, space_, p, observations_, warm,
-                         {.with_sensitivity = with_jacobian, .path_step = options_.path_step});
+    out.equilibria = frame_equilibria(scene_, space_, p, observations_, warm,
+                                      {.with_sensitivity = with_jacobian,
+                                       .path_step = options_.path_step,
+                                       .stop = stop_});
     const Equilibrium* surface_at = nullptr;  // frames of a fixed scene share one equilibrium
     for (std::size_t k = 0; k < observations_.frames.size(); ++k) {
       const ObservationFrame& frame = observations_.frames[k];
@@ -90,6 +96,7 @@ class CalibrationProblem {
   const Observations& observations_;
   const ParameterSpace& space_;
   const CalibrationOptions& options_;
+  StopRequest stop_;
   SurfaceDistance surface_;
 };
 
@@ -195,6 +202,20 @@ const char* unit_of(Kind kind) {
   return "";
 }
 
+// Why the fit must stop now (cancelled, or its time budget spent), or empty.
+std::string stop_reason(const CalibrationOptions& options,
+                        std::chrono::steady_clock::time_point started) {
+  if (options.cancel && options.cancel->load()) return "cancelled";
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (seconds > options.max_seconds) {
+    std::ostringstream reason;
+    reason << "time limit of " << options.max_seconds << " s reached";
+    return reason.str();
+  }
+  return {};
+}
+
 }  // namespace
 
 CalibrationResult calibrate(const Scene& scene, const Observations& observations,
@@ -203,11 +224,23 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
   if (observations.frames.empty()) throw std::invalid_argument("no observed frames");
   check_frames(scene, observations);
   const ParameterSpace space(scene, fit);
-  CalibrationProblem problem(scene, observations, space, options);
+  // Asked deep inside (each Newton iteration, path step, frame): the first reason sticks.
+  std::string stopped;
+  const StopRequest stop = [&] {
+    if (stopped.empty()) stopped = stop_reason(options, started);
+    return !stopped.empty();
+  };
+  CalibrationProblem problem(scene, observations, space, options, stop);
   const PhysicalParameters initial = PhysicalParameters::of(scene);
 
   CalibrationResult result;
-  FitPoint at = problem.evaluate(initial, nullptr, {}, true);
+  FitPoint at;
+  try {
+    at = problem.evaluate(initial, nullptr, {}, true);
+  } catch (const std::runtime_error&) {
+    if (stop()) throw std::runtime_error(stopped + " before the model was evaluated");
+    throw;
+  }
   const FitPoint before = at;
   const std::vector<int> active =
       identifiable_coordinates(space, at.jacobian(), options.identifiability_threshold,
@@ -215,6 +248,7 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
   double lambda = -1;  // set at the first iteration
   result.reason = "iteration limit";
   for (int iteration = 0; iteration < options.max_iterations && !active.empty(); ++iteration) {
+    if (stop()) break;
     const Eigen::MatrixXd J = columns(at.jacobian(), active);
     const Eigen::VectorXd r = at.residuals();
     const Eigen::MatrixXd JtJ = J.transpose() * J;
@@ -222,7 +256,7 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
     if (lambda < 0) lambda = 1e-3;  // relative to the diagonal (Marquardt)
     bool accepted = false;
     double step = 0;
-    for (int trial = 0; trial < 12 && !accepted; ++trial) {
+    for (int trial = 0; trial < 12 && !accepted && !stop(); ++trial) {
       Eigen::MatrixXd A = JtJ;
       A.diagonal() += lambda * JtJ.diagonal().cwiseMax(1e-12 * JtJ.diagonal().maxCoeff());
       const Eigen::VectorXd delta = -A.ldlt().solve(g);
@@ -237,12 +271,17 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
         next = problem.evaluate(space.advanced(at.equilibria.parameters, dz), &at.equilibria,
                                 at.cutoffs, false);
       } catch (const std::runtime_error&) {
-        lambda *= 4;  // a step too far for statics: shorter
+        lambda *= 4;  // a step too far for statics: shorter (or stopped: the loop ends)
         continue;
       }
       if (next.cost < at.cost) {
         const double decrease = (at.cost - next.cost) / std::max(at.cost, 1e-300);
-        at = problem.evaluate(next.equilibria.parameters, &next.equilibria, {}, true);
+        try {
+          at = problem.evaluate(next.equilibria.parameters, &next.equilibria, {}, true);
+        } catch (const std::runtime_error&) {
+          if (stop()) break;  // `at` stays the last point with a Jacobian
+          throw;
+        }
         lambda = std::max(lambda / 3, 1e-12);
         accepted = true;
         result.iterations = iteration + 1;
@@ -255,6 +294,7 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
         lambda *= 4;
       }
     }
+    if (!accepted && stop()) break;
     if (!accepted) {
       // No step lowers the cost: at a minimum up to round-off.
       result.converged = true;
@@ -263,6 +303,7 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
     if (result.converged) break;
   }
   if (active.empty()) result.reason = "nothing identifiable to fit";
+  if (!stopped.empty() && !result.converged) result.reason = stopped;
 
   // Gauss–Newton covariance of the fitted coordinates (residuals are in units of σ).
   const Eigen::MatrixXd J = columns(at.jacobian(), active);

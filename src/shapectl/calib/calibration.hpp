@@ -13,6 +13,7 @@
 // translations) and reported, never fitted to noise. With gravity and grips only, for example,
 // the shape depends on stiffness and density through their ratio alone: asked for both, the
 // fit holds density and fits Young's modulus.
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,13 @@ struct CalibrationOptions {
   double identifiability_threshold = 0.1;
   // Steps to walk the joints from the reference configuration to a frame's (rad, largest joint).
   double path_step = 0.05;
+  // s: the fit's time budget, checked between Newton iterations, path steps, frames and trials
+  // (a factorization or a sensitivity solve is not cut). Spent, the fit stops with the best
+  // values so far, not converged; spent before the first evaluation, it throws.
+  double max_seconds = 300;
+  // Set from another thread to stop the fit the same way (OnlineCalibration::cancel); may be
+  // null.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct FittedParameter {
@@ -69,7 +77,8 @@ struct CalibrationResult {
 
 // Throws std::invalid_argument for a selection the scene does not allow (ParameterSpace) or
 // observations that do not match it (joints of another robot, or joints without one),
-// std::runtime_error when a frame's equilibrium cannot be found.
+// std::runtime_error when a frame's equilibrium cannot be found or the fit is stopped (time
+// budget, cancel) before the model was evaluated at the initial values.
 CalibrationResult calibrate(const Scene& scene, const Observations& observations,
                             const FitSelection& fit, const CalibrationOptions& options = {});
 

@@ -12,13 +12,16 @@ namespace {
 // A robot holds the object: frame k's equilibrium at its joints, Newton from the warm start,
 // or (without one, or when that fails) walked from the reference joints.
 ObjectState robot_equilibrium(const GrippedObject& object, const Eigen::VectorXd& joints,
-                              const Positions* warm, std::size_t frame, double path_step) {
+                              const Positions* warm, std::size_t frame,
+                              const EquilibriumOptions& options) {
+  if (options.stop && options.stop())
+    throw std::runtime_error("frame " + std::to_string(frame) + ": stopped");
   if (warm) {
-    ObjectState state = object.solve_from(joints, *warm);
+    ObjectState state = object.solve_from(joints, *warm, 0, nullptr, options.stop);
     if (state.statics().converged() && object.stable(state)) return state;
   }
   try {
-    return equilibrium_along_path(object, joints, path_step);
+    return equilibrium_along_path(object, joints, options.path_step, options.stop);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error("frame " + std::to_string(frame) + ": " + e.what());
   }
@@ -30,9 +33,8 @@ Equilibria robot_equilibria(const Scene& scene, const ParameterSpace& space,
   const GrippedObject object(parameters.applied_to(scene));
   Equilibria out{.parameters = parameters, .frames = {}};
   for (std::size_t k = 0; k < observations.frames.size(); ++k) {
-    ObjectState state =
-        robot_equilibrium(object, observations.frames[k].joints,
-                          warm ? &warm->frames[k]->positions : nullptr, k, options.path_step);
+    ObjectState state = robot_equilibrium(object, observations.frames[k].joints,
+                                          warm ? &warm->frames[k]->positions : nullptr, k, options);
     auto e = std::make_shared<Equilibrium>();
     if (options.with_sensitivity)
       e->dx_dz = object.force_response(state, space.force_derivatives(object, state, parameters));
@@ -65,11 +67,11 @@ Equilibria fixed_equilibria(const Scene& scene, const ParameterSpace& space,
   if (warm) {
     x = carried(warm->frames.front()->positions, warm->parameters.object_pose,
                 parameters.object_pose);
-    r = statics.solve(ws, x);
+    r = statics.solve(ws, x, nullptr, 0, nullptr, options.stop);
   }
   if (!r.converged()) {
     x = placed.world_rest_positions();
-    r = statics.solve(ws, x);
+    r = statics.solve(ws, x, nullptr, 0, nullptr, options.stop);
   }
   if (!r.converged()) throw std::runtime_error("no equilibrium of the fixed scene: " + r.reason);
   auto e = std::make_shared<Equilibrium>();

@@ -31,6 +31,9 @@ struct Equilibria {
 struct EquilibriumOptions {
   bool with_sensitivity = false;  // also dx̂/dz
   double path_step = 0.05;        // rad: see calib/joint_path.hpp
+  // Asked between frames and Newton iterations (may be empty); true ends the search with
+  // std::runtime_error (a calibration's time budget or its cancel).
+  StopRequest stop = {};
 };
 
 // Newton starts from `warm` (the frames' equilibria at nearby parameters) when given. Throws

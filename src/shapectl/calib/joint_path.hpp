@@ -7,9 +7,15 @@
 
 namespace shapectl {
 
+// Steps a path may take: 50 rad at the default step, beyond any joint range a robot has
+// (a continuous joint's reading far off would otherwise make the walk last hours).
+inline constexpr int max_joint_path_steps = 1000;
+
 // A step where Newton does not converge is halved (up to 4 times). Throws std::runtime_error
-// with Newton's reason when an equilibrium on the way is not found even so.
+// with Newton's reason when an equilibrium on the way is not found even so, or when the path
+// needs more than max_joint_path_steps steps. `stop` (may be empty) ends Newton early: the
+// walk then throws with Newton's "stopped" reason.
 ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::VectorXd& joints,
-                                   double max_step = 0.05);
+                                   double max_step = 0.05, const StopRequest& stop = {});
 
 }  // namespace shapectl

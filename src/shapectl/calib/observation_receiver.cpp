@@ -30,7 +30,6 @@ std::vector<ObservationFrame> ObservationReceiver::receive() {
   std::vector<ObservationFrame> frames;
   sockaddr_in from{};
   for (long size; (size = socket_.receive(buffer_, &from)) >= 0;) {
-    ++received_;
     const std::string source = sender_name(from);
     try {
       if (static_cast<std::size_t>(size) > max_observation_datagram)
@@ -41,6 +40,7 @@ std::vector<ObservationFrame> ObservationReceiver::receive() {
                                              .max_depth = max_frame_depth}),
                             source);
       frames.push_back(read_observation_frame(frame, context_));
+      ++received_;
     } catch (const InputError& e) {
       ++rejected_;
       last_rejection_ = e.what();

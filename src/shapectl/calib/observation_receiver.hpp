@@ -4,8 +4,9 @@
 // program can feed the closed loop with a few lines of code. Never a points file (a sender
 // must not make shapectl read its files); clouds go inline, within one datagram.
 //
-// A bad datagram (not JSON, too deep, an unknown node, non-finite numbers, joints missing) is
-// counted and its reason kept; it never stops the loop and never reaches the controller.
+// A bad datagram (not JSON, too deep, an unknown node, non-finite numbers, joints missing or
+// outside their limits) is counted as rejected and its reason kept; it never stops the loop
+// and never reaches the controller.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -27,6 +28,7 @@ class ObservationReceiver {
 
   // The frames of every datagram waiting now, in arrival order; bad ones counted.
   std::vector<ObservationFrame> receive();
+  // Each datagram counts once: received (a checked frame, returned) or rejected.
   std::uint64_t received() const { return received_; }
   std::uint64_t rejected() const { return rejected_; }
   const std::string& last_rejection() const { return last_rejection_; }

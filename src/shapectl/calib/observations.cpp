@@ -30,8 +30,22 @@ Eigen::VectorXd read_frame_joints(const JsonInput& frame, const RobotModel* robo
   // number; the frame is wrapped so that its messages name "frames[i].joints.<name>".
   nlohmann::json wrapped = nlohmann::json::object();
   wrapped["joints"] = joints.raw();
-  return read_joints(JsonInput(std::move(wrapped), frame.source(), frame.path()), *robot,
-                     Eigen::VectorXd::Zero(robot->active_count()));
+  const Eigen::VectorXd theta =
+      read_joints(JsonInput(std::move(wrapped), frame.source(), frame.path()), *robot,
+                  Eigen::VectorXd::Zero(robot->active_count()));
+  // A pose the robot cannot take is not a measurement: calibration would walk the model there
+  // from the reference joints (calib/joint_path.hpp), and the feedback would compare it.
+  const Eigen::VectorXd lower = robot->lower_limits(), upper = robot->upper_limits();
+  const std::vector<std::string> names = robot->active_joint_names();
+  for (Eigen::Index k = 0; k < theta.size(); ++k)
+    if (!(theta[k] >= lower[k] - observation_joint_margin &&
+          theta[k] <= upper[k] + observation_joint_margin)) {
+      std::ostringstream expected;
+      expected << "a value within the joint's limits [" << lower[k] << ", " << upper[k]
+               << "] give or take " << observation_joint_margin;
+      joints.at(names[static_cast<std::size_t>(k)]).fail(expected.str());
+    }
+  return theta;
 }
 
 std::vector<ObservedMarker> read_markers(const JsonInput& list, int node_count) {

@@ -5,11 +5,12 @@
 //                "markers": [{"node": 12, "position": [x, y, z]}, ...],
 //                "points": [[x, y, z], ...]   or   "points_file": "cloud.ply",
 //                "sigma": 0.0005, "time": 12.5}]}
-// joints: every active joint of the robot (rad, m for prismatic), none other; omitted for a
-//   scene without a robot. markers: distinct nodes. points_file: .xyz, .ply or .npy
-//   (calib/point_cloud_file.hpp), relative to the JSON file's directory. Each frame observes at
-//   least one marker or one point. sigma: the measurement noise (standard deviation, m,
-//   > 0, default default_observation_sigma). time: seconds (>= 0), optional.
+// joints: every active joint of the robot (rad, m for prismatic), none other, each within its
+//   limits give or take observation_joint_margin; omitted for a scene without a robot. markers:
+//   distinct nodes. points_file: .xyz, .ply or .npy (calib/point_cloud_file.hpp), relative to the
+//   JSON file's directory. Each frame observes at least one marker or one point. sigma: the
+//   measurement noise (standard deviation, m, > 0, default default_observation_sigma). time:
+//   seconds (>= 0), optional.
 #include <cstddef>
 #include <filesystem>
 #include <optional>
@@ -30,6 +31,9 @@ inline constexpr std::size_t max_observation_frames = 10'000;
 inline constexpr std::size_t max_markers_per_frame = 100'000;
 inline constexpr std::size_t max_observed_points = 20'000'000;  // all frames together: 480 MB
 inline constexpr double max_observation_distance = 1e3;         // m from the world origin
+// rad (m for prismatic joints): how far past a limit a measured joint may read (encoder noise,
+// the controller's own tolerance at a limit); further is not a pose the robot can take.
+inline constexpr double observation_joint_margin = 0.01;
 
 struct ObservedMarker {
   int node;       // mesh node the marker sits on
@@ -59,9 +63,10 @@ struct ObservationContext {
 // Throws InputError naming the source and field ("obs.json: frames[3].markers[0].node: expected
 // a whole number from 0 to 424, got 500"): an empty or too long list of frames, a frame with
 // nothing observed, a node out of range or repeated, non-finite numbers, points beyond
-// max_observation_distance, a joint missing or not active, joints without a robot, both points
-// and points_file, a points file that cannot be read (the message names it and the problem),
-// a points_file where they are not allowed, unknown keys, sizes over the limits above.
+// max_observation_distance, a joint missing, not active or outside its limits (± the margin),
+// joints without a robot, both points and points_file, a points file that cannot be read (the
+// message names it and the problem), a points_file where they are not allowed, unknown keys, sizes
+// over the limits above.
 Observations read_observations(const JsonInput& json, const ObservationContext& context);
 // One frame, e.g. from a WebSocket message: the object inside "frames" above.
 ObservationFrame read_observation_frame(const JsonInput& frame, const ObservationContext& context);

@@ -75,9 +75,11 @@ OnlineCalibration::OnlineCalibration(Controller& controller, const Scene& model,
       options_(options),
       period_(options.period) {
   status_.automatic = options_.automatic;
+  options_.calibration.cancel = &cancel_;
 }
 
 OnlineCalibration::~OnlineCalibration() {
+  cancel();
   if (worker_.joinable()) worker_.join();
 }
 
@@ -120,6 +122,7 @@ bool OnlineCalibration::start(std::string* why) {
   Observations observations{{window_.begin(), window_.end()}};
   frames_since_start_ = 0;
   done_ = false;
+  cancel_ = false;
   {
     std::lock_guard lock(mutex_);
     status_.running = true;

@@ -59,7 +59,9 @@ struct OnlineCalibrationOptions {
   int new_frames = 3;        // frames since the last calibration before an automatic one
   int window = 6;            // frames kept
   double same_pose = 0.005;  // rad (m for prismatic joints), largest joint difference
-  CalibrationOptions calibration{.max_iterations = 8};
+  // A fit that takes longer than max_seconds stops with what it has (not converged, not
+  // applied unless it lowered the residuals): a session is never stuck "running".
+  CalibrationOptions calibration{.max_iterations = 8, .max_seconds = 30};
   std::size_t max_drawn_points = 1000;  // of the newest cloud, for a GUI to draw
   ModelBounds bounds = {};
   // A fit whose residuals stay above this χ²/dof (RMS 10σ) does not explain its window: frames
@@ -84,7 +86,7 @@ class OnlineCalibration {
   // `controller` must outlive this; `model` is the scene it was made from.
   OnlineCalibration(Controller& controller, const Scene& model,
                     OnlineCalibrationOptions options = {});
-  ~OnlineCalibration();  // waits for a running calibration
+  ~OnlineCalibration();  // cancels a running calibration and waits for it to stop
   OnlineCalibration(const OnlineCalibration&) = delete;
   OnlineCalibration& operator=(const OnlineCalibration&) = delete;
 
@@ -98,6 +100,9 @@ class OnlineCalibration {
   void set_automatic(bool on);
   // Blocks until a running calibration has finished (poll() then hands it over).
   void wait();
+  // Asks a running calibration to stop at its next check (a Newton iteration, a path step, a
+  // frame): it finishes soon after with what it has, reason "cancelled"; poll() hands it over.
+  void cancel() { cancel_ = true; }
   // Call often (each tick): hands a finished calibration to the controller, and starts an
   // automatic one when it is due. `time`: s, any clock that only moves forward.
   void poll(double time);
@@ -124,6 +129,7 @@ class OnlineCalibration {
   std::optional<CalibrationResult> outcome_;
   std::string outcome_error_;
   std::atomic<bool> done_{false};
+  std::atomic<bool> cancel_{false};  // read by the worker's calibration
   std::thread worker_;
 };
 

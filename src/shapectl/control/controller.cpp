@@ -132,6 +132,9 @@ struct Controller::State {
   std::mutex step_mutex;  // one runner at a time
   std::thread worker;
   std::atomic<bool> running{false};
+  // Set while stop() waits: the optimizer's step in progress ends at its next statics check
+  // (one step of a 12k-tet object can take seconds; `serve` and `run` stop within 1 s).
+  std::atomic<bool> stopping{false};
 
   void apply(Inbox in);
   // The objective is immutable: new targets make a new one. It aims at the user's targets,
@@ -463,6 +466,7 @@ Controller::Controller(const Scene& scene, ControllerOptions options)
   s.object = s.loaded;
   s.objective = std::make_unique<ReducedObjective>(*s.object);
   s.optimizer = make_optimizer(options.optimizer, options.gradient);
+  s.optimizer->out_of_time = [&s] { return s.stopping.load(); };
   s.bar_axis = find_bar_axis(s.object->mesh());
   s.feedback = std::make_unique<ModelErrorFeedback>(s.scene.object_mesh, options.feedback);
   s.current = s.objective->evaluate(s.object->reference_joints(), s.object->reference_positions());
@@ -482,8 +486,10 @@ void Controller::start() {
 
 void Controller::stop() {
   if (!state_->running.exchange(false)) return;
+  state_->stopping = true;
   state_->inbox_changed.notify_all();
   if (state_->worker.joinable()) state_->worker.join();
+  state_->stopping = false;
 }
 
 void Controller::step_once() {

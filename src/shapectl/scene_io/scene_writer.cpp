@@ -15,8 +15,10 @@ std::string rebased(const std::string& path, const std::filesystem::path& from_d
   const std::filesystem::path p(path);
   if (p.is_absolute()) return path;
   const auto target = std::filesystem::weakly_canonical(std::filesystem::absolute(from_dir / p));
-  const auto relative = target.lexically_relative(
-      std::filesystem::weakly_canonical(std::filesystem::absolute(to_dir)));
+  // A file named without a directory ("out.json") is in the current one.
+  const std::filesystem::path to = to_dir.empty() ? std::filesystem::path(".") : to_dir;
+  const auto relative =
+      target.lexically_relative(std::filesystem::weakly_canonical(std::filesystem::absolute(to)));
   return relative.empty() ? target.string() : relative.string();
 }
 

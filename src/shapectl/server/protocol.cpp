@@ -244,15 +244,27 @@ void read_arguments(const JsonInput& message, const ProtocolContext& context, Co
 
 }  // namespace
 
-nlohmann::json message_id(std::string_view text) {
+namespace {
+// `text` parsed when it is within the size and nesting limits, else null (so is bad JSON).
+nlohmann::json parsed_message(std::string_view text) {
   if (text.size() > max_message_bytes ||
       json_too_deep_at(text, max_json_depth) != std::string_view::npos)
     return nullptr;
-  const nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+  return nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+}
+}  // namespace
+
+nlohmann::json message_id(std::string_view text) {
+  const nlohmann::json j = parsed_message(text);
   if (!j.is_object()) return nullptr;
   const auto it = j.find("id");
   if (it == j.end() || !valid_id(*it)) return nullptr;
   return *it;
+}
+
+bool is_observe_message(std::string_view text) {
+  const nlohmann::json j = parsed_message(text);
+  return j.is_object() && j.contains("type") && j["type"] == "observe";
 }
 
 Command parse_command(std::string_view text, const ProtocolContext& context) {

@@ -77,6 +77,9 @@ struct Command {
 // The client's "id" if `text` is an object carrying a valid one (integer or string of at most
 // 64 characters), else null; used to address an error reply to a message that failed to parse.
 nlohmann::json message_id(std::string_view text);
+// Whether `text` is an object of type "observe", whatever else is wrong with it: a rejected
+// observation is counted as one.
+bool is_observe_message(std::string_view text);
 
 // Parses and validates one text message; throws InputError (source "message") when invalid.
 Command parse_command(std::string_view text, const ProtocolContext& context);

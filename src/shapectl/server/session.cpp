@@ -381,6 +381,7 @@ Session::Reply Session::handle(std::string_view text) {
     if (id.is_null()) id = message_id(text);
     reply.text = error_reply(id, e.what());
     reply.log = e.what();
+    if (is_observe_message(text)) ++observations_rejected_, observation_rejection_ = e.what();
   } catch (const std::exception& e) {
     if (id.is_null()) id = message_id(text);
     reply.text = error_reply(id, std::string("failed: ") + e.what());
@@ -632,6 +633,8 @@ std::string Session::state_message(int clients) const {
       {"observation_problem", s.observation_problem},
       {"gate", gate_json(s.gate)},
       {"authority", authority_json(s.authority)},
+      {"observations_rejected", observations_rejected_},
+      {"observation_rejection", observation_rejection_},
       // null until something was observed: 0 would claim a perfect model and object.
       {"model_error", s.observations ? finite_or_null(s.model_error) : nlohmann::json()},
       {"observed_error", s.observations ? finite_or_null(s.observed_error) : nlohmann::json()},

@@ -138,6 +138,10 @@ class Session {
   SessionLog* log_ = nullptr;
   std::uint64_t logged_sequence_ = 0;  // of the last snapshot written to log_
   GateCounts logged_gate_;             // the gate's counts last written to log_
+  // `observe` messages refused (bad frame: joints outside their limits, unknown nodes, ...)
+  // and why the newest was; in the state message.
+  std::uint64_t observations_rejected_ = 0;
+  std::string observation_rejection_;
 };
 
 }  // namespace shapectl::server
