@@ -224,6 +224,11 @@ bool settle_decided(const ControllerSnapshot& s, const LinkStatus& st, bool arme
         "arrive";
     return true;
   }
+  // Held short of a self-collision on the way, at a standstill: it stays there.
+  if (st.blocked) {
+    outcome.failure = "robot cannot arrive: " + st.reason;
+    return true;
+  }
   outcome.settled = st.arrived;
   return st.arrived;
 }
