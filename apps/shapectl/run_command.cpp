@@ -72,6 +72,7 @@ nlohmann::json link_json(const LinkStatus& s) {
           {"connected", s.connected},
           {"armed", s.armed},
           {"arrived", s.arrived},
+          {"blocked", s.blocked},
           {"reason", s.reason},
           {"commands_sent", s.commands_sent},
           {"rejected_datagrams", s.rejected_datagrams},
