@@ -11,3 +11,15 @@ shapectl_tests(server shapectl_server shapectl_link shapectl_scene_io Boost::hea
 if(TARGET server_tests)
   add_dependencies(server_tests shapectl_cli)  # serve_cli_test runs the CLI
 endif()
+
+# The drag soak (issue 32, item 5): its own binary, not a discovered GoogleTest, so CTest can
+# label it, give it a longer timeout and start it first (COST). SHAPECTL_SOAK_SECONDS (default
+# 600) sets its duration; `ctest -L soak` runs it alone, `ctest -LE soak` everything else.
+if(SHAPECTL_BUILD_TESTS)
+  add_executable(drag_soak ${PROJECT_SOURCE_DIR}/tests/server/drag_soak.cpp)
+  target_link_libraries(drag_soak PRIVATE shapectl_server shapectl_link shapectl_scene_io
+                        shapectl_test_support GTest::gtest_main)
+  target_precompile_headers(drag_soak REUSE_FROM shapectl_test_support)
+  add_test(NAME drag_soak COMMAND drag_soak)
+  set_tests_properties(drag_soak PROPERTIES LABELS soak COST 10000 TIMEOUT 1200)
+endif()

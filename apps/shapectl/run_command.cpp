@@ -74,6 +74,7 @@ nlohmann::json link_json(const LinkStatus& s) {
           {"connected", s.connected},
           {"armed", s.armed},
           {"arrived", s.arrived},
+          {"blocked", s.blocked},
           {"reason", s.reason},
           {"commands_sent", s.commands_sent},
           {"rejected_datagrams", s.rejected_datagrams},
@@ -224,6 +225,11 @@ bool settle_decided(const ControllerSnapshot& s, const LinkStatus& st, bool arme
     outcome.failure =
         "the optimizer reached the targets, but the robot is not armed (--arm), so it cannot "
         "arrive";
+    return true;
+  }
+  // Held short of a self-collision on the way, at a standstill: it stays there.
+  if (st.blocked) {
+    outcome.failure = "robot cannot arrive: " + st.reason;
     return true;
   }
   outcome.settled = st.arrived;

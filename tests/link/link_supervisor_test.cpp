@@ -16,17 +16,24 @@ GovernorLimits limits() {
 }
 
 // Two joints, two channels ("a" drives joint 0, "b" joint 1); joint limits ±2 rad.
+// Or other channels, e.g. one "robot" channel driving both.
 struct Fixture {
-  explicit Fixture(PoseCheck check = {})
-      : s("test", {"j0", "j1"}, {{"a", {0}}, {"b", {1}}}, Eigen::Vector2d(-2, -2),
-          Eigen::Vector2d(2, 2), limits(), {.watchdog_timeout = 0.1}, std::move(check)) {}
-  // One sample on both channels at time `t`, the robot exactly where commanded.
+  explicit Fixture(PoseCheck check = {},
+                   std::vector<LinkChannel> channels = {{"a", {0}}, {"b", {1}}})
+      : s("test", {"j0", "j1"}, std::move(channels), Eigen::Vector2d(-2, -2), Eigen::Vector2d(2, 2),
+          limits(), {.watchdog_timeout = 0.1}, std::move(check)) {}
+  // One sample on every channel at time `t`, the robot exactly where commanded.
   void tick(bool with_feedback = true) {
     t += dt;
     if (with_feedback)
-      for (int c = 0; c < 2; ++c) {
-        s.on_feedback(c, robot.segment(c, 1), "", t, t);
-        robot[c] = s.command(c)[0];
+      for (int c = 0; c < static_cast<int>(s.channels().size()); ++c) {
+        const auto& joints = s.channels()[static_cast<std::size_t>(c)].joints;
+        Eigen::VectorXd measured(static_cast<Eigen::Index>(joints.size()));
+        for (std::size_t i = 0; i < joints.size(); ++i)
+          measured[static_cast<Eigen::Index>(i)] = robot[joints[i]];
+        s.on_feedback(c, measured, "", t, t);
+        for (std::size_t i = 0; i < joints.size(); ++i)
+          robot[joints[i]] = s.command(c)[static_cast<Eigen::Index>(i)];
       }
     s.check_watchdog(t);
   }
@@ -148,29 +155,91 @@ TEST(LinkSupervisor, TrackingErrorDisarms) {
   EXPECT_EQ(f.s.status(f.t).reason, "a: tracking error 0.3 rad above 0.2 rad");
 }
 
-TEST(LinkSupervisor, CollidingTargetIsRefusedAndCollidingCommandsAreNeverIssued) {
-  // "Collision" in the corner j0 > 0.5, j1 < 0.05.
-  auto collides = [](const Eigen::VectorXd& q) { return q[0] > 0.5 && q[1] < 0.05; };
-  auto check = [&](const Eigen::VectorXd& q, std::string* why) {
-    if (!collides(q)) return true;
-    *why = "collides";
-    return false;
-  };
-  Fixture f(check);
-  EXPECT_FALSE(f.target(Eigen::Vector2d(1, 0)));
+// "Collision": within 0.3 rad of the origin of (j0, j1).
+bool collides(const Eigen::VectorXd& q) { return q.head<2>().norm() < 0.3; }
+bool disk_check(const Eigen::VectorXd& q, std::string* why) {
+  if (!collides(q)) return true;
+  *why = "collides";
+  return false;
+}
+
+TEST(LinkSupervisor, CollidingTargetIsRefused) {
+  Fixture f(disk_check);
+  EXPECT_FALSE(f.target(Eigen::Vector2d(0.1, 0.1)));
   EXPECT_EQ(f.s.status(f.t).reason, "target pose: collides");
-  // A safe target whose joint-space path crosses the corner: the link stops at the last
-  // good pose and disarms.
-  ASSERT_TRUE(f.target(Eigen::Vector2d(1.1, 0.1)));
+}
+
+// Issue 32, item 5: two safe targets whose joint-space path grazes, commanded alternately:
+// the link stays armed, never commands a colliding pose, and keeps its velocity and
+// acceleration limits while it holds short of the graze.
+void expect_grazing_alternation_is_held_short(Fixture& f) {
+  const Eigen::Vector2d a(-0.6, 0.29), b(0.6, 0.29);
+  ASSERT_TRUE(collides(0.5 * (a + b))) << "the straight path must graze";
+  f.robot = a;
+  ASSERT_TRUE(f.target(a));
   f.tick();
   ASSERT_TRUE(f.s.arm(f.t, nullptr));
-  for (int k = 0; k < 3000; ++k) {
+  const GovernorLimits l = limits();
+  std::vector<Eigen::Vector2d> sent = {f.s.status(f.t).commanded, f.s.status(f.t).commanded};
+  int holding = 0;
+  for (int k = 0; k < 10500; ++k) {
+    if (k % 700 == 0) {
+      ASSERT_TRUE(f.target(k / 700 % 2 ? a : b));  // 2.8 s each, b first and last
+    }
     f.tick();
-    ASSERT_FALSE(collides(f.s.status(f.t).commanded)) << "step " << k;
+    const LinkStatus st = f.s.status(f.t);
+    ASSERT_TRUE(st.armed) << "step " << k << ": " << st.reason;
+    ASSERT_FALSE(collides(st.commanded)) << "step " << k;
+    holding += st.reason.find("holding: ") != std::string::npos;
+    const Eigen::Vector2d q = st.commanded;
+    const auto n = sent.size();
+    for (int j = 0; j < 2; ++j) {
+      ASSERT_LE(std::abs(q[j] - sent[n - 1][j]), l.velocity[j] * dt + 1e-12) << "step " << k;
+      ASSERT_LE(std::abs(q[j] - 2 * sent[n - 1][j] + sent[n - 2][j]),
+                l.acceleration[j] * dt * dt + 1e-12)
+          << "step " << k;
+    }
+    sent.push_back(q);
   }
+  EXPECT_GT(holding, 0) << f.s.status(f.t).commanded.transpose();
+  // On the way to b it stands still short of the graze, and says so.
   const LinkStatus st = f.s.status(f.t);
+  EXPECT_TRUE(st.blocked);
+  EXPECT_EQ(st.reason, f.s.channels()[0].name +
+                           ": holding: going on towards the target leaves no safe stop (collides)");
+  EXPECT_LT(st.commanded[0], 0);
+  // A target on its side frees it.
+  ASSERT_TRUE(f.target(Eigen::Vector2d(-0.5, 0.6)));
+  for (int k = 0; k < 2000; ++k) f.tick();
+  EXPECT_TRUE(f.s.status(f.t).arrived);
+  EXPECT_FALSE(f.s.status(f.t).blocked);
+}
+
+TEST(LinkSupervisor, GrazingPathOfOneChannelIsHeldShortOfNotDisarmed) {
+  Fixture f(disk_check, {{"robot", {0, 1}}});
+  expect_grazing_alternation_is_held_short(f);
+}
+
+TEST(LinkSupervisor, GrazingPathOfTwoChannelsIsHeldShortOfNotDisarmed) {
+  Fixture f(disk_check);
+  expect_grazing_alternation_is_held_short(f);
+}
+
+TEST(LinkSupervisor, CollidingMeasuredPoseDisarmsAndRefusesArmingWithItsReason) {
+  Fixture f(disk_check);
+  f.target(Eigen::Vector2d(1, 1));
+  f.tick();
+  ASSERT_TRUE(f.s.arm(f.t, nullptr));
+  for (int k = 0; k < 10; ++k) f.tick();
+  // E.g. pushed there: the robot is not where commanded (0.3, -0.2), within the tracking limit.
+  f.robot = Eigen::Vector2d(0.25, -0.1);
+  f.tick();
+  LinkStatus st = f.s.status(f.t);
   EXPECT_FALSE(st.armed);
-  EXPECT_NE(st.reason.find("commanded pose: collides"), std::string::npos) << st.reason;
+  EXPECT_EQ(st.reason, "b: measured pose: collides");  // b's feedback completes the pose
+  std::string why;
+  EXPECT_FALSE(f.s.arm(f.t, &why));
+  EXPECT_EQ(why, "measured pose: collides");
 }
 
 TEST(LinkSupervisor, MeasuredBeyondTheHardLimitsGetsNoCommandAndCannotBeArmed) {

@@ -42,7 +42,9 @@ LinkSupervisor::LinkSupervisor(std::string kind, std::vector<std::string> joint_
               -std::numeric_limits<double>::infinity(),
               false,
               {},
-              {}};
+              {},
+              {},
+              false};
     c.measured = c.governor.position();
     state_.push_back(std::move(c));
   }
@@ -97,8 +99,11 @@ bool LinkSupervisor::set_target(const Eigen::VectorXd& joints, const std::string
   if (!target_problem_.empty() && !armed_) reason_ = "not armed";
   assert(joints.size() == limits_.size());
   target_problem_.clear();
+  const Eigen::VectorXd target = joints.cwiseMax(limits_.lower).cwiseMin(limits_.upper);
+  if (target != target_)
+    for (auto& c : state_) c.blocked = false;
   has_target_ = true;
-  target_ = joints.cwiseMax(limits_.lower).cwiseMin(limits_.upper);
+  target_ = target;
   return true;
 }
 
@@ -112,6 +117,7 @@ bool LinkSupervisor::arm(double now, std::string* why_not) {
     if (!why.empty()) break;
   }
   if (why.empty() && !target_problem_.empty()) why = target_problem_;
+  if (why.empty()) why = measured_problem();
   if (!why.empty()) {
     if (why_not) *why_not = why;
     log("arm_refused", {{"reason", why}});
@@ -123,6 +129,7 @@ bool LinkSupervisor::arm(double now, std::string* why_not) {
     if (c.governor.at_rest()) c.governor.reset(c.measured);
   armed_ = true;
   reason_.clear();
+  for (auto& c : state_) c.holding.clear(), c.blocked = false;
   log("arm", {{"commanded", vector_json(full_commanded())}});
   return true;
 }
@@ -177,6 +184,8 @@ FeedbackStep LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& mea
       disarm(c.spec.name + ": tracking error " + format(error) + " rad above " +
              format(settings_.max_tracking_error) + " rad");
   }
+  if (armed_)
+    if (std::string why = measured_problem(); !why.empty()) disarm(c.spec.name + ": " + why);
   const PaceStep pace = c.pacer.on_feedback(now, controller_time);
   FeedbackStep step{.send = true,
                     .advanced = pace.advance,
@@ -188,15 +197,75 @@ FeedbackStep LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& mea
     step.from_rest = true;
   }
   const Eigen::VectorXd before = c.governor.position();
-  const double dt = settings_.period;
-  if (armed_ && has_target_) c.governor.step_towards(channel_part(target_, c), dt);
-  else c.governor.step_stop(dt);
+  if (armed_ && has_target_) step_clear_of_collisions(channel, now);
+  else c.governor.step_stop(settings_.period);
+  // Backstop: with several channels the look-ahead pairs their ticks; should it miss, no
+  // colliding pose is sent (the stop at once is then the lesser evil).
   std::string why;
   if (check_ && c.governor.position() != before && !check_(full_commanded(), &why)) {
-    c.governor.reset(before);  // stop at the last good pose at once
+    c.governor.reset(before);
     disarm(c.spec.name + ": commanded pose: " + why);
   }
   return step;
+}
+
+void LinkSupervisor::step_clear_of_collisions(int channel, double now) {
+  Channel& c = state_[static_cast<std::size_t>(channel)];
+  const double dt = settings_.period;
+  MotionGovernor next = c.governor;
+  next.step_towards(channel_part(target_, c), dt);
+  MotionGovernor braking = c.governor;
+  braking.step_stop(dt);
+  // Braking is always clear: its path was checked before the last step was taken.
+  const bool is_braking =
+      next.position() == braking.position() && next.velocity() == braking.velocity();
+  std::string why;
+  if (!check_ || is_braking || stop_is_clear(channel, next, &why)) {
+    c.governor = std::move(next);
+    c.holding.clear();
+    c.blocked = false;
+    return;
+  }
+  // From a standstill the same target always gives the same first step: stuck until it changes.
+  c.blocked = c.governor.at_rest();
+  c.governor = std::move(braking);
+  // Creeping up to the obstacle alternates steps and holds: a log line a second is enough.
+  if (now - last_hold_logged_ >= 1) {
+    log("hold", {{"channel", c.spec.name}, {"reason", why}});
+    last_hold_logged_ = now;
+  }
+  c.holding =
+      c.spec.name + ": holding: going on towards the target leaves no safe stop (" + why + ")";
+}
+
+bool LinkSupervisor::stop_is_clear(int channel, const MotionGovernor& next,
+                                   std::string* why) const {
+  std::vector<MotionGovernor> governors;
+  for (std::size_t i = 0; i < state_.size(); ++i)
+    governors.push_back(static_cast<int>(i) == channel ? next : state_[i].governor);
+  Eigen::VectorXd full = target_;
+  for (;;) {
+    bool at_rest = true;
+    for (std::size_t i = 0; i < governors.size(); ++i) {
+      const auto& joints = state_[i].spec.joints;
+      for (std::size_t k = 0; k < joints.size(); ++k)
+        full[joints[k]] = governors[i].position()[static_cast<Eigen::Index>(k)];
+      at_rest = at_rest && governors[i].at_rest();
+    }
+    if (!check_(full, why)) return false;
+    if (at_rest) return true;
+    for (auto& g : governors) g.step_stop(settings_.period);
+  }
+}
+
+std::string LinkSupervisor::measured_problem() const {
+  if (!check_) return {};
+  Eigen::VectorXd full = target_;
+  for (const auto& c : state_)
+    for (std::size_t i = 0; i < c.spec.joints.size(); ++i)
+      full[c.spec.joints[i]] = c.measured[static_cast<Eigen::Index>(i)];
+  std::string why;
+  return check_(full, &why) ? std::string() : "measured pose: " + why;
 }
 
 const Eigen::VectorXd& LinkSupervisor::command(int channel) const {
@@ -228,6 +297,8 @@ LinkStatus LinkSupervisor::status(double now) const {
   double oldest = 0;
   bool arrived = armed_ && has_target_;
   for (const auto& c : state_) {
+    if (armed_ && !c.holding.empty()) s.reason = c.holding;
+    s.blocked = s.blocked || (armed_ && c.blocked);
     s.connected = s.connected && c.connected;
     oldest = std::max(oldest, now - c.last_feedback);
     for (std::size_t i = 0; i < c.spec.joints.size(); ++i)

@@ -10,8 +10,14 @@
 //   at the acceleration limit and holds.
 // - Disarm (with a reason) on: an unsafe target (flagged, non-finite, outside the joint limits,
 //   failing the pose check), feedback missing longer than the watchdog time, a robot fault,
-//   a tracking error above the limit, a commanded pose failing the pose check (then it stops
-//   at the last good pose at once).
+//   a tracking error above the limit, measured joints failing the pose check.
+// - Look-ahead: a governor step is taken only if the poses of braking to a standstill from
+//   it (at the acceleration limit, tick by tick) all pass the pose check; else the governor
+//   brakes along the path checked at the step before, and holds (status reason "holding: …")
+//   until the target changes or the way clears. So a path between two safe targets that
+//   grazes is never commanded, and the session stays armed. Exact for one channel; several
+//   channels (EGM's arms) are paired tick by tick. A commanded pose that still fails the check
+//   is not sent: it stops at the last good pose at once and disarms.
 // - Real time: a channel's governor advances one step of `period` per controller tick that its
 //   replies land on (MotionPacer), whatever the arrival pattern of the feedback; other replies
 //   repeat the command.
@@ -108,12 +114,22 @@ class LinkSupervisor {
     double last_feedback = -std::numeric_limits<double>::infinity();
     bool connected = false;
     std::string fault;
-    std::string outside;  // why the measured joints are outside the hard limits; empty: inside
+    std::string outside;   // why the measured joints are outside the hard limits; empty: inside
+    std::string holding;   // while armed: why it holds short of the target; empty: it moves
+    bool blocked = false;  // holding at a standstill: the first step from it leaves no safe stop
   };
   std::string outside_limits(const Channel& c, const Eigen::VectorXd& measured) const;
   void log(std::string_view event, const nlohmann::json& fields) const;
   Eigen::VectorXd channel_part(const Eigen::VectorXd& full, const Channel& c) const;
   Eigen::VectorXd full_commanded() const;
+  // One step of `channel`'s governor towards the target if every pose on the way to a
+  // standstill from there is clear, else one step of braking (whose path was checked before).
+  void step_clear_of_collisions(int channel, double now);
+  // Whether the poses while every channel brakes to a standstill, tick by tick, `channel`
+  // from `next` and the others from where they are, all pass the pose check; else `why`.
+  bool stop_is_clear(int channel, const MotionGovernor& next, std::string* why) const;
+  // Why the measured joints of all channels fail the pose check; empty when they pass.
+  std::string measured_problem() const;
 
   std::string kind_;
   std::vector<std::string> joint_names_;
@@ -130,6 +146,7 @@ class LinkSupervisor {
   bool has_target_ = false;
   std::string target_problem_;  // why the last target was refused; empty when it was fine
   Eigen::VectorXd target_;      // band-clamped
+  double last_hold_logged_ = -std::numeric_limits<double>::infinity();
 };
 
 }  // namespace shapectl

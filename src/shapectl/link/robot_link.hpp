@@ -22,6 +22,9 @@ struct LinkStatus {
   Eigen::VectorXd measured;   // θ as the robot reports it (active-joint order)
   Eigen::VectorXd commanded;  // θ last commanded
   bool arrived = false;       // armed, at rest on the target, measured within tolerance
+  // Armed, at rest short of the target: no step towards it leaves a collision-free stop
+  // (`reason` says which pose); a new target frees it.
+  bool blocked = false;
   std::uint64_t commands_sent = 0;
   std::uint64_t rejected_datagrams = 0;  // egm: malformed, truncated, oversized, wrong type
   std::uint64_t lost_datagrams = 0;      // egm: controller sequence numbers never received
