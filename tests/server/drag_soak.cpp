@@ -95,7 +95,8 @@ TEST(DragSoak, SimLinkStaysArmedAndNeverCommandsACollision) {
   const auto scene_file = test::source_path("scenes/yumi_bar.json");
   const Scene scene = load_scene(scene_file);
   ASSERT_TRUE(scene.robot->collisions);
-  auto log = std::make_shared<SessionLog>(log_file);
+  // One file however long the soak runs: every command it sent is checked, none rotated away.
+  auto log = std::make_shared<SessionLog>(log_file, SessionLogLimits{.max_bytes = 8ull << 30});
   LinkConfig config;  // as `serve --robot sim`: defaults, starting at the reference joints
   config.sim_initial_joints = scene.robot->reference_joints;
   const auto link = make_robot_link(config, *scene.robot->model, scene.robot->collisions, log);
