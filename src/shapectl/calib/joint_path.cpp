@@ -1,7 +1,6 @@
 #include <shapectl/calib/joint_path.hpp>
 
 #include <cmath>
-#include <stdexcept>
 
 namespace shapectl {
 
@@ -32,8 +31,8 @@ ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::Vec
     if (!state.statics().converged()) break;
   }
   if (!state.statics().converged())
-    throw std::runtime_error("no equilibrium on the way from the reference joints (" +
-                             state.statics().reason + ")");
+    throw NoEquilibrium("no equilibrium on the way from the reference joints (" +
+                        state.statics().reason + ")");
   return state;
 }
 
