@@ -124,15 +124,7 @@ std::unique_ptr<SimulatedWorld> make_world(const RunArgs& args, const Scene& mod
     throw InputError("run", "--world", "--robot sim (a real robot holds a real object)");
   SimulatedCamera camera = simulated_camera(args.loop, "run");
   camera.marker_nodes = targets.nodes;
-  const Scene world = load_scene(args.loop.world);
-  try {
-    return std::make_unique<SimulatedWorld>(world, model, camera, args.loop.camera_rate);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(args.loop.world, "object", e.what());
-  } catch (const NoEquilibrium& e) {
-    throw SolverFailure(args.loop.world +
-                        ": the world's object at the reference joints: " + e.what());
-  }
+  return simulated_world(args.loop, model, camera);
 }
 
 // The scene (with a robot) and the targets, checked; the link settings completed from them.

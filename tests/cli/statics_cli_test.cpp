@@ -336,6 +336,15 @@ TEST(StaticsCli, NearlyIncompressibleBarSagsAsDolfinxOrIsRefusedWithTheRange) {
   EXPECT_EQ(run.exit_code, 1) << run.err;
   EXPECT_NE(run.err.find("kappa.json: object.material.kappa: expected at most "), std::string::npos)
       << run.err;
+  // Stiff and light at an ordinary nu: Young's modulus is named.
+  const auto stiff =
+      dir.write("stiff.json",
+                foam_bar(R"({"youngs_modulus": 1e13, "poisson_ratio": 0.3, "density": 0.001})"));
+  run = run_cli({"statics", stiff.string(), "--out", out.string()});
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("stiff.json: object.material.youngs_modulus: expected at most "),
+            std::string::npos)
+      << run.err;
 }
 
 }  // namespace

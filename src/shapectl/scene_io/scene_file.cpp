@@ -209,22 +209,25 @@ void check_resolvable_material(const JsonInput& j, const Scene& scene) {
       " on this mesh under this gravity (beyond, round-off in the forces would exceed 1 % of a "
       "node's load: the rest shape would pass as the equilibrium)";
   if (j.has("poisson_ratio")) {
-    // The ratio grows with nu (mu + kappa = E/(2(1+nu)(1-2nu))): bisect on log(0.5 - nu).
-    const double E = j.at("youngs_modulus").number();
-    auto resolves = [&](double gap) {
-      return roundoff_load_ratio(scene, material_from_youngs(E, 0.5 - gap, m.density)) <= 1;
+    const double E = j.at("youngs_modulus").number(), nu = j.at("poisson_ratio").number();
+    auto resolves = [&](double youngs, double poisson) {
+      return roundoff_load_ratio(scene, material_from_youngs(youngs, poisson, m.density)) <= 1;
     };
+    // The ratio grows with nu (mu + kappa = E/(2(1+nu)(1-2nu))): bisect on log(0.5 - nu).
     double valid = 0.49, invalid = 1e-17;
-    if (resolves(valid)) {
+    if (resolves(E, 0.5 - valid)) {
       for (int k = 0; k < 24; ++k) {  // to a factor 1 + 3e-6 of the gap
         const double mid = std::sqrt(valid * invalid);
-        (resolves(mid) ? valid : invalid) = mid;
+        (resolves(E, 0.5 - mid) ? valid : invalid) = mid;
       }
       const double gap = 1.01 * valid;  // rounded into the valid side
       j.at("poisson_ratio")
           .fail("a number from 0 to " + significant(0.5 - gap, 10) + " (0.5 - " +
                 significant(gap, 2) + ")" + why);
     }
+    // Too stiff even at nu = 0.01: under gravity the ratio is proportional to E.
+    if (const double largest = 0.99 * E / ratio; largest >= 1 && resolves(largest, nu))
+      j.at("youngs_modulus").fail("at most " + significant(largest, 3) + " Pa" + why);
   } else if (const double kappa = 0.99 * ((m.mu + m.kappa) / ratio - m.mu); kappa >= 0.1) {
     j.at("kappa").fail("at most " + significant(kappa, 3) + " Pa" + why);
   }
