@@ -1,6 +1,10 @@
 #include "closed_loop_options.hpp"
 
+#include <shapectl/calib/joint_path.hpp>
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/scene_io/scene_file.hpp>
+
+#include "commands.hpp"
 
 namespace shapectl::cli {
 
@@ -54,6 +58,18 @@ OnlineCalibrationOptions online_calibration_options(const ClosedLoopArgs& args,
     throw InputError(command, "--fit", e.what());
   }
   return options;
+}
+
+std::unique_ptr<SimulatedWorld> simulated_world(const ClosedLoopArgs& args, const Scene& model,
+                                                const SimulatedCamera& camera) {
+  const Scene world = load_scene(args.world);
+  try {
+    return std::make_unique<SimulatedWorld>(world, model, camera, args.camera_rate);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(args.world, "object", e.what());
+  } catch (const NoEquilibrium& e) {
+    throw SolverFailure(args.world + ": the world's object at the reference joints: " + e.what());
+  }
 }
 
 }  // namespace shapectl::cli

@@ -1,12 +1,14 @@
 #pragma once
 // The closed loop's options, the same for `run` and `serve`: the simulated world and its
 // camera, model-error feedback, and the online calibration (docs/calibration.md).
+#include <memory>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include <shapectl/calib/online_calibration.hpp>
 #include <shapectl/calib/simulated_camera.hpp>
+#include <shapectl/calib/simulated_world.hpp>
 
 namespace shapectl::cli {
 
@@ -29,5 +31,10 @@ void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args, bool feedback_
 SimulatedCamera simulated_camera(const ClosedLoopArgs& args, const std::string& command);
 OnlineCalibrationOptions online_calibration_options(const ClosedLoopArgs& args,
                                                     const std::string& command);
+// The world of --world (non-empty) holding `model`'s mesh with its robot: InputError when
+// WORLD.json is no such scene, SolverFailure when its object has no equilibrium at the
+// reference joints (a world too soft to hold itself up).
+std::unique_ptr<SimulatedWorld> simulated_world(const ClosedLoopArgs& args, const Scene& model,
+                                                const SimulatedCamera& camera);
 
 }  // namespace shapectl::cli

@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <shapectl/calib/joint_path.hpp>
 #include <shapectl/calib/observation_receiver.hpp>
 #include <shapectl/calib/online_calibration.hpp>
 #include <shapectl/calib/simulated_world.hpp>
@@ -126,12 +127,7 @@ std::unique_ptr<SimulatedWorld> make_world(const RunArgs& args, const Scene& mod
     throw InputError("run", "--world", "--robot sim (a real robot holds a real object)");
   SimulatedCamera camera = simulated_camera(args.loop, "run");
   camera.marker_nodes = targets.nodes;
-  const Scene world = load_scene(args.loop.world);
-  try {
-    return std::make_unique<SimulatedWorld>(world, model, camera, args.loop.camera_rate);
-  } catch (const std::invalid_argument& e) {
-    throw InputError(args.loop.world, "object", e.what());
-  }
+  return simulated_world(args.loop, model, camera);
 }
 
 // The scene (with a robot) and the targets, checked; the link settings completed from them.
@@ -313,7 +309,12 @@ RunOutcome follow_optimizer(const RunArgs& args, Controller& controller, RobotLi
       if (log) server::log_snapshot(*log, snap);
     }
     const LinkStatus st = link.status();
-    observe(observers, snap, st, clock.elapsed(), log);
+    try {
+      observe(observers, snap, st, clock.elapsed(), log);
+    } catch (const NoEquilibrium& e) {  // the world's object, at the robot's measured joints
+      outcome.failure = args.loop.world + ": the world's object: " + e.what();
+      break;
+    }
     const std::string report = progress_report(snap, st);
     if (report != last_report) {
       std::cerr << "run: " << clock.elapsed() << " s: " << report << " (error "

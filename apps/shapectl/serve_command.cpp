@@ -96,15 +96,9 @@ void run_serve(const ServeArgs& args) {
   if (!args.loop.world.empty()) {
     if (args.robot != "sim")
       throw InputError("serve", "--world", "--robot sim (a real robot holds a real object)");
-    const Scene model = load_scene(scene), world = load_scene(args.loop.world);
     // Markers on the target nodes, set at every tick.
     const SimulatedCamera camera = simulated_camera(args.loop, "serve");
-    try {
-      session.set_world(
-          std::make_unique<SimulatedWorld>(world, model, camera, args.loop.camera_rate));
-    } catch (const std::invalid_argument& e) {
-      throw InputError(args.loop.world, "object", e.what());
-    }
+    session.set_world(simulated_world(args.loop, load_scene(scene), camera));
   }
   server::Server server(session, options);
   std::cout << "shapectl serve: open " << server.url() << " (scene " << session.scene_name()

@@ -160,5 +160,25 @@ TEST_F(ClosedLoopCli, AWorldNeedsTheSimulatedRobotAndTheModelsMesh) {
   EXPECT_NE(r.err.find("mesh"), std::string::npos) << r.err;
 }
 
+// A world too soft to hold itself up (1 Pa) has no equilibrium: a failed solve, exit 2 with
+// the reason, never exit 3 (issue 32), in `run` and in `serve`.
+TEST_F(ClosedLoopCli, AWorldWithoutEquilibriumIsAFailedSolveNotABug) {
+  Scene world = load_scene(kBar);
+  world.material =
+      material_from_youngs(1, poisson_ratio_of(world.material), world.material.density);
+  const std::filesystem::path world_file = dir.path() / "soft_world.json";
+  std::ofstream(world_file) << scene_json_with_values(kBar, world, world_file).dump(1);
+  std::vector<std::string> all = args;
+  all[std::find(all.begin(), all.end(), "--world") - all.begin() + 1] = world_file.string();
+  for (const auto& command :
+       {all, std::vector<std::string>{"serve", kBar.string(), "--robot", "sim", "--port", "0",
+                                      "--world", world_file.string()}}) {
+    const auto r = run_cli(command);
+    EXPECT_EQ(r.exit_code, 2) << command[0] << ": " << r.err;
+    EXPECT_NE(r.err.find("soft_world.json: the world's object"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("no equilibrium"), std::string::npos) << r.err;
+  }
+}
+
 }  // namespace
 }  // namespace shapectl

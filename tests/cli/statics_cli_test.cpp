@@ -8,6 +8,8 @@
 #include <csignal>
 #include <nlohmann/json.hpp>
 
+#include <shapectl/scene_io/scene_file.hpp>
+
 #include "support/test_support.hpp"
 
 namespace shapectl {
@@ -265,6 +267,86 @@ TEST(StaticsCli, TheTwelveThousandTetBarSagsLikeTheDefaultBar) {
     EXPECT_NE(fine_err.find(grip), std::string::npos) << fine_err;
   EXPECT_NE(coarse_err.find("50 nodes, centre 6.6 mm"), std::string::npos) << coarse_err;
   EXPECT_NEAR(fine, coarse, 0.5e-3);  // refinement moves the sag by about 0.1 mm
+}
+
+// The clamped foam bar (scenes/foam_bar_clamped.json) with another material.
+std::string foam_bar(const std::string& material) {
+  return R"({"object": {"mesh": {"box": {"size": [0.32, 0.03, 0.03], "cells": [16, 4, 4]}},
+             "material": )" +
+         material + R"(}, "gravity": [0, 0, -9.81],
+             "fixed": {"box": {"min": [-0.161, -0.02, -0.02], "max": [-0.139, 0.02, 0.02]}}})";
+}
+
+std::string poisson(const std::string& nu) {
+  return R"({"youngs_modulus": 2e5, "poisson_ratio": )" + nu + R"(, "density": 40})";
+}
+
+// Mean z displacement of the free end's nodes (rest x = 0.16) in a statics result.
+double tip_sag(const std::filesystem::path& scene, const std::filesystem::path& result) {
+  const Positions rest = load_scene(scene).world_rest_positions();
+  const auto positions = nlohmann::json::parse(test::read_text(result))["positions"];
+  double sum = 0;
+  int count = 0;
+  for (std::size_t i = 0; i < positions.size(); ++i)
+    if (std::abs(rest[3 * i] - 0.16) < 1e-9) {
+      sum += positions[i][2].get<double>() - rest[3 * i + 2];
+      ++count;
+    }
+  EXPECT_EQ(count, 25);
+  return sum / count;
+}
+
+// Near Poisson's ratio 0.5 (issue 32): the sag of the same discretisation, or a refusal naming
+// the range doubles resolve; never "converged" at the rest shape under the weight.
+// Reference: DOLFINx 0.5.2's P1 solution of the same mesh, clamp, material and gravity at
+// nu = 0.499999, mean tip sag 6.856398452e-4 m (locked: 15.5 mm at nu = 0.3), from
+// `/usr/bin/python3 scripts/dolfinx_sag.py 0.499999` (README, Limitations).
+TEST(StaticsCli, NearlyIncompressibleBarSagsAsDolfinxOrIsRefusedWithTheRange) {
+  constexpr double dolfinx_tip_sag = -6.856398452e-4;  // m
+  TempDir dir;
+  const auto out = dir.path() / "result.json";
+  const auto resolved = dir.write("resolved.json", foam_bar(poisson("0.499999")));  // 0.5 - 1e-6
+  auto run = run_cli({"statics", resolved.string(), "--out", out.string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_GT(nlohmann::json::parse(test::read_text(out))["iterations"].get<int>(), 0);
+  EXPECT_NEAR(tip_sag(resolved, out), dolfinx_tip_sag, 0.05 * std::abs(dolfinx_tip_sag));
+
+  for (const std::string nu : {"0.4999999999", "0.4999999999999"}) {  // 0.5 - 1e-10, 0.5 - 1e-13
+    const auto scene = dir.write("refused.json", foam_bar(poisson(nu)));
+    run = run_cli({"statics", scene.string(), "--out", out.string()});
+    EXPECT_EQ(run.exit_code, 1) << run.err;
+    EXPECT_NE(run.err.find("refused.json: object.material.poisson_ratio: expected a number from 0 "
+                           "to 0.49999"),
+              std::string::npos)
+        << run.err;
+    EXPECT_NE(run.err.find("got " + nu), std::string::npos) << run.err;
+    // The range it names is honest: its upper end is solved, with iterations, and sags as the
+    // reference (DOLFINx: -6.844973919e-4 m at 0.499999814, the range's end for this bar).
+    const std::size_t at = run.err.find("from 0 to ") + 10;
+    const std::string largest = run.err.substr(at, run.err.find(' ', at) - at);
+    const auto edge = dir.write("edge.json", foam_bar(poisson(largest)));
+    const auto edge_run = run_cli({"statics", edge.string(), "--out", out.string()});
+    ASSERT_EQ(edge_run.exit_code, 0) << largest << ": " << edge_run.err;
+    EXPECT_GT(nlohmann::json::parse(test::read_text(out))["iterations"].get<int>(), 0);
+    EXPECT_NEAR(tip_sag(edge, out), dolfinx_tip_sag, 0.05 * std::abs(dolfinx_tip_sag));
+  }
+
+  // Given as mu and kappa: kappa is named, with its largest resolvable value.
+  const auto kappa =
+      dir.write("kappa.json", foam_bar(R"({"mu": 6.7e4, "kappa": 1e16, "density": 40})"));
+  run = run_cli({"statics", kappa.string(), "--out", out.string()});
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("kappa.json: object.material.kappa: expected at most "), std::string::npos)
+      << run.err;
+  // Stiff and light at an ordinary nu: Young's modulus is named.
+  const auto stiff =
+      dir.write("stiff.json",
+                foam_bar(R"({"youngs_modulus": 1e13, "poisson_ratio": 0.3, "density": 0.001})"));
+  run = run_cli({"statics", stiff.string(), "--out", out.string()});
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("stiff.json: object.material.youngs_modulus: expected at most "),
+            std::string::npos)
+      << run.err;
 }
 
 }  // namespace

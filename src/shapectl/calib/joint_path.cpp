@@ -28,10 +28,10 @@ ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::Vec
   const double distance = (joints - start).cwiseAbs().maxCoeff();
   // Compared before rounding: a huge or non-finite distance must not overflow the count.
   if (!(distance <= max_step * max_joint_path_steps))
-    throw std::runtime_error("the joints are " + std::to_string(distance) +
-                             " rad from the reference joints, more than " +
-                             std::to_string(max_joint_path_steps) + " steps of " +
-                             std::to_string(max_step) + " rad");
+    throw NoEquilibrium("the joints are " + std::to_string(distance) +
+                        " rad from the reference joints, more than " +
+                        std::to_string(max_joint_path_steps) + " steps of " +
+                        std::to_string(max_step) + " rad");
   const int steps = std::max(1, int(std::ceil(distance / max_step)));
   // The rest shape at θ⁰, unsolved: the first step solves from it.
   ObjectState state = object.make_state(start, object.reference_positions());
@@ -40,8 +40,8 @@ ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::Vec
     if (!state.statics().converged()) break;
   }
   if (!state.statics().converged())
-    throw std::runtime_error("no equilibrium on the way from the reference joints (" +
-                             state.statics().reason + ")");
+    throw NoEquilibrium("no equilibrium on the way from the reference joints (" +
+                        state.statics().reason + ")");
   return state;
 }
 

@@ -15,13 +15,14 @@ namespace shapectl {
 class SimulatedWorld {
  public:
   // `world` must hold the model's mesh (same nodes) with the same robot; throws
-  // std::invalid_argument otherwise. rate: observations per second.
+  // std::invalid_argument otherwise, NoEquilibrium (calib/joint_path.hpp) when the world's
+  // object has none at the reference joints. rate: observations per second.
   SimulatedWorld(const Scene& world, const Scene& model, SimulatedCamera camera, double rate,
                  unsigned seed = 1);
 
   // The world's object settled at the robot's measured joints, and an observation of it when
-  // one is due at `time` (s, any clock that only moves forward). Throws std::runtime_error when
-  // the world's object has no equilibrium there.
+  // one is due at `time` (s, any clock that only moves forward). Throws NoEquilibrium when
+  // the world's object has no equilibrium there (the world stays where it was).
   std::optional<ObservationFrame> step(double time, const Eigen::VectorXd& measured_joints);
   // Mean distance of the targets' nodes from their targets in the world, m (NaN without targets).
   double true_error(const ShapeTargets& targets) const;

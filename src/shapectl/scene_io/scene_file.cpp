@@ -18,6 +18,7 @@
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/robot_model.hpp>
 #include <shapectl/sim/cholesky_backend.hpp>
+#include <shapectl/sim/object_statics.hpp>
 #include <shapectl/sim/scene_checks.hpp>
 
 namespace shapectl {
@@ -191,6 +192,49 @@ Material read_material(const JsonInput& j) {
           .density = positive_in(j.at("density"), 1e-3, 1e5, "kg/m^3")};
 }
 
+std::string significant(double value, int digits) {
+  std::ostringstream out;
+  out.precision(digits);
+  out << value;
+  return out.str();
+}
+
+// A material whose load doubles resolve on the scene's mesh under its gravity
+// (sim/object_statics.hpp, roundoff_load_ratio): otherwise the rest shape would pass as the
+// equilibrium. Names the field and its largest valid value.
+void check_resolvable_material(const JsonInput& j, const Scene& scene) {
+  const Material& m = scene.material;
+  const double ratio = roundoff_load_ratio(scene, m);
+  if (ratio <= 1) return;
+  const std::string why =
+      " on this mesh under this gravity (beyond, round-off in the forces would exceed 1 % of a "
+      "node's load: the rest shape would pass as the equilibrium)";
+  if (j.has("poisson_ratio")) {
+    const double E = j.at("youngs_modulus").number(), nu = j.at("poisson_ratio").number();
+    auto resolves = [&](double youngs, double poisson) {
+      return roundoff_load_ratio(scene, material_from_youngs(youngs, poisson, m.density)) <= 1;
+    };
+    // The ratio grows with nu (mu + kappa = E/(2(1+nu)(1-2nu))): bisect on log(0.5 - nu).
+    double valid = 0.49, invalid = 1e-17;
+    if (resolves(E, 0.5 - valid)) {
+      for (int k = 0; k < 24; ++k) {  // to a factor 1 + 3e-6 of the gap
+        const double mid = std::sqrt(valid * invalid);
+        (resolves(E, 0.5 - mid) ? valid : invalid) = mid;
+      }
+      const double gap = 1.01 * valid;  // rounded into the valid side
+      j.at("poisson_ratio")
+          .fail("a number from 0 to " + significant(0.5 - gap, 10) + " (0.5 - " +
+                significant(gap, 2) + ")" + why);
+    }
+    // Too stiff even at nu = 0.01: under gravity the ratio is proportional to E.
+    if (const double largest = 0.99 * E / ratio; largest >= 1 && resolves(largest, nu))
+      j.at("youngs_modulus").fail("at most " + significant(largest, 3) + " Pa" + why);
+  } else if (const double kappa = 0.99 * ((m.mu + m.kappa) / ratio - m.mu); kappa >= 0.1) {
+    j.at("kappa").fail("at most " + significant(kappa, 3) + " Pa" + why);
+  }
+  j.fail_problem("a material too stiff for its weight" + why);
+}
+
 RobotSetup read_robot(const JsonInput& j) {
   j.expect_only({"urdf", "reference_joints", "active_joints", "fixed_joints", "end_effectors",
                  "collision_spheres", "joint_limit_margin", "joint_limit_stiffness"});
@@ -331,6 +375,7 @@ Scene load_scene(const std::filesystem::path& file) {
   read_object(root.at("object"), scene);
   if (root.has("gravity"))
     scene.gravity = root.at("gravity").vec3_within(max_gravity, "a gravity vector", "m/s^2");
+  check_resolvable_material(root.at("object").at("material"), scene);
   if (root.has("fixed"))
     scene.fixed = read_node_selection(root.at("fixed"), scene.object_mesh->node_count());
   if (root.has("statics")) scene.statics = read_statics(root.at("statics"));

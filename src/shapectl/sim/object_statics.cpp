@@ -59,6 +59,11 @@ RoundoffScale roundoff_scale(const TetMesh& mesh, const Material& material, doub
   return r;
 }
 
+double object_load(const TetMesh& mesh, const Material& material, double weight) {
+  const double size = (mesh.bounds_max() - mesh.bounds_min()).norm();
+  return weight > 0 ? weight : 1e-3 * material.mu * size * size;
+}
+
 namespace {
 std::shared_ptr<const TetMesh> placed_mesh(const Scene& scene) {
   std::vector<Vec3> p;
@@ -90,11 +95,14 @@ constexpr int kKrylovFrom = 5000;  // unknowns
 StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double weight) {
   // Converged when every nodal force is a tiny fraction of the weight (or, for a weightless
   // object, of the force that strains it by 0.1 %) — but never below what round-off leaves.
-  const double size = (placed.bounds_max() - placed.bounds_min()).norm();
-  const double scale = weight > 0 ? weight : 1e-3 * scene.material.mu * size * size;
+  // Nor that floor above a share of a node's load: where round-off is larger the load cannot be
+  // resolved (load_scene refuses such a material), and a scene built in code then ends not
+  // converged instead of passing the rest shape as its equilibrium.
+  const double load = object_load(placed, scene.material, weight);
   const RoundoffScale roundoff = roundoff_scale(placed, scene.material, weight);
-  return {.force_tolerance = scene.statics.relative_tolerance * scale,
-          .force_roundoff = roundoff.force,
+  return {.force_tolerance = scene.statics.relative_tolerance * load,
+          .force_roundoff =
+              std::min(roundoff.force, max_roundoff_share * load / placed.node_count()),
           .energy_roundoff = roundoff.energy,
           .max_iterations = scene.statics.max_iterations,
           .backend = scene.statics.backend,
@@ -106,6 +114,13 @@ StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double
           .single_precision_chord = scene.statics.single_precision_chord};
 }
 }  // namespace
+
+double roundoff_load_ratio(const Scene& scene, const Material& material) {
+  const auto placed = placed_mesh(scene);
+  const double weight = material.density * scene.gravity.norm() * placed->total_volume();
+  return roundoff_scale(*placed, material, weight).force /
+         (max_roundoff_share * object_load(*placed, material, weight) / placed->node_count());
+}
 
 ObjectStatics::ObjectStatics(const Scene& scene, const std::vector<int>& held_nodes)
     : mesh_(placed_mesh(scene)),

@@ -58,6 +58,18 @@ struct RoundoffScale {
 };
 RoundoffScale roundoff_scale(const TetMesh& mesh, const Material& material, double weight);
 
+// Doubles resolve an object's load only while that force floor stays a small share of it: at
+// most this share of the mean nodal load (object_load over the nodes). Above it (κ ≫ μ:
+// Poisson's ratio near 0.5; stiff and light; far from the origin) the rest shape would pass as
+// converged under the object's own weight.
+inline constexpr double max_roundoff_share = 0.01;
+// The load the force tolerance is relative to, N: the weight; for a weightless object the force
+// that strains it by 0.1 %.
+double object_load(const TetMesh& mesh, const Material& material, double weight);
+// RoundoffScale::force over max_roundoff_share × the mean nodal load, for `material` on the
+// scene's mesh placed in the world under its gravity: above 1 its load cannot be resolved.
+double roundoff_load_ratio(const Scene& scene, const Material& material);
+
 // Empty if every connected part of the mesh has a held node; otherwise says which is free.
 std::string find_unheld_part(const TetMesh& mesh, const std::vector<char>& held);
 
