@@ -121,6 +121,27 @@ class Watcher {
     }
     return std::nullopt;
   }
+  // Reads until the server ends the connection: its close frame's reason, or nullopt when it
+  // ended without one, or nothing ended within `limit`.
+  std::optional<boost::beast::websocket::close_reason> close_frame(std::chrono::seconds limit) {
+    const auto deadline = std::chrono::steady_clock::now() + limit;
+    while (std::chrono::steady_clock::now() < deadline) {
+      boost::beast::error_code result = boost::asio::error::timed_out;
+      buffer_.clear();
+      ws_.async_read(buffer_, [&](boost::beast::error_code ec, std::size_t) { result = ec; });
+      ioc_.restart();
+      ioc_.run_until(deadline);
+      if (!ioc_.stopped()) break;
+      // A close frame sets the reason; its teardown may then fail (the server has exited).
+      if (result && ws_.reason().code != boost::beast::websocket::close_code::none)
+        return ws_.reason();
+      if (result) return std::nullopt;
+    }
+    boost::beast::get_lowest_layer(ws_).cancel();
+    ioc_.restart();
+    ioc_.run();
+    return std::nullopt;
+  }
 
  private:
   using tcp = boost::asio::ip::tcp;

@@ -60,5 +60,26 @@ TEST(ServeStop, SigintStopsTheServerWithinOneSecondWhileACalibrationRuns) {
   EXPECT_LT(exit->seconds, 1.0) << server.log();
 }
 
+// A page open when serve stops is told so by a close frame (1001, going away), not left to
+// find a dead connection (issue 32).
+TEST(ServeStop, SigintSendsEveryPageACloseFrame) {
+  TempDir dir;
+  ServeProcess server(dir, {"serve", source_path("scenes/yumi_bar.json").string(), "--port", "0"});
+  const int port = server.wait_for_port(60s);
+  ASSERT_GT(port, 0) << server.log();
+  Watcher first(port), second(port);
+  ASSERT_TRUE(first.next("\"type\":\"state\"", 30s)) << server.log();
+  ASSERT_TRUE(second.next("\"type\":\"state\"", 30s)) << server.log();
+  const auto exit = server.signal_and_wait(SIGINT, 30s);
+  ASSERT_TRUE(exit) << "still running 30 s after SIGINT\n" << server.log();
+  EXPECT_EQ(exit->code, 0) << server.log();
+  EXPECT_LT(exit->seconds, 1.0) << server.log();
+  for (Watcher* page : {&first, &second}) {
+    const auto reason = page->close_frame(10s);
+    ASSERT_TRUE(reason) << "the connection ended without a close frame";
+    EXPECT_EQ(reason->code, boost::beast::websocket::close_code::going_away);
+  }
+}
+
 }  // namespace
 }  // namespace shapectl::test

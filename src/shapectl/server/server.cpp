@@ -80,6 +80,7 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   net::steady_timer accept_timer{ioc};
   net::steady_timer ticker{ioc};
   net::signal_set signals{ioc, SIGINT, SIGTERM};
+  net::steady_timer goodbye_timer{ioc};
   Clock::time_point next_tick;
   std::set<std::shared_ptr<Client>> clients;  // after the handshake
   int next_client_id = 1;
@@ -91,6 +92,8 @@ struct Server::Impl : std::enable_shared_from_this<Server::Impl> {
   void tick();
   void handle_message(const std::shared_ptr<Client>& client, std::string_view text);
   void broadcast_scene();
+  // SIGINT/SIGTERM: every page gets a close frame ("going away"), then the loop stops.
+  void close_all_and_stop();
 };
 
 namespace {
@@ -137,6 +140,18 @@ class Client : public std::enable_shared_from_this<Client> {
     if (queue_.size() == 1) write_next();
   }
   bool behind() const { return queue_.size() >= max_queued_stream; }
+
+  // The server stops: a close frame says so (code 1001), then the connection ends. Bounded by
+  // the server's goodbye time, after which the loop stops whatever the peer does.
+  void go_away() {
+    if (closed_) return;
+    closed_ = true;
+    server_.clients.erase(shared_from_this());
+    if (queue_.size() > 1)
+      queue_.erase(queue_.begin() + 1, queue_.end());  // the front is on its way
+    ws_.async_close(websocket::close_reason(websocket::close_code::going_away, "server stopped"),
+                    [self = shared_from_this()](beast::error_code) {});
+  }
 
   // Per client first, so one noisy page does not use up the server's whole log budget.
   void log(const std::string& line) {
@@ -457,6 +472,15 @@ void Server::Impl::tick() {
   });
 }
 
+void Server::Impl::close_all_and_stop() {
+  for (const auto& c : std::vector<std::shared_ptr<Client>>(clients.begin(), clients.end()))
+    c->go_away();
+  // Long enough for the close frames to leave on a local network, short against the 1 s in
+  // which serve must stop after SIGINT.
+  goodbye_timer.expires_after(std::chrono::milliseconds(150));
+  goodbye_timer.async_wait([this](beast::error_code) { ioc.stop(); });
+}
+
 Server::Server(Session& session, ServerOptions options)
     : impl_(std::make_shared<Impl>(session, std::move(options))) {
   auto& a = impl_->acceptor;
@@ -485,7 +509,7 @@ std::string Server::url() const {
 
 void Server::run() {
   impl_->signals.async_wait([impl = impl_](beast::error_code ec, int) {
-    if (!ec) impl->ioc.stop();
+    if (!ec) impl->close_all_and_stop();
   });
   impl_->accept();
   impl_->next_tick = Clock::now();
