@@ -27,9 +27,9 @@ namespace {
 
 // Generous bounds on scene numbers: finite but absurd values (gravity 1e300) are typos.
 constexpr double max_distance = max_scene_distance;  // m, positions and sizes
-constexpr double max_gravity = 1e3;     // m/s^2 (100 g)
-constexpr double max_stiffness = 1e12;  // N/m, and the barrier stiffnesses
-constexpr double max_weight = 1e12;     // objective weights
+constexpr double max_gravity = 1e3;                  // m/s^2 (100 g)
+constexpr double max_stiffness = 1e12;               // N/m, and the barrier stiffnesses
+constexpr double max_weight = 1e12;                  // objective weights
 
 // A positive number from lo to hi; "a positive number" for zero or negative values.
 double positive_in(const JsonInput& j, double lo, double hi, const std::string& unit) {
