@@ -103,18 +103,7 @@ class Watcher {
   std::optional<std::string> next(const std::string& needle, std::chrono::seconds limit) {
     const auto deadline = std::chrono::steady_clock::now() + limit;
     while (std::chrono::steady_clock::now() < deadline) {
-      boost::beast::error_code result = boost::asio::error::timed_out;
-      buffer_.clear();
-      ws_.async_read(buffer_, [&](boost::beast::error_code ec, std::size_t) { result = ec; });
-      ioc_.restart();
-      ioc_.run_until(deadline);
-      if (!ioc_.stopped()) {  // the deadline passed with the read pending
-        boost::beast::get_lowest_layer(ws_).cancel();
-        ioc_.restart();
-        ioc_.run();
-        return std::nullopt;
-      }
-      if (result) return std::nullopt;
+      if (read_one(deadline)) return std::nullopt;
       if (!ws_.got_text()) continue;
       std::string text = boost::beast::buffers_to_string(buffer_.data());
       if (text.find(needle) != std::string::npos) return text;
@@ -126,24 +115,32 @@ class Watcher {
   std::optional<boost::beast::websocket::close_reason> close_frame(std::chrono::seconds limit) {
     const auto deadline = std::chrono::steady_clock::now() + limit;
     while (std::chrono::steady_clock::now() < deadline) {
-      boost::beast::error_code result = boost::asio::error::timed_out;
-      buffer_.clear();
-      ws_.async_read(buffer_, [&](boost::beast::error_code ec, std::size_t) { result = ec; });
-      ioc_.restart();
-      ioc_.run_until(deadline);
-      if (!ioc_.stopped()) break;
+      if (!read_one(deadline)) continue;
       // A close frame sets the reason; its teardown may then fail (the server has exited).
-      if (result && ws_.reason().code != boost::beast::websocket::close_code::none)
-        return ws_.reason();
-      if (result) return std::nullopt;
+      if (ws_.reason().code != boost::beast::websocket::close_code::none) return ws_.reason();
+      return std::nullopt;
     }
-    boost::beast::get_lowest_layer(ws_).cancel();
-    ioc_.restart();
-    ioc_.run();
     return std::nullopt;
   }
 
  private:
+  // One message into buffer_; its error, timed_out when the deadline passed first (the read
+  // then cancelled).
+  boost::beast::error_code read_one(std::chrono::steady_clock::time_point deadline) {
+    boost::beast::error_code result = boost::asio::error::timed_out;
+    buffer_.clear();
+    ws_.async_read(buffer_, [&](boost::beast::error_code ec, std::size_t) { result = ec; });
+    ioc_.restart();
+    ioc_.run_until(deadline);
+    if (!ioc_.stopped()) {  // the deadline passed with the read pending
+      boost::beast::get_lowest_layer(ws_).cancel();
+      ioc_.restart();
+      ioc_.run();
+      return boost::asio::error::timed_out;
+    }
+    return result;
+  }
+
   using tcp = boost::asio::ip::tcp;
   boost::asio::io_context ioc_;
   boost::beast::websocket::stream<boost::beast::tcp_stream> ws_{ioc_};
