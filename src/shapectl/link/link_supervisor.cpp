@@ -184,8 +184,10 @@ FeedbackStep LinkSupervisor::on_feedback(int channel, const Eigen::VectorXd& mea
       disarm(c.spec.name + ": tracking error " + format(error) + " rad above " +
              format(settings_.max_tracking_error) + " rad");
   }
-  if (armed_)
-    if (std::string why = measured_problem(); !why.empty()) disarm(c.spec.name + ": " + why);
+  // A measured pose is not judged while armed: commands graze at ~0 clearance (the optimizer's
+  // poses may), and a robot following them lags a few µm off their path, which the sphere model
+  // would call an overlap (a 10-minute drag soak was disarmed so after 79 s). Arming is refused
+  // from a colliding measured pose (arm()); commanded poses are checked before they are sent.
   const PaceStep pace = c.pacer.on_feedback(now, controller_time);
   FeedbackStep step{.send = true,
                     .advanced = pace.advance,
