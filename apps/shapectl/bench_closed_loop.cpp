@@ -77,7 +77,7 @@ double median(std::vector<double> v) {
 
 }  // namespace
 
-void bench_closed_loop(const Scene& scene, int trials, unsigned seed) {
+void bench_closed_loop(const Scene& scene, int trials, unsigned seed, nlohmann::json& record) {
   if (!scene.robot || scene.grips.empty() || scene.robot->reference_joints.size() < 8) return;
   Eigen::VectorXd goal = scene.robot->reference_joints;
   goal[0] -= 0.03, goal[7] += 0.03;
@@ -101,6 +101,11 @@ void bench_closed_loop(const Scene& scene, int trials, unsigned seed) {
         calibrate ? "feedback + online calibration" : "feedback only", median(times),
         static_cast<int>(times.size()),
         times.empty() ? NAN : *std::max_element(times.begin(), times.end()), missed, give_up_after);
+    record[calibrate ? "feedback_calibration" : "feedback"] = {
+        {"median_s", median(times)},
+        {"max_s", times.empty() ? NAN : *std::max_element(times.begin(), times.end())},
+        {"reached", times.size()},
+        {"trials", trials}};
   }
 }
 

@@ -1,4 +1,5 @@
 // shapectl bench [SCENE.json ...] [--trials N] [--seed S] [--scaling | --sizes 1.5k,6k,...]
+//                [--json FILE]
 // Reproduces the paper's performance figures (Section V-A) on the bundled scenes: time per
 // reduced gradient by sensitivities, adjoint and finite differences, and the time and
 // iterations from a target change to a mean error below 1 mm.
@@ -19,6 +20,7 @@
 #include <shapectl/scene_io/scene_file.hpp>
 
 #include "bench_closed_loop.hpp"
+#include "bench_json.hpp"
 #include "bench_scaling.hpp"
 #include "bench_targets.hpp"
 #include "commands.hpp"
@@ -40,6 +42,7 @@ struct BenchArgs {
   std::string sizes;  // --sizes / --scaling: the scaling table instead of the paper's
   bool no_krylov = false;
   bool double_chord = false;
+  std::string json;  // --json: the figures also as JSON (bench_json.hpp)
 };
 
 // Timings of one reduced-gradient variant, seconds.
@@ -85,7 +88,7 @@ GradientTimes time_gradients(const GrippedObject& object, const ReducedObjective
   return t;
 }
 
-void print_gradient_times(const GradientTimes& t) {
+void print_gradient_times(const GradientTimes& t, nlohmann::json& record) {
   const double fd = percentile(t.fd_newton, 0.5);
   auto row = [&](const char* name, const std::vector<double>& times) {
     std::printf("    %-40s %8.3f ms   %6.1fx\n", name, 1e3 * percentile(times, 0.5),
@@ -101,11 +104,19 @@ void print_gradient_times(const GradientTimes& t) {
   row("adjoint, factorization counted", t.adjoint_factored);
   row("finite differences, chord re-solves", t.fd_chord);
   row("finite differences, Newton re-solves", t.fd_newton);
+  record = {{"samples", t.fd_newton.size()}};
+  for (auto [key, times] :
+       {std::pair{"sensitivity", &t.sensitivity},
+        std::pair{"sensitivity_factored", &t.sensitivity_factored},
+        std::pair{"adjoint", &t.adjoint}, std::pair{"adjoint_factored", &t.adjoint_factored},
+        std::pair{"fd_chord", &t.fd_chord}, std::pair{"fd_newton", &t.fd_newton}})
+    record[key] = {{"median_s", percentile(*times, 0.5)}};
 }
 
 // 2. Target change → mean error below 1 mm, from the reference equilibrium.
 void bench_target_changes(const ReducedObjective& objective, const Evaluation& reference,
-                          OptimizerKind kind, const char* name, const BenchArgs& args) {
+                          OptimizerKind kind, const char* name, const BenchArgs& args,
+                          nlohmann::json& record) {
   std::vector<double> times, iterations;
   int failures = 0;
   std::mt19937 goals(args.seed + 1);
@@ -125,6 +136,13 @@ void bench_target_changes(const ReducedObjective& objective, const Evaluation& r
       name, 1e3 * percentile(times, 0.5), 1e3 * percentile(times, 0.9),
       1e3 * percentile(times, 1.0), percentile(iterations, 0.5), percentile(iterations, 1.0),
       failures, times.size() + failures);
+  record = {{"median_s", percentile(times, 0.5)},
+            {"p90_s", percentile(times, 0.9)},
+            {"max_s", percentile(times, 1.0)},
+            {"iterations_median", percentile(iterations, 0.5)},
+            {"iterations_max", percentile(iterations, 1.0)},
+            {"reached", times.size()},
+            {"trials", times.size() + failures}};
 }
 
 // Targets that push the first two grips' nodes 4 cm towards each other each.
@@ -144,7 +162,7 @@ ShapeTargets squeeze_targets(const Scene& scene, const Positions& x0) {
 
 // 3. The slow tail: push the gripped ends 4 cm towards each other each, so the object buckles.
 void bench_buckling(const Scene& scene, const ReducedObjective& objective,
-                    const Evaluation& reference) {
+                    const Evaluation& reference, nlohmann::json& record) {
   if (scene.grips.size() < 2) {
     std::printf("  buckling: needs two grips to push together (this scene has %zu)\n",
                 scene.grips.size());
@@ -169,12 +187,17 @@ void bench_buckling(const Scene& scene, const ReducedObjective& objective,
       "< 1 mm after %.0f ms; final mean error %.3f mm\n",
       to_string(r.termination), r.iterations, 1e3 * seconds(t0, Clock::now()), 1e3 * to_1mm,
       1e3 * r.best.error.mean);
+  record = {{"termination", to_string(r.termination)},
+            {"iterations", r.iterations},
+            {"seconds", seconds(t0, Clock::now())},
+            {"to_1mm_s", to_1mm},
+            {"error_mean", r.best.error.mean}};
 }
 
 // Calibration (docs/calibration.md) on synthetic observations: the "real" object 1.8× stiffer
 // and held 4 mm / 3° off at each grip, 15 markers with 0.3 mm noise at 3 poses; fit Young's
 // modulus and the grip offsets. Median wall time over noise seeds.
-void bench_calibration(const Scene& scene, const BenchArgs& args) {
+void bench_calibration(const Scene& scene, const BenchArgs& args, nlohmann::json& record) {
   Scene truth = scene;
   truth.material = material_from_youngs(1.8 * youngs_modulus_of(scene.material),
                                         poisson_ratio_of(scene.material), scene.material.density);
@@ -218,9 +241,14 @@ void bench_calibration(const Scene& scene, const BenchArgs& args) {
       trials, percentile(times, 0.5), percentile(times, 1), 100 * percentile(stiffness_errors, 0.5),
       100 * percentile(stiffness_deviations, 0.5),
       held.empty() ? "" : ("; not identifiable, held:" + held).c_str());
+  record = {{"median_s", percentile(times, 0.5)},
+            {"max_s", percentile(times, 1)},
+            {"trials", trials},
+            {"youngs_error", percentile(stiffness_errors, 0.5)},
+            {"held", held}};
 }
 
-void bench_scene(const std::string& file, const BenchArgs& args) {
+void bench_scene(const std::string& file, const BenchArgs& args, nlohmann::json& record) {
   const Scene scene = load_scene(file);
   print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(file, "robot", "a scene with a robot (missing key)");
@@ -233,13 +261,16 @@ void bench_scene(const std::string& file, const BenchArgs& args) {
     throw SolverFailure("statics at the reference: " + reference.statics.reason);
   std::printf("\n%s: %d tets, %d nodes, %d joints\n", file.c_str(), object.mesh().tet_count(),
               object.node_count(), object.joint_count());
-  print_gradient_times(time_gradients(object, objective, reference, args.trials, rng));
-  for (auto [kind, name] : {std::pair{OptimizerKind::GaussNewton, "gauss-newton"},
-                            std::pair{OptimizerKind::Lbfgs, "lbfgs (sensitivity)"}})
-    bench_target_changes(objective, reference, kind, name, args);
-  bench_buckling(scene, objective, reference);
-  bench_calibration(scene, args);
-  bench_closed_loop(scene, std::min(args.trials, 3), args.seed);
+  record["tets"] = object.mesh().tet_count();
+  print_gradient_times(time_gradients(object, objective, reference, args.trials, rng),
+                       record["gradient"]);
+  for (auto [kind, name, key] :
+       {std::tuple{OptimizerKind::GaussNewton, "gauss-newton", "gauss_newton"},
+        std::tuple{OptimizerKind::Lbfgs, "lbfgs (sensitivity)", "lbfgs"}})
+    bench_target_changes(objective, reference, kind, name, args, record[key]);
+  bench_buckling(scene, objective, reference, record["buckling"]);
+  bench_calibration(scene, args, record["calibration"]);
+  bench_closed_loop(scene, std::min(args.trials, 3), args.seed, record["closed_loop"]);
 }
 
 }  // namespace
@@ -267,20 +298,26 @@ void add_bench_command(CLI::App& app) {
   cmd->add_flag("--double-chord", args->double_chord,
                 "with --sizes: chord and Krylov steps solve in double precision, not single (to "
                 "measure what single saves)");
+  cmd->add_option("--json", args->json,
+                  "also write the figures to this JSON file (for scripts/bench_table.py)");
   cmd->add_flag_callback(
       "--scaling", [args] { args->sizes = kDefaultSizes; },
       std::string("the scaling table at ") + kDefaultSizes + " tets (--sizes " + kDefaultSizes +
           ")");
   cmd->callback([args, scenes] {
+    nlohmann::json record = nlohmann::json::object();
     if (!args->sizes.empty()) {
       const auto counts = parse_tet_counts(args->sizes, "--sizes");
       bench_scaling(scenes->count() ? args->scenes.front() : "scenes/yumi_bar.json", counts,
                     args->trials, args->seed,
                     {.krylov_steps = !args->no_krylov,
-                     .single_precision_chord = !args->double_chord});
+                     .single_precision_chord = !args->double_chord},
+                    record["sizes"]);
+      write_bench_record(args->json, record);
       return;
     }
-    for (const auto& s : args->scenes) bench_scene(s, *args);
+    for (const auto& s : args->scenes) bench_scene(s, *args, record["scenes"][s]);
+    write_bench_record(args->json, record);
   });
 }
 

@@ -203,7 +203,7 @@ std::vector<int> parse_tet_counts(const std::string& text, const std::string& op
 }
 
 void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_counts, int trials,
-                   unsigned seed, ScalingLevers levers) {
+                   unsigned seed, ScalingLevers levers, nlohmann::json& record) {
   Scene scene = load_scene(scene_file);
   scene.statics.krylov_steps = levers.krylov_steps;
   scene.statics.single_precision_chord = levers.single_precision_chord;
@@ -241,18 +241,33 @@ void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_co
         percentile(row.steps, 0.5), percentile(row.steps, 1.0), row.peak_mb,
         per_size ? "" : " (whole run)");
     std::fflush(stdout);
+    record["scene"] = scene_file;
+    record["rows"].push_back(
+        {{"tets", row.tets},
+         {"from_rest_s", row.from_rest},
+         {"from_rest_first_s", row.from_rest_first},
+         {"warm_s", row.warm},
+         {"target_median_s", percentile(row.target_times, 0.5)},
+         {"target_p90_s", percentile(row.target_times, 0.9)},
+         {"reached", row.target_times.size()},
+         {"trials", static_cast<int>(row.target_times.size()) + row.not_reached},
+         {"peak_mb", per_size ? nlohmann::json(row.peak_mb) : nlohmann::json()}});
     tets.push_back(row.tets);
     target_medians.push_back(percentile(row.target_times, 0.5));
     rest_medians.push_back(row.from_rest);
     warm_medians.push_back(row.warm);
   }
   // An exponent needs two sizes.
-  if (std::set<double>(tets.begin(), tets.end()).size() >= 2)
+  if (std::set<double>(tets.begin(), tets.end()).size() >= 2) {
+    record["growth"] = {{"target_change", growth_exponent(tets, target_medians)},
+                        {"from_rest", growth_exponent(tets, rest_medians)},
+                        {"warm", growth_exponent(tets, warm_medians)}};
     std::printf(
         "  growth exponent (time ~ tets^k, least squares on log-log): target change %.2f, "
         "statics from rest %.2f, warm re-solve %.2f\n",
         growth_exponent(tets, target_medians), growth_exponent(tets, rest_medians),
         growth_exponent(tets, warm_medians));
+  }
   std::printf(
       "  Newton it/fac: statics iterations (Newton + chord) and numeric factorizations per target "
       "change, medians; peak MB: VmHWM of /proc/self/status, reset before each size\n");

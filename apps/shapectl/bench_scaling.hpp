@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 namespace shapectl::cli {
 
 // The size that stands for the scene's own mesh, unrefined ("mesh" in --sizes).
@@ -22,8 +24,9 @@ struct ScalingLevers {
 };
 
 // Runs and prints the table for the scene file (to refine, its object must be a box mesh
-// without hole); `trials` random reachable target sets per size.
+// without hole); `trials` random reachable target sets per size. The figures also go to
+// `record` (bench_json.hpp).
 void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_counts, int trials,
-                   unsigned seed, ScalingLevers levers);
+                   unsigned seed, ScalingLevers levers, nlohmann::json& record);
 
 }  // namespace shapectl::cli
