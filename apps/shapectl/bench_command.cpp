@@ -65,9 +65,9 @@ GradientTimes time_gradients(const GrippedObject& object, const ReducedObjective
     ShapeTargets targets;
     if (!random_goal(objective, reference, rng, targets)) continue;
     std::uniform_real_distribution<double> u(-0.1, 0.1);
-    Eigen::VectorXd theta = reference.joints;
+    Eigen::VectorXd theta = reference.joints();
     for (int j = 0; j < theta.size(); ++j) theta[j] += u(rng);
-    if (!objective.evaluate(theta, reference.positions).statics.converged()) continue;
+    if (!objective.evaluate(theta, reference.positions()).statics().converged()) continue;
     for (auto [method, times, factor] :
          {std::tuple{GradientMethod::Sensitivity, &t.sensitivity, Factor::Reused},
           std::tuple{GradientMethod::Sensitivity, &t.sensitivity_factored, Factor::Counted},
@@ -78,7 +78,7 @@ GradientTimes time_gradients(const GrippedObject& object, const ReducedObjective
       const ReducedObjective variant(object, targets,
                                      {.stale_factor_step = factor == Factor::Counted ? 0.0 : 1e-6,
                                       .chord_steps = factor != Factor::NewtonResolves});
-      Evaluation fresh = variant.evaluate(theta, reference.positions);
+      Evaluation fresh = variant.evaluate(theta, reference.positions());
       if (factor == Factor::Reused && !variant.confirm_stable(fresh)) break;
       const auto t0 = Clock::now();
       variant.gradient(fresh, method);
@@ -169,7 +169,7 @@ void bench_buckling(const Scene& scene, const ReducedObjective& objective,
     return;
   }
   const ReducedObjective buckle =
-      objective.with_targets(squeeze_targets(scene, reference.positions));
+      objective.with_targets(squeeze_targets(scene, reference.positions()));
   Evaluation current = reference;
   buckle.rescore(current);
   GaussNewton optimizer;
@@ -257,8 +257,8 @@ void bench_scene(const std::string& file, const BenchArgs& args, nlohmann::json&
   std::mt19937 rng(args.seed);
   const Evaluation reference =
       objective.evaluate(object.reference_joints(), object.reference_positions());
-  if (!reference.statics.converged())
-    throw SolverFailure("statics at the reference: " + reference.statics.reason);
+  if (!reference.statics().converged())
+    throw SolverFailure("statics at the reference: " + reference.statics().reason);
   std::printf("\n%s: %d tets, %d nodes, %d joints\n", file.c_str(), object.mesh().tet_count(),
               object.node_count(), object.joint_count());
   record["tets"] = object.mesh().tet_count();

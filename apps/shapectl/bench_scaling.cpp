@@ -127,25 +127,25 @@ SizeRow measure(const Scene& scene, int trials, unsigned seed) {
     const auto t0 = BenchClock::now();
     Evaluation e = objective.evaluate(theta0, object.reference_positions());
     from_rest.push_back(seconds_between(t0, BenchClock::now()));
-    if (!e.statics.converged())
+    if (!e.statics().converged())
       throw SolverFailure("statics at the reference, " + std::to_string(row.tets) +
-                          " tets: " + e.statics.reason);
-    row.from_rest_iterations = e.statics.iterations;
+                          " tets: " + e.statics().reason);
+    row.from_rest_iterations = e.statics().iterations;
     reference = std::move(e);
   }
   row.from_rest_first = from_rest[0];
   row.from_rest = percentile(from_rest, 0.5);
 
-  const Eigen::VectorXd moved = one_mm_grip_move(object, reference->positions);
+  const Eigen::VectorXd moved = one_mm_grip_move(object, reference->positions());
   std::vector<double> warm;
   for (int r = 0; r < 5; ++r) {
-    Positions x = reference->positions;
-    object.carry_gripped_nodes(theta0, moved, reference->positions, x);
+    Positions x = reference->positions();
+    object.carry_gripped_nodes(theta0, moved, reference->positions(), x);
     const auto t0 = BenchClock::now();
     const Evaluation e = objective.evaluate(moved, x, 0, &*reference);
     warm.push_back(seconds_between(t0, BenchClock::now()));
-    row.warm_iterations = e.statics.iterations;
-    row.warm_factorizations = e.statics.factorizations;
+    row.warm_iterations = e.statics().iterations;
+    row.warm_factorizations = e.statics().factorizations;
   }
   row.warm = percentile(warm, 0.5);
 

@@ -18,18 +18,18 @@ double percentile(std::vector<double> v, double p) {
 bool random_goal(const ReducedObjective& objective, const Evaluation& reference, std::mt19937& rng,
                  ShapeTargets& targets) {
   std::uniform_real_distribution<double> u(-0.15, 0.15);
-  Eigen::VectorXd theta = reference.joints;
+  Eigen::VectorXd theta = reference.joints();
   for (int j = 0; j < theta.size(); ++j) theta[j] += u(rng);
-  const Evaluation goal = objective.evaluate(theta, reference.positions);
+  const Evaluation goal = objective.evaluate(theta, reference.positions());
   if (!goal.safe()) return false;
-  const int n = static_cast<int>(goal.positions.size() / 3);
+  const int n = static_cast<int>(goal.positions().size() / 3);
   std::vector<int> nodes(n);
   for (int i = 0; i < n; ++i) nodes[i] = i;
   std::shuffle(nodes.begin(), nodes.end(), rng);
   targets = {};
   for (int k = 0; k < std::min(20, n); ++k) {
     targets.nodes.push_back(nodes[k]);
-    targets.positions.push_back(goal.positions.segment<3>(3 * nodes[k]));
+    targets.positions.push_back(goal.positions().segment<3>(3 * nodes[k]));
   }
   return true;
 }

@@ -87,15 +87,15 @@ void run_solve(const SolveArgs& args) {
   const Evaluation start =
       objective.evaluate(object.reference_joints(), object.reference_positions(), 0, nullptr,
                          out_of_time);
-  if (!start.statics.converged())
-    throw SolverFailure("statics at the reference joints: " + start.statics.reason +
+  if (!start.statics().converged())
+    throw SolverFailure("statics at the reference joints: " + start.statics().reason +
                         (out_of_time() ? " (--max-seconds reached)" : ""));
-  const OptimizeResult result = optimize(objective, *optimizer, start,
-                                         {.max_iterations = args.max_iterations,
-                                          .max_seconds = std::max(0.0, aim - elapsed())});
+  OptimizeResult result = optimize(objective, *optimizer, start,
+                                   {.max_iterations = args.max_iterations,
+                                    .max_seconds = std::max(0.0, aim - elapsed())});
 
-  const Evaluation& best = result.best;
-  nlohmann::json out = robot_json(scene, best.joints);
+  Evaluation& best = result.best;  // the shortfall probe may factor its state
+  nlohmann::json out = robot_json(scene, best.joints());
   out["converged"] = result.converged();
   out["termination"] = to_string(result.termination);
   out["reason"] = result.reason;
@@ -117,12 +117,12 @@ void run_solve(const SolveArgs& args) {
   if (best.min_clearance != std::numeric_limits<double>::infinity())
     out["min_clearance"] = best.min_clearance;
   nlohmann::json violations = nlohmann::json::array();
-  const KinematicsState state = forward_kinematics(object.robot(), best.joints);
+  const KinematicsState state = forward_kinematics(object.robot(), best.joints());
   for (const auto& v : limit_violations(object.robot(), state.joints))
     violations.push_back(
         {{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
-  out["positions"] = positions_json(best.positions);
+  out["positions"] = positions_json(best.positions());
   out["targets"] = targets_json(objective.targets());
   for (const auto& h : result.history)
     out["history"].push_back({{"iteration", h.iteration},
@@ -142,10 +142,10 @@ void run_solve(const SolveArgs& args) {
     for (const auto& t : object.mesh().tets()) tets.push_back(t.nodes);
     const Positions rest = scene.world_rest_positions();
     files.push_back(
-        {args.vtu, vtu_text(best.positions, tets, {{"displacement", best.positions - rest}})});
+        {args.vtu, vtu_text(best.positions(), tets, {{"displacement", best.positions() - rest}})});
   }
   if (!args.surface.empty())
-    files.push_back(surface_file(args.surface, object.mesh(), best.positions));
+    files.push_back(surface_file(args.surface, object.mesh(), best.positions()));
   write_files_atomically(files);
   std::cerr << "solve: " << to_string(status)
             << (shortfall.detail.empty() ? "" : " (" + shortfall.detail + ")") << "; "

@@ -44,6 +44,9 @@ class SolverError : public std::runtime_error {
 struct SceneHandle {
   std::shared_ptr<const Scene> scene;
   std::shared_ptr<const GrippedObject> object;  // null without a robot
+  // The statics workspaces of every call on this scene (thread-safe): a batch's solves, e.g. a
+  // Dask worker's tasks, share their symbolic analyses.
+  std::shared_ptr<WorkspacePool> workspaces = WorkspacePool::create();
   // A scene given as a dict: its JSON text, file names absolute. Null: scene->source is its file.
   std::shared_ptr<const std::string> document;
   const GrippedObject& gripped() const;  // InputError if the scene has no robot

@@ -75,19 +75,18 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
   const TargetsInput input = read_targets_from(targets_in, object.node_count(), source);
 
   py::gil_scoped_release release;
-  const ReducedObjective objective(object, resolve(input, source, object));
+  const ReducedObjective objective(object, resolve(input, source, object), {}, s.workspaces);
   auto optimizer = make_optimizer(kind, gradient);
   const Evaluation start =
       objective.evaluate(object.reference_joints(), object.reference_positions());
-  if (!start.statics.converged())
-    throw SolverError("statics at the reference joints: " + start.statics.reason);
-  const OptimizeResult result =
-      optimize(objective, *optimizer, start,
-               {.max_iterations = max_iterations, .max_seconds = max_seconds});
+  if (!start.statics().converged())
+    throw SolverError("statics at the reference joints: " + start.statics().reason);
+  OptimizeResult result = optimize(objective, *optimizer, start,
+                                   {.max_iterations = max_iterations, .max_seconds = max_seconds});
 
-  const Evaluation& best = result.best;
+  Evaluation& best = result.best;  // the shortfall probe may factor its state
   SolveResult out;
-  out.joints = best.joints;
+  out.joints = best.joints();
   out.joint_names = object.robot().active_joint_names();
   out.converged = result.converged();
   out.termination = to_string(result.termination);
@@ -108,12 +107,12 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
   // +inf without collision spheres: nothing to report.
   if (best.min_clearance != std::numeric_limits<double>::infinity())
     out.min_clearance = best.min_clearance;
-  out.limit_violations = violations_at(object.robot(), best.joints);
-  out.positions = best.positions;
+  out.limit_violations = violations_at(object.robot(), best.joints());
+  out.positions = best.positions();
   out.targets = objective.targets();
   out.history = result.history;
   out.timing = objective.timing();
-  out.tools = tool_poses(*s.scene, best.joints);
+  out.tools = tool_poses(*s.scene, best.joints());
   if (!out.joints.allFinite() || !out.positions.allFinite() || !std::isfinite(out.objective))
     throw SolverError("solve: the result is not finite (" + result.reason + ")");
   return out;

@@ -31,7 +31,8 @@ StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in)
   const GrippedObject& object = *s.object;
   const Eigen::VectorXd joints = joints_from(joints_in, object.robot(), object.reference_joints());
   py::gil_scoped_release release;
-  const ObjectState state = object.solve_from(joints, object.reference_positions());
+  const ObjectState state =
+      object.solve_from(joints, object.reference_positions(), 0, nullptr, {}, s.workspaces);
   out.result = state.statics();
   out.positions = state.positions();
   out.joints = joints;
@@ -63,7 +64,8 @@ StateHandle solve_state(const ObjectHandle& o, const py::object& joints_in,
   if (max_iterations < 0) throw InputError("max_iterations", "", "a number >= 0", max_iterations);
   py::gil_scoped_release release;
   return {s.object, s.scene,
-          std::make_shared<ObjectState>(object.solve_from(joints, x, max_iterations))};
+          std::make_shared<ObjectState>(
+              object.solve_from(joints, x, max_iterations, nullptr, {}, s.workspaces))};
 }
 
 Eigen::MatrixXd sensitivity(const ObjectHandle&, const StateHandle& h) {

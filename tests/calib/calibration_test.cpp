@@ -8,6 +8,7 @@
 #include <string>
 #include <thread>
 
+#include <shapectl/calib/equilibria.hpp>
 #include <shapectl/calib/joint_path.hpp>
 #include <shapectl/calib/simulated_camera.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
@@ -58,6 +59,14 @@ std::vector<int> spread_nodes(int node_count, int count, unsigned seed) {
   return {all.begin(), all.begin() + count};
 }
 
+// 15 markers spread over the bar, 0.3 mm noise, at the study's three poses.
+Observations fifteen_markers(const SyntheticStudy& study) {
+  SimulatedCamera camera;
+  camera.marker_nodes = spread_nodes(study.model.object_mesh->node_count(), 15, 7);
+  camera.sigma = 0.0003;
+  return study.observe(camera, 11);
+}
+
 void expect_truth_recovered(const SyntheticStudy& study, const CalibrationResult& r) {
   ASSERT_TRUE(r.converged) << r.reason;
   EXPECT_TRUE(r.unidentified.empty()) << r.unidentified.front().held << " held";
@@ -72,10 +81,7 @@ void expect_truth_recovered(const SyntheticStudy& study, const CalibrationResult
 
 TEST(Calibration, RecoversStiffnessAndGripOffsetsFromFifteenMarkersAtThreePoses) {
   const SyntheticStudy study;
-  SimulatedCamera camera;
-  camera.marker_nodes = spread_nodes(study.model.object_mesh->node_count(), 15, 7);
-  camera.sigma = 0.0003;
-  const Observations observations = study.observe(camera, 11);
+  const Observations observations = fifteen_markers(study);
   const CalibrationResult r =
       calibrate(study.model, observations, parse_fit_selection("youngs_modulus,grip_offsets"));
   expect_truth_recovered(study, r);
@@ -87,6 +93,31 @@ TEST(Calibration, RecoversTheSameFromPointCloudsWithOutliers) {
   const CalibrationResult r =
       calibrate(study.model, observations, parse_fit_selection("youngs_modulus,grip_offsets"));
   expect_truth_recovered(study, r);
+}
+
+// Every trial of the fit is a new model (another stiffness, other grip offsets), the pattern of
+// its Hessian the same. One trial makes the workspaces its frames' equilibria need at once (a
+// walk from the reference joints holds two states); a whole fit on the same pool, every trial
+// with a new GrippedObject, analyses nothing more.
+TEST(Calibration, OneSymbolicAnalysisPerPatternNotOnePerTrial) {
+  const SyntheticStudy study;
+  const Observations observations = fifteen_markers(study);
+  ASSERT_EQ(observations.frames.size(), 3u);
+  const FitSelection fit = parse_fit_selection("youngs_modulus,grip_offsets");
+  const auto pool = WorkspacePool::create();
+  long long before = statics_totals().analyses;
+  frame_equilibria(study.model, ParameterSpace(study.model, fit),
+                   PhysicalParameters::of(study.model), observations, nullptr,
+                   {.workspaces = pool});
+  const long long one_trial = statics_totals().analyses - before;
+  EXPECT_GE(one_trial, 1);
+  EXPECT_LE(one_trial, 2);
+  before = statics_totals().analyses;
+  const CalibrationResult r =
+      calibrate(study.model, observations, fit, {.max_seconds = 300, .workspaces = pool});
+  ASSERT_TRUE(r.converged) << r.reason;
+  EXPECT_GE(r.iterations, 3);  // trials: at least one per iteration
+  EXPECT_EQ(statics_totals().analyses - before, 0);
 }
 
 TEST(Calibration, StiffnessAndDensityFromShapeAloneAreReportedUnidentifiable) {

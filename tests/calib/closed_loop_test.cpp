@@ -33,9 +33,9 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
   // Targets: the model's own shape at other joints (reachable by the model), 12 nodes, each
   // carrying a tracked marker.
   std::mt19937 rng(5);
-  Eigen::VectorXd goal = reference.joints;
+  Eigen::VectorXd goal = reference.joints();
   goal[0] -= 0.03, goal[7] += 0.03;  // the shoulders push the grippers together: the bar arches
-  const Evaluation at_goal = objective.evaluate(goal, reference.positions);
+  const Evaluation at_goal = objective.evaluate(goal, reference.positions());
   ASSERT_TRUE(at_goal.safe());
   ShapeTargets targets;
   std::vector<int> nodes(model.node_count());
@@ -43,7 +43,7 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
   std::shuffle(nodes.begin(), nodes.end(), rng);
   for (int k = 0; k < 12; ++k)
     targets.nodes.push_back(nodes[k]),
-        targets.positions.push_back(at_goal.positions.segment<3>(3 * nodes[k]));
+        targets.positions.push_back(at_goal.positions().segment<3>(3 * nodes[k]));
   SimulatedCamera camera;
   camera.marker_nodes = targets.nodes;
   camera.sigma = 0.0003;
@@ -55,7 +55,7 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
   GaussNewton optimizer;
   OptimizeResult result = optimize(objective, optimizer, start, {.max_iterations = 50});
   ASSERT_LT(result.best.error.mean, 1e-3) << result.reason;
-  ObjectState truth = equilibrium_along_path(world, result.best.joints);
+  ObjectState truth = equilibrium_along_path(world, result.best.joints());
   const double open_loop = true_error(targets, truth.positions());
   EXPECT_GE(open_loop, 5e-3);
 
@@ -63,17 +63,17 @@ TEST(ClosedLoop, ModelErrorFeedbackBringsTheObservedBarToTargetsTheModelAloneMis
   ModelErrorFeedback feedback(model_scene.object_mesh);
   for (int round = 0; round < 12; ++round) {
     const ObservationFrame frame =
-        camera.observe(world.mesh(), truth.positions(), result.best.joints, rng);
+        camera.observe(world.mesh(), truth.positions(), result.best.joints(), rng);
     std::vector<std::pair<int, Vec3>> observed;
     for (const ObservedMarker& m : frame.markers) observed.emplace_back(m.node, m.position);
     // A second per round: the round's ten optimizer iterations take about that.
-    feedback.observe(observed, result.best.positions, camera.sigma, round);
+    feedback.observe(observed, result.best.positions(), camera.sigma, round);
     const ReducedObjective aimed = objective.with_targets(feedback.corrected(targets));
     Evaluation from = result.best;
     aimed.rescore(from);
     result = optimize(aimed, optimizer, from, {.max_iterations = 10});
     ASSERT_TRUE(result.best.safe()) << "round " << round;
-    truth = world.solve_from(result.best.joints, truth.positions());
+    truth = world.solve_from(result.best.joints(), truth.positions());
     ASSERT_TRUE(truth.statics().converged()) << truth.statics().reason;
   }
   const double closed_loop = true_error(targets, truth.positions());

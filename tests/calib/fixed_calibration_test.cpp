@@ -85,6 +85,22 @@ TEST(FixedCalibration, RecoversStiffnessAndClampPoseFromFifteenMarkers) {
   EXPECT_LT(r.parameters[0].standard_deviation, 0.01 * r.fitted.youngs_modulus);
 }
 
+// Every trial of the fit is a new model (another stiffness, another pose), the pattern of its
+// Hessian the same: the fit's workspace pool keeps its one symbolic analysis.
+TEST(FixedCalibration, OneSymbolicAnalysisPerPatternNotOnePerTrial) {
+  const ClampedStudy study;
+  SimulatedCamera camera;
+  camera.marker_nodes = markers_along_the_bar(*study.model.object_mesh);
+  camera.sigma = 0.0003;
+  const Observations observations = study.observe(camera, 21, 3);
+  const long long before = statics_totals().analyses;
+  const CalibrationResult r =
+      calibrate(study.model, observations, parse_fit_selection("youngs_modulus,object_pose"));
+  ASSERT_TRUE(r.converged) << r.reason;
+  EXPECT_GE(r.iterations, 3);  // trials: at least one per iteration
+  EXPECT_EQ(statics_totals().analyses - before, 1);
+}
+
 TEST(FixedCalibration, RecoversTheSameFromPointCloudsWithOutliers) {
   const ClampedStudy study;
   const CalibrationResult r =

@@ -27,7 +27,7 @@ TEST(Controller, FollowsTargetsSetFromAnotherThread) {
   ShapeTargets targets;
   for (int i = 0; i < probe.node_count(); i += 7) {
     targets.nodes.push_back(i);
-    targets.positions.push_back(e.positions.segment<3>(3 * i));
+    targets.positions.push_back(e.positions().segment<3>(3 * i));
   }
 
   Controller controller(scene);
@@ -142,6 +142,26 @@ TEST(Controller, AJogRightAfterThePauseIsAcceptedBeforeThePauseIsPublished) {
   EXPECT_TRUE(controller.snapshot()->paused);
 }
 
+// Quick jogs of two joints, the second before the thread applied the first: the second keeps
+// the first (it composes from the pending jog, not from the snapshot). The one guard of the
+// jog race; the server's Session only forwards.
+TEST(Controller, QuickJogsOfTwoJointsDoNotUndoEachOther) {
+  Controller controller(test::two_arm_scene());
+  EXPECT_THROW(controller.set_joint(0, 0.0), InputError);  // not paused yet
+  controller.set_paused(true);
+  controller.step_once();
+  const Eigen::VectorXd before = controller.snapshot()->joints;
+  controller.set_joint(1, before[1] + 0.04);
+  controller.set_joint(4, before[4] - 0.03);  // the snapshot still shows `before`
+  EXPECT_EQ(controller.snapshot()->joints, before);
+  controller.step_once();
+  Eigen::VectorXd expected = before;
+  expected[1] += 0.04, expected[4] -= 0.03;
+  EXPECT_EQ(controller.snapshot()->joints, expected);
+  EXPECT_THROW(controller.set_joint(6, 0.0), InputError);
+  EXPECT_THROW(controller.set_joint(1, std::nan("")), InputError);
+}
+
 TEST(Controller, AJogIntoSelfCollisionIsRefusedNamingTheLinks) {
   // The third links' spheres 1 cm apart; the arms swing towards each other 5 mrad a jog.
   Controller controller(test::two_arm_scene_with_clearance(0.01));
@@ -198,9 +218,9 @@ TEST(Controller, StatusSaysReachedOnlyWithinTheTolerance) {
   ShapeTargets reachable, beyond;
   for (int i = 0; i < probe.node_count(); i += 5) {
     reachable.nodes.push_back(i);
-    reachable.positions.push_back(e.positions.segment<3>(3 * i));
+    reachable.positions.push_back(e.positions().segment<3>(3 * i));
     beyond.nodes.push_back(i);
-    beyond.positions.push_back(e.positions.segment<3>(3 * i) + Vec3(0, 0, 0.6));
+    beyond.positions.push_back(e.positions().segment<3>(3 * i) + Vec3(0, 0, 0.6));
   }
   const auto stopped = [](const ControllerSnapshot& s) {
     return !s.targets.empty() && s.status != ControllerStatus::Optimizing;

@@ -53,8 +53,8 @@ TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
     Eigen::VectorXd goal = object.reference_joints();
     for (int j = 0; j < goal.size(); ++j) goal[j] += u(rng);
     const Evaluation at_goal = objective.evaluate(goal, object.reference_positions());
-    ASSERT_TRUE(at_goal.statics.converged());
-    objective = objective.with_targets(targets_from_shape(at_goal.positions, 10 + seed * 5, rng));
+    ASSERT_TRUE(at_goal.statics().converged());
+    objective = objective.with_targets(targets_from_shape(at_goal.positions(), 10 + seed * 5, rng));
 
     const Evaluation start =
         objective.evaluate(object.reference_joints(), object.reference_positions());
@@ -97,7 +97,7 @@ TEST_P(OptimizeTest, UnreachableTargetsGiveAnHonestBestEffort) {
   auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
   const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 60});
   EXPECT_TRUE(result.best.safe());
-  EXPECT_TRUE(result.best.positions.allFinite());
+  EXPECT_TRUE(result.best.positions().allFinite());
   EXPECT_GT(result.best.error.mean, 4.0);
   EXPECT_LE(result.best.objective, start.objective);
   EXPECT_FALSE(result.reason.empty());
@@ -118,17 +118,17 @@ TEST_P(OptimizeTest, NonFiniteObjectiveNeitherCrashesNorConverges) {
     objective = objective.with_targets(t);
     const Evaluation start =
         objective.evaluate(object.reference_joints(), object.reference_positions());
-    ASSERT_TRUE(start.statics.converged());
+    ASSERT_TRUE(start.statics().converged());
     ASSERT_FALSE(std::isfinite(start.objective)) << "the test needs a non-finite objective";
     for (const GradientMethod method : {GradientMethod::Sensitivity, GradientMethod::Adjoint}) {
       auto optimizer = make_optimizer(GetParam(), method);
       Evaluation current = start;
       EXPECT_EQ(optimizer->step(objective, current), StepOutcome::Stuck) << weight;
-      EXPECT_EQ(current.joints, start.joints);
+      EXPECT_EQ(current.joints(), start.joints());
       const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 5});
       EXPECT_FALSE(result.converged()) << result.reason;
       EXPECT_NE(result.reason.find("not finite"), std::string::npos) << result.reason;
-      EXPECT_EQ(result.best.joints, start.joints);
+      EXPECT_EQ(result.best.joints(), start.joints());
     }
   }
 }
@@ -144,8 +144,8 @@ TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
   Eigen::VectorXd goal = object.reference_joints();
   goal << 0.2, -0.5, 1.2, -0.2, -0.1, 0.7;
   const Evaluation at_goal = objective.evaluate(goal, object.reference_positions());
-  ASSERT_TRUE(at_goal.statics.converged());
-  objective = objective.with_targets(targets_from_shape(at_goal.positions, 12, rng));
+  ASSERT_TRUE(at_goal.statics().converged());
+  objective = objective.with_targets(targets_from_shape(at_goal.positions(), 12, rng));
   const ShapeTargets targets = objective.targets();
   // Each run from scratch, so every run takes the same path until its budget runs out.
   auto run = [&](double max_seconds, double* work_done) {
@@ -209,12 +209,13 @@ TEST_F(YumiBar, ReachableTargetsAreReachedOverSeveralSeeds) {
   for (unsigned seed = 1; tried < 3; ++seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<double> u(-0.15, 0.15);
-    Eigen::VectorXd goal = reference.joints;
+    Eigen::VectorXd goal = reference.joints();
     for (int j = 0; j < goal.size(); ++j) goal[j] += u(rng);
-    const Evaluation at_goal = objective.evaluate(goal, reference.positions);
+    const Evaluation at_goal = objective.evaluate(goal, reference.positions());
     if (!at_goal.safe()) continue;  // only collision-free, in-limit goals are reachable
     ++tried;
-    objective = objective.with_targets(targets_from_shape(at_goal.positions, 10 + 7 * tried, rng));
+    objective =
+        objective.with_targets(targets_from_shape(at_goal.positions(), 10 + 7 * tried, rng));
     Evaluation start = reference;
     objective.rescore(start);
     GaussNewton optimizer;

@@ -37,12 +37,12 @@ TEST(ReducedObjective, GradientAgreesAllThreeWaysWithCentralDifferences) {
     Eigen::VectorXd theta = object.reference_joints();
     for (int j = 0; j < theta.size(); ++j) theta[j] += u(rng);
     theta[1] = 1.97;  // inside the joint-limit margin: the barrier contributes
-    const Evaluation at = objective.evaluate(theta, object.reference_positions());
-    ASSERT_TRUE(at.statics.converged());
+    Evaluation at = objective.evaluate(theta, object.reference_positions());
+    ASSERT_TRUE(at.statics().converged());
     ASSERT_GT(at.joint_limits, 0);
     // Ô with the equilibrium re-solved at each perturbed θ.
     const auto reduced = [&](const Eigen::VectorXd& t) {
-      return objective.evaluate(t, at.positions).objective;
+      return objective.evaluate(t, at.positions()).objective;
     };
     const Eigen::VectorXd central = test::central_difference_gradient(reduced, theta, 1e-5);
     const Eigen::VectorXd sensitivity = objective.gradient(at, GradientMethod::Sensitivity);
@@ -66,7 +66,7 @@ TEST(ReducedObjective, LeastSquaresFormMatchesObjectiveAndGradient) {
   const ReducedObjective objective(object, some_targets(object, rng), {.stale_factor_step = 0});
   Eigen::VectorXd theta = object.reference_joints();
   theta[4] = -1.97;  // near the lower limit
-  const Evaluation at = objective.evaluate(theta, object.reference_positions());
+  Evaluation at = objective.evaluate(theta, object.reference_positions());
   Eigen::VectorXd r;
   Eigen::MatrixXd J;
   objective.least_squares(at, r, J);
@@ -78,7 +78,8 @@ TEST(ReducedObjective, LeastSquaresFormMatchesObjectiveAndGradient) {
   const auto residuals = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
     Eigen::VectorXd residual;
     Eigen::MatrixXd unused;
-    objective.least_squares(objective.evaluate(t, at.positions), residual, unused);
+    Evaluation e = objective.evaluate(t, at.positions());
+    objective.least_squares(e, residual, unused);
     return residual;
   };
   EXPECT_TRUE(test::derivative_matches(J, test::central_difference_jacobian(residuals, theta, 1e-6),
@@ -90,24 +91,35 @@ TEST(ReducedObjective, ConfirmStableRejectsAStateWhoseHessianIsIndefinite) {
   GrippedObject object(scene);
   ReducedObjective objective(object);
   Evaluation held = objective.evaluate(object.reference_joints(), object.reference_positions());
-  ASSERT_TRUE(held.statics.converged());
+  ASSERT_TRUE(held.statics().converged());
   EXPECT_TRUE(objective.confirm_stable(held));
-  EXPECT_EQ(held.statics.status, StaticsStatus::Converged);
+  EXPECT_EQ(held.statics().status, StaticsStatus::Converged);
   // The same bar shortened 10 % along its axis, straight: ten times its Euler buckling strain,
-  // so bending has negative stiffness there.
-  Evaluation squeezed = held;
+  // so bending has negative stiffness there. Solved by an object whose force tolerance passes
+  // any state, so that the state is a converged one (its own: the mark goes into the state).
+  Positions x = held.positions();
   const Vec3 centre = scene.T_world_object.translation();
   const Vec3 axis = scene.T_world_object.linear().col(0);
   for (int i = 0; i < object.node_count(); ++i) {
-    const Vec3 p = squeezed.positions.segment<3>(3 * i);
-    squeezed.positions.segment<3>(3 * i) = p - 0.1 * axis.dot(p - centre) * axis;
+    const Vec3 p = x.segment<3>(3 * i);
+    x.segment<3>(3 * i) = p - 0.1 * axis.dot(p - centre) * axis;
   }
-  squeezed.state =
-      std::make_shared<ObjectState>(object.make_state(held.joints, squeezed.positions));
-  EXPECT_FALSE(objective.confirm_stable(squeezed));
-  EXPECT_EQ(squeezed.statics.status, StaticsStatus::Unstable);
+  Scene loose_scene = scene;
+  loose_scene.statics.relative_tolerance = 1e12;
+  GrippedObject loose(loose_scene);
+  ReducedObjective loose_objective(loose);
+  Evaluation squeezed = loose_objective.evaluate(held.joints(), x);
+  ASSERT_TRUE(squeezed.statics().converged());
+  ASSERT_EQ(squeezed.statics().iterations, 0);
+  EXPECT_FALSE(loose_objective.confirm_stable(squeezed));
+  EXPECT_EQ(squeezed.statics().status, StaticsStatus::Unstable);
+  EXPECT_EQ(squeezed.state->statics().status, StaticsStatus::Unstable);
   EXPECT_FALSE(std::isfinite(squeezed.objective));
   EXPECT_FALSE(squeezed.safe());
+  // A copy reads the same state, mark included; `held` has a state of its own.
+  const Evaluation copy = squeezed;
+  EXPECT_EQ(copy.statics().status, StaticsStatus::Unstable);
+  EXPECT_EQ(held.statics().status, StaticsStatus::Converged);
 }
 
 TEST(ReducedObjective, AbsurdTargetsAreRefusedNamingTheTargetAndChangeNothing) {

@@ -15,6 +15,10 @@
 namespace shapectl {
 namespace {
 
+// A new evaluation for find_shortfalls, which may factor its state (it lives to the end of
+// the call's full expression).
+Evaluation& fresh(Evaluation&& e) { return e; }
+
 bool has(const ShortfallReport& r, Shortfall s) {
   return std::find(r.reasons.begin(), r.reasons.end(), s) != r.reasons.end();
 }
@@ -48,9 +52,9 @@ TEST(Shortfall, JointAtItsLimitThatTheTargetsPushFurther) {
   // The targets: the shape with l3 bent past its limit.
   const Evaluation goal =
       probe.evaluate(joints(0, -0.3, 1.2, 0, -0.3, 0.9), object.reference_positions());
-  ASSERT_TRUE(goal.statics.converged());
-  const ReducedObjective objective = probe.with_targets(targets_at(goal.positions));
-  const Evaluation at = objective.evaluate(object.reference_joints(), object.reference_positions());
+  ASSERT_TRUE(goal.statics().converged());
+  const ReducedObjective objective = probe.with_targets(targets_at(goal.positions()));
+  Evaluation at = objective.evaluate(object.reference_joints(), object.reference_positions());
   const ShortfallReport r = find_shortfalls(objective, at);
   EXPECT_TRUE(has(r, Shortfall::JointLimit)) << r.detail;
   EXPECT_NE(r.detail.find("l3 "), std::string::npos) << r.detail;
@@ -60,9 +64,9 @@ TEST(Shortfall, JointAtItsLimitThatTheTargetsPushFurther) {
   // Targets that pull l3 back from the limit: no joint-limit reason.
   const Evaluation back =
       probe.evaluate(joints(0, -0.3, 0.6, 0, -0.3, 0.9), object.reference_positions());
-  const ReducedObjective away = probe.with_targets(targets_at(back.positions));
-  EXPECT_FALSE(
-      has(find_shortfalls(away, away.evaluate(at.joints, at.positions)), Shortfall::JointLimit));
+  const ReducedObjective away = probe.with_targets(targets_at(back.positions()));
+  EXPECT_FALSE(has(find_shortfalls(away, fresh(away.evaluate(at.joints(), at.positions()))),
+                   Shortfall::JointLimit));
 }
 
 TEST(Shortfall, SpheresWithinTheMarginThatTheTargetsPushTogether) {
@@ -72,17 +76,18 @@ TEST(Shortfall, SpheresWithinTheMarginThatTheTargetsPushTogether) {
   const ReducedObjective probe(object);
   const Evaluation at = probe.evaluate(object.reference_joints(), object.reference_positions());
   // The targets: the shape with the arms swung towards each other.
-  const Evaluation goal = probe.evaluate(test::arms_swung_in(0.01), at.positions, 0, &at);
-  ASSERT_TRUE(at.statics.converged() && goal.statics.converged());
-  const ReducedObjective objective = probe.with_targets(targets_at(goal.positions));
-  const ShortfallReport r = find_shortfalls(objective, objective.evaluate(at.joints, at.positions));
+  const Evaluation goal = probe.evaluate(test::arms_swung_in(0.01), at.positions(), 0, &at);
+  ASSERT_TRUE(at.statics().converged() && goal.statics().converged());
+  const ReducedObjective objective = probe.with_targets(targets_at(goal.positions()));
+  const ShortfallReport r =
+      find_shortfalls(objective, fresh(objective.evaluate(at.joints(), at.positions())));
   EXPECT_TRUE(has(r, Shortfall::Collision)) << r.detail;
   EXPECT_NE(r.detail.find("l_link3–r_link3 clearance 4.0 mm"), std::string::npos) << r.detail;
   EXPECT_FALSE(has(r, Shortfall::JointLimit)) << r.detail;
   // Targets that swing the arms apart: no collision reason.
-  const Evaluation apart = probe.evaluate(test::arms_swung_in(-0.01), at.positions, 0, &at);
-  const ReducedObjective opening = probe.with_targets(targets_at(apart.positions));
-  EXPECT_FALSE(has(find_shortfalls(opening, opening.evaluate(at.joints, at.positions)),
+  const Evaluation apart = probe.evaluate(test::arms_swung_in(-0.01), at.positions(), 0, &at);
+  const ReducedObjective opening = probe.with_targets(targets_at(apart.positions()));
+  EXPECT_FALSE(has(find_shortfalls(opening, fresh(opening.evaluate(at.joints(), at.positions()))),
                    Shortfall::Collision));
 }
 
@@ -93,16 +98,17 @@ TEST(Shortfall, ArmsStretchedTowardsTargetsBeyondTheirReach) {
   // Both arms straight up (their full 0.55 m), the targets 20 cm above the bar held there.
   const Evaluation up =
       probe.evaluate(joints(0, -M_PI / 2, 0, 0, -M_PI / 2, 0), object.reference_positions());
-  ASSERT_TRUE(up.statics.converged()) << up.statics.reason;
-  const ReducedObjective objective = probe.with_targets(targets_at(up.positions, {0, 0, 0.2}));
-  const ShortfallReport r = find_shortfalls(objective, objective.evaluate(up.joints, up.positions));
+  ASSERT_TRUE(up.statics().converged()) << up.statics().reason;
+  const ReducedObjective objective = probe.with_targets(targets_at(up.positions(), {0, 0, 0.2}));
+  const ShortfallReport r =
+      find_shortfalls(objective, fresh(objective.evaluate(up.joints(), up.positions())));
   EXPECT_TRUE(has(r, Shortfall::Reach)) << r.detail;
   EXPECT_NE(r.detail.find("left arm stretched to 100 %"), std::string::npos) << r.detail;
   EXPECT_FALSE(has(r, Shortfall::JointLimit)) << r.detail;
   // At the reference the arms are bent: the same targets are no question of reach there.
   const ShortfallReport bent =
-      find_shortfalls(objective,
-                      objective.evaluate(object.reference_joints(), object.reference_positions()));
+      find_shortfalls(objective, fresh(objective.evaluate(object.reference_joints(),
+                                                          object.reference_positions())));
   EXPECT_FALSE(has(bent, Shortfall::Reach)) << bent.detail;
 }
 
@@ -114,8 +120,8 @@ TEST(Shortfall, NoneOfTheFourIsALocalMinimumSaidAsSuch) {
   const ReducedObjective objective =
       probe.with_targets(targets_at(object.reference_positions(), {0, 0, -0.05}));
   const ShortfallReport r =
-      find_shortfalls(objective,
-                      objective.evaluate(object.reference_joints(), object.reference_positions()));
+      find_shortfalls(objective, fresh(objective.evaluate(object.reference_joints(),
+                                                          object.reference_positions())));
   EXPECT_TRUE(r.reasons.empty()) << r.detail;
   EXPECT_NE(r.detail.find("local minimum"), std::string::npos);
 }

@@ -67,6 +67,7 @@ class CalibrationProblem {
         space_(space),
         options_(options),
         stop_(std::move(stop)),
+        workspaces_(options.workspaces ? options.workspaces : WorkspacePool::create()),
         surface_(scene.object_mesh->surface_triangles()) {}
 
   // The fit at p. Equilibria start from `warm`'s (see frame_equilibria). New cut-offs are
@@ -77,7 +78,8 @@ class CalibrationProblem {
     out.equilibria = frame_equilibria(scene_, space_, p, observations_, warm,
                                       {.with_sensitivity = with_jacobian,
                                        .path_step = options_.path_step,
-                                       .stop = stop_});
+                                       .stop = stop_,
+                                       .workspaces = workspaces_});
     const Equilibrium* surface_at = nullptr;  // frames of a fixed scene share one equilibrium
     for (std::size_t k = 0; k < observations_.frames.size(); ++k) {
       const ObservationFrame& frame = observations_.frames[k];
@@ -97,6 +99,7 @@ class CalibrationProblem {
   const ParameterSpace& space_;
   const CalibrationOptions& options_;
   StopRequest stop_;
+  std::shared_ptr<WorkspacePool> workspaces_;
   SurfaceDistance surface_;
 };
 

@@ -14,6 +14,7 @@
 // the shape depends on stiffness and density through their ratio alone: asked for both, the
 // fit holds density and fits Young's modulus.
 #include <atomic>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,10 @@ struct CalibrationOptions {
   // Set from another thread to stop the fit the same way (OnlineCalibration::cancel); may be
   // null.
   const std::atomic<bool>* cancel = nullptr;
+  // The statics workspaces of the fit's equilibria (null: a pool of the fit's own). Every
+  // trial's model is new, its states' workspaces are not: one symbolic analysis per pattern.
+  // OnlineCalibration passes one pool to all its fits.
+  std::shared_ptr<WorkspacePool> workspaces = nullptr;
 };
 
 struct FittedParameter {

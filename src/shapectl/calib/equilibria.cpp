@@ -17,11 +17,13 @@ ObjectState robot_equilibrium(const GrippedObject& object, const Eigen::VectorXd
   if (options.stop && options.stop())
     throw std::runtime_error("frame " + std::to_string(frame) + ": stopped");
   if (warm) {
-    ObjectState state = object.solve_from(joints, *warm, 0, nullptr, options.stop);
+    ObjectState state =
+        object.solve_from(joints, *warm, 0, nullptr, options.stop, options.workspaces);
     if (state.statics().converged() && object.stable(state)) return state;
   }
   try {
-    return equilibrium_along_path(object, joints, options.path_step, options.stop);
+    return equilibrium_along_path(object, joints, options.path_step, options.stop,
+                                  options.workspaces);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error("frame " + std::to_string(frame) + ": " + e.what());
   }
@@ -61,7 +63,10 @@ Equilibria fixed_equilibria(const Scene& scene, const ParameterSpace& space,
                             const Equilibria* warm, const EquilibriumOptions& options) {
   const Scene placed = parameters.applied_to(scene);
   const ObjectStatics statics(placed);
-  StaticsWorkspace ws = statics.make_workspace();
+  const auto pooled = options.workspaces
+                          ? options.workspaces->acquire(statics.solver())
+                          : std::make_shared<StaticsWorkspace>(statics.make_workspace());
+  StaticsWorkspace& ws = *pooled;
   Positions x;
   StaticsResult r;
   if (warm) {

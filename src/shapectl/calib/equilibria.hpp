@@ -34,6 +34,9 @@ struct EquilibriumOptions {
   // Asked between frames and Newton iterations (may be empty); true ends the search with
   // std::runtime_error (a calibration's time budget or its cancel).
   StopRequest stop = {};
+  // Where the equilibria take their statics workspaces (null: their own): one pool for every
+  // trial of a calibration keeps one symbolic analysis per pattern, not one per trial.
+  std::shared_ptr<WorkspacePool> workspaces = nullptr;
 };
 
 // Newton starts from `warm` (the frames' equilibria at nearby parameters) when given. Throws

@@ -14,7 +14,7 @@ ObjectState step_to(const GrippedObject& object, const ObjectState& from, const 
                     int depth, const StopRequest& stop) {
   Positions carried = from.positions();
   object.carry_gripped_nodes(from.joints(), to, from.positions(), carried);
-  ObjectState state = object.solve_from(to, carried, 0, nullptr, stop);
+  ObjectState state = object.solve_from(to, carried, 0, nullptr, stop, from.workspaces());
   if (state.statics().converged() || depth == 0 || (stop && stop())) return state;
   ObjectState halfway = step_to(object, from, (from.joints() + to) / 2, depth - 1, stop);
   if (!halfway.statics().converged()) return halfway;
@@ -23,7 +23,8 @@ ObjectState step_to(const GrippedObject& object, const ObjectState& from, const 
 }  // namespace
 
 ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::VectorXd& joints,
-                                   double max_step, const StopRequest& stop) {
+                                   double max_step, const StopRequest& stop,
+                                   std::shared_ptr<WorkspacePool> workspaces) {
   const Eigen::VectorXd& start = object.reference_joints();
   const double distance = (joints - start).cwiseAbs().maxCoeff();
   // Compared before rounding: a huge or non-finite distance must not overflow the count.
@@ -33,8 +34,9 @@ ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::Vec
                         std::to_string(max_joint_path_steps) + " steps of " +
                         std::to_string(max_step) + " rad");
   const int steps = std::max(1, int(std::ceil(distance / max_step)));
-  // The rest shape at θ⁰, unsolved: the first step solves from it.
-  ObjectState state = object.make_state(start, object.reference_positions());
+  // The rest shape at θ⁰, unsolved: the first step solves from it. The steps share a pool.
+  if (!workspaces) workspaces = WorkspacePool::create();
+  ObjectState state = object.make_state(start, object.reference_positions(), std::move(workspaces));
   for (int s = 1; s <= steps; ++s) {
     state = step_to(object, state, start + (joints - start) * (double(s) / steps), 4, stop);
     if (!state.statics().converged()) break;

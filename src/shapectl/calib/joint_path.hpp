@@ -23,8 +23,10 @@ class NoEquilibrium : public std::runtime_error {
 // A step where Newton does not converge is halved (up to 4 times). Throws NoEquilibrium with
 // Newton's reason when an equilibrium on the way is not found even so, or when the path needs
 // more than max_joint_path_steps steps. `stop` (may be empty) ends Newton early: the walk then
-// throws with Newton's "stopped" reason.
+// throws with Newton's "stopped" reason. The states on the way take their workspaces from
+// `workspaces` (null: a pool of the walk's own).
 ObjectState equilibrium_along_path(const GrippedObject& object, const Eigen::VectorXd& joints,
-                                   double max_step = 0.05, const StopRequest& stop = {});
+                                   double max_step = 0.05, const StopRequest& stop = {},
+                                   std::shared_ptr<WorkspacePool> workspaces = nullptr);
 
 }  // namespace shapectl

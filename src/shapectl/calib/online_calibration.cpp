@@ -76,6 +76,8 @@ OnlineCalibration::OnlineCalibration(Controller& controller, const Scene& model,
       period_(options.period) {
   status_.automatic = options_.automatic;
   options_.calibration.cancel = &cancel_;
+  // Fits of one object: their equilibria keep the symbolic analyses from fit to fit.
+  if (!options_.calibration.workspaces) options_.calibration.workspaces = WorkspacePool::create();
 }
 
 OnlineCalibration::~OnlineCalibration() {

@@ -18,7 +18,8 @@ SimulatedWorld::SimulatedWorld(const Scene& world, const Scene& model, Simulated
     throw std::invalid_argument("the world's robot must have the model's active joints");
   if (!(rate > 0 && std::isfinite(rate)))
     throw std::invalid_argument("the camera rate must be positive");
-  state_.emplace(equilibrium_along_path(object_, object_.reference_joints()));
+  state_.emplace(
+      equilibrium_along_path(object_, object_.reference_joints(), 0.05, {}, workspaces_));
 }
 
 std::optional<ObservationFrame> SimulatedWorld::step(double time,
@@ -26,8 +27,10 @@ std::optional<ObservationFrame> SimulatedWorld::step(double time,
   // A robot standing still leaves the world as it is: no solve (it shares the cores with the
   // controller it is testing).
   if (measured_joints != state_->joints()) {
-    ObjectState next = object_.solve_from(measured_joints, state_->positions());
-    if (!next.statics().converged()) next = equilibrium_along_path(object_, measured_joints);
+    ObjectState next =
+        object_.solve_from(measured_joints, state_->positions(), 0, nullptr, {}, workspaces_);
+    if (!next.statics().converged())
+      next = equilibrium_along_path(object_, measured_joints, 0.05, {}, workspaces_);
     state_.emplace(std::move(next));
   }
   if (time < next_time_) return std::nullopt;

@@ -31,6 +31,7 @@ class SimulatedWorld {
 
  private:
   GrippedObject object_;
+  std::shared_ptr<WorkspacePool> workspaces_ = WorkspacePool::create();
   SimulatedCamera camera_;
   double period_;
   double next_time_ = 0;

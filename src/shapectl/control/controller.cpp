@@ -71,7 +71,7 @@ bool parse(std::string_view name, ControllerStatus* status) {
 }
 
 ControllerStatus stopped_status(const Evaluation& best, bool failed, double tolerance) {
-  if (failed || !best.statics.converged()) return ControllerStatus::Failed;
+  if (failed || !best.statics().converged()) return ControllerStatus::Failed;
   return best.error.max <= tolerance ? ControllerStatus::Reached : ControllerStatus::BestEffort;
 }
 
@@ -220,7 +220,7 @@ void Controller::State::apply(Inbox in) {
     // Checked when posted; a target the mapping still puts out of bounds (a sketch at the edge
     // of the world, the bar's offset beyond it) is refused here, not thrown out of the thread.
     try {
-      retarget(centerline_targets(object->mesh(), *bar_axis, *in.centerline, current.positions));
+      retarget(centerline_targets(object->mesh(), *bar_axis, *in.centerline, current.positions()));
       centerline = *in.centerline;
     } catch (const InputError& e) {
       retarget({});
@@ -236,14 +236,14 @@ void Controller::State::apply(Inbox in) {
     jog_refused_links.clear();
     const Eigen::VectorXd theta =
         in.jog->cwiseMax(object->robot().lower_limits()).cwiseMin(object->robot().upper_limits());
-    Evaluation e = objective->evaluate(theta, current.positions, 0, &current);
+    Evaluation e = objective->evaluate(theta, current.positions(), 0, &current);
     if (objective->confirm_stable(e)) {
       current = std::move(e);
       last_error.clear();
     } else {
-      last_error = "jog refused: statics " + e.statics.reason;
+      last_error = "jog refused: statics " + e.statics().reason;
       std::lock_guard lock(inbox_mutex);
-      if (jogged_to && *jogged_to == theta) jogged_to = current.joints;  // stayed here
+      if (jogged_to && *jogged_to == theta) jogged_to = current.joints();  // stayed here
     }
   }
   if (in.jog_refused_links) jog_refused_links = *in.jog_refused_links;  // after the jog before it
@@ -263,21 +263,24 @@ void Controller::State::apply(Inbox in) {
 
 bool Controller::State::replace_model(const Scene& model) {
   auto next_object = std::make_shared<const GrippedObject>(model);
+  // The same pool: the new model's states (same mesh, fixed nodes and grips) keep the
+  // symbolic analyses.
   auto next_objective =
-      std::make_unique<ReducedObjective>(*next_object, objective->targets(), objective->options());
+      std::make_unique<ReducedObjective>(*next_object, objective->targets(), objective->options(),
+                                         objective->workspaces());
   // No chord steps from the old model's factorization: it belongs to another Hessian.
-  Evaluation next = next_objective->evaluate(current.joints, current.positions);
-  if (!next.statics.converged() || !next_objective->confirm_stable(next)) {
+  Evaluation next = next_objective->evaluate(current.joints(), current.positions());
+  if (!next.statics().converged() || !next_objective->confirm_stable(next)) {
     last_error = "model update refused: no stable equilibrium at the current joints (" +
-                 next.statics.reason + ")";
+                 next.statics().reason + ")";
     return false;
   }
   if (last_observation) {
     const Eigen::VectorXd& joints = last_observation->joints;
-    const Evaluation before = objective->evaluate(joints, current.positions, 0, &current);
-    const Evaluation after = next_objective->evaluate(joints, next.positions, 0, &next);
-    if (before.statics.converged() && after.statics.converged())
-      feedback->model_changed(before.positions, after.positions);
+    const Evaluation before = objective->evaluate(joints, current.positions(), 0, &current);
+    const Evaluation after = next_objective->evaluate(joints, next.positions(), 0, &next);
+    if (before.statics().converged() && after.statics().converged())
+      feedback->model_changed(before.positions(), after.positions());
   }
   current = std::move(next);
   objective = std::move(next_objective);  // before the object it refers to
@@ -291,19 +294,19 @@ bool Controller::State::replace_model(const Scene& model) {
 bool Controller::State::take(const ShapeObservation& observation) {
   // The model's prediction at the joints the observation was taken at (the robot may lag θ*),
   // from the current shape with the gripped nodes carried along.
-  Positions x = current.positions;
-  object->carry_gripped_nodes(current.joints, observation.joints, current.positions, x);
+  Positions x = current.positions();
+  object->carry_gripped_nodes(current.joints(), observation.joints, current.positions(), x);
   Evaluation predicted = objective->evaluate(observation.joints, x, 0, &current);
-  if (!predicted.statics.converged()) {
+  if (!predicted.statics().converged()) {
     // Not the optimizer's failure: the loop goes on with the next observation.
     ++observations_ignored;
     observation_problem =
-        "observation ignored: no equilibrium at its joints (" + predicted.statics.reason + ")";
+        "observation ignored: no equilibrium at its joints (" + predicted.statics().reason + ")";
     return false;
   }
   const double now = std::chrono::duration<double>(Clock::now() - started).count();
   const GateVerdict gate =
-      feedback->observe(observation.markers, predicted.positions, observation.sigma, now);
+      feedback->observe(observation.markers, predicted.positions(), observation.sigma, now);
   observation_problem = gate.reason.empty() ? "" : "observation gated: " + gate.reason;
   if (gate.frame_rejected) return false;
   // What the loop shows and judges by: the markers the gate let through.
@@ -395,11 +398,11 @@ void Controller::State::publish() {
   const RobotModel& robot = object->robot();
   s->time = std::chrono::duration<double>(Clock::now() - started).count();
   s->joint_names = robot.active_joint_names();
-  s->joints = current.joints;
+  s->joints = current.joints();
   s->lower_limits = robot.lower_limits();
   s->upper_limits = robot.upper_limits();
-  s->T_world_link = forward_kinematics(robot, current.joints).T_world_link;
-  s->positions = current.positions;
+  s->T_world_link = forward_kinematics(robot, current.joints()).T_world_link;
+  s->positions = current.positions();
   s->targets = user_targets;
   s->centerline = centerline;
   s->error = current.error;
@@ -550,9 +553,24 @@ void Controller::set_joints(const Eigen::VectorXd& joints) {
                      "one value per active joint (" +
                          std::to_string(state_->loaded->joint_count()) + ")");
   if (!joints.allFinite()) throw InputError("joints", "", "finite values");
+  jog([&](const Eigen::VectorXd&) { return joints; });
+}
+
+void Controller::set_joint(int joint, double value) {
+  const int count = state_->loaded->joint_count();
+  if (joint < 0 || joint >= count)
+    throw InputError("joint", "",
+                     "an active joint's index (0 to " + std::to_string(count - 1) + ")", joint);
+  if (!std::isfinite(value)) throw InputError("value", "", "a finite number");
+  jog([&](const Eigen::VectorXd& from) {
+    Eigen::VectorXd joints = from;
+    joints[joint] = value;
+    return joints;
+  });
+}
+
+void Controller::jog(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& joints_from) {
   const RobotModel& robot = state_->loaded->robot();
-  const Eigen::VectorXd theta =
-      joints.cwiseMax(robot.lower_limits()).cwiseMin(robot.upper_limits());
   std::string refusal;
   {
     std::lock_guard lock(state_->inbox_mutex);
@@ -560,6 +578,8 @@ void Controller::set_joints(const Eigen::VectorXd& joints) {
     if (!state_->pause_requested)
       throw InputError("joints", "", "the optimizer to be paused before jogging");
     const Eigen::VectorXd& from = state_->jogged_to ? *state_->jogged_to : now->joints;
+    const Eigen::VectorXd theta =
+        joints_from(from).cwiseMax(robot.lower_limits()).cwiseMin(robot.upper_limits());
     std::vector<int> links;
     refusal = state_->jog_collision(from, theta, links);
     if (refusal.empty()) {

@@ -5,6 +5,7 @@
 // robot link and the logger read without ever touching the state.
 #include <condition_variable>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -144,6 +145,10 @@ class Controller {
   // current joints (or the last jog still pending), or when it would make spheres overlap
   // that do not already (the message names the two links).
   void set_joints(const Eigen::VectorXd& joints);
+  // A jog of one joint (an active joint's index): the others stay at the last jog still
+  // pending, else at the current joints; judged as set_joints. Quick jogs of two joints from
+  // several threads or clients do not undo each other: the jog race is guarded here alone.
+  void set_joint(int joint, double value);
   void reset();  // reference joints and shape, targets cleared
   // The closed loop: each observation updates the model-error estimate (control/
   // model_error_feedback.hpp); with feedback on, the optimizer aims at the corrected targets
@@ -166,6 +171,10 @@ class Controller {
   struct State;  // the worker's state (controller.cpp)
 
  private:
+  // The jog to joints_from(the last jog still pending, else the current joints), judged and
+  // queued under the inbox's lock (see set_joints).
+  void jog(const std::function<Eigen::VectorXd(const Eigen::VectorXd&)>& joints_from);
+
   std::unique_ptr<State> state_;
 };
 

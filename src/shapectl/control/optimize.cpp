@@ -56,7 +56,7 @@ OptimizeResult optimize(const ReducedObjective& objective, Optimizer& optimizer,
     result.history.push_back({it, elapsed(), result.best.error.mean, result.best.objective});
     if (outcome == StepOutcome::Converged) {
       const bool converged =
-          result.best.statics.converged() && std::isfinite(result.best.objective);
+          result.best.statics().converged() && std::isfinite(result.best.objective);
       result.termination = converged ? Termination::Converged : Termination::Failed;
       result.reason = converged ? "stationary after " + std::to_string(it) + " iterations"
                                 : "stopped after " + std::to_string(it) +

@@ -34,7 +34,7 @@ namespace {
 // A trial may replace the current state if it is at least as safe and strictly better (a
 // non-finite objective is neither).
 bool acceptable(const Evaluation& trial, const Evaluation& current, double required_objective) {
-  if (!trial.statics.converged() || !std::isfinite(trial.objective)) return false;
+  if (!trial.statics().converged() || !std::isfinite(trial.objective)) return false;
   if (current.safe() && !trial.safe()) return false;
   return trial.objective < required_objective;
 }
@@ -53,9 +53,9 @@ Evaluation evaluate_predicted(const ReducedObjective& objective, const Eigen::Ve
   // rejected (and the step shortened) than solved at length.
   constexpr int kTrialNewtonLimit = 25;
   Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit, &from, out_of_time);
-  if (e.statics.status == StaticsStatus::Inverted && e.statics.iterations == 0 &&
+  if (e.statics().status == StaticsStatus::Inverted && e.statics().iterations == 0 &&
       !(out_of_time && out_of_time()))
-    e = objective.evaluate(joints, from.positions, kTrialNewtonLimit, &from,
+    e = objective.evaluate(joints, from.positions(), kTrialNewtonLimit, &from,
                            out_of_time);  // the prediction itself inverted
   return e;
 }
@@ -63,7 +63,7 @@ Evaluation evaluate_predicted(const ReducedObjective& objective, const Eigen::Ve
 StepOutcome GaussNewton::step(const ReducedObjective& objective, Evaluation& current) {
   // At an equilibrium whose objective overflowed (or is NaN) no trial can be "better" and the
   // derivatives are meaningless. (An unconverged state scores +inf by design: steps may leave it.)
-  if (current.statics.converged() && !std::isfinite(current.objective)) return StepOutcome::Stuck;
+  if (current.statics().converged() && !std::isfinite(current.objective)) return StepOutcome::Stuck;
   if (budget_spent()) return StepOutcome::OutOfTime;
   Eigen::VectorXd r;
   Eigen::MatrixXd J, dx;
@@ -86,11 +86,12 @@ StepOutcome GaussNewton::step(const ReducedObjective& objective, Evaluation& cur
     if (!std::isfinite(largest)) return StepOutcome::Stuck;
     if (largest < 1e-12) return StepOutcome::Converged;
     if (largest > max_step) delta *= max_step / largest;
-    const Eigen::VectorXd theta = current.joints + delta;
+    const Eigen::VectorXd theta = current.joints() + delta;
     // First-order prediction of the new equilibrium with its rotation made finite (a linear
     // one stretches the object), the gripped nodes carried exactly.
-    Positions predicted_x = with_finite_rotation(current.positions, dx * delta);
-    objective.object().carry_gripped_nodes(current.joints, theta, current.positions, predicted_x);
+    Positions predicted_x = with_finite_rotation(current.positions(), dx * delta);
+    objective.object().carry_gripped_nodes(current.joints(), theta, current.positions(),
+                                           predicted_x);
     Evaluation trial = evaluate_predicted(objective, theta, current, predicted_x, out_of_time);
     const double predicted = current.objective - 0.5 * (r + J * delta).squaredNorm();
     if (acceptable(trial, current, current.objective) && objective.confirm_stable(trial)) {
@@ -114,12 +115,12 @@ void Lbfgs::reset() {
 }
 
 StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) {
-  if (current.statics.converged() && !std::isfinite(current.objective))
+  if (current.statics().converged() && !std::isfinite(current.objective))
     return StepOutcome::Stuck;  // as in GaussNewton
-  if (gradient_.size() == 0 || gradient_at_ != current.joints) {
+  if (gradient_.size() == 0 || gradient_at_ != current.joints()) {
     if (budget_spent()) return StepOutcome::OutOfTime;
     gradient_ = objective.gradient(current, method_);
-    gradient_at_ = current.joints;
+    gradient_at_ = current.joints();
   }
   // A copy: the accepted step below replaces gradient_.
   const Eigen::VectorXd g = gradient_;
@@ -154,14 +155,14 @@ StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) 
   double t = 1.0;
   for (int k = 0; k < 16; ++k, t *= 0.5) {
     if (budget_spent()) return StepOutcome::OutOfTime;
-    const Eigen::VectorXd theta = current.joints + t * d;
+    const Eigen::VectorXd theta = current.joints() + t * d;
     // Warm start from the current shape: carrying the gripped nodes alone (without dx̂/dθ·Δθ
     // for the rest) measured no faster for these short steps.
-    Evaluation trial = objective.evaluate(theta, current.positions, 25, &current, out_of_time);
+    Evaluation trial = objective.evaluate(theta, current.positions(), 25, &current, out_of_time);
     if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
     if (!objective.confirm_stable(trial)) continue;
     const bool tiny = negligible(current.objective, trial.objective);
-    const Eigen::VectorXd s = trial.joints - current.joints;
+    const Eigen::VectorXd s = trial.joints() - current.joints();
     current = trial;
     // Out of time: keep the better state; its gradient is computed when (if) a next step comes.
     if (budget_spent()) return tiny ? StepOutcome::Converged : StepOutcome::Improved;
@@ -176,7 +177,7 @@ StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) 
       }
     }
     gradient_ = g_new;
-    gradient_at_ = current.joints;
+    gradient_at_ = current.joints();
     return tiny ? StepOutcome::Converged : StepOutcome::Improved;
   }
   if (s_.empty()) return StepOutcome::Stuck;

@@ -25,15 +25,26 @@ bool parse(std::string_view name, GradientMethod* method) {
 
 std::vector<std::string> gradient_names() { return kGradientMethods.names(); }
 
+namespace {
+const Eigen::VectorXd kNoJoints;
+const StaticsResult kNotSolved;
+}  // namespace
+
+const Eigen::VectorXd& Evaluation::joints() const { return state ? state->joints() : kNoJoints; }
+const Positions& Evaluation::positions() const { return state ? state->positions() : kNoJoints; }
+const StaticsResult& Evaluation::statics() const { return state ? state->statics() : kNotSolved; }
+
 ReducedObjective::ReducedObjective(const GrippedObject& object, ShapeTargets targets,
-                                   ObjectiveOptions options)
+                                   ObjectiveOptions options,
+                                   std::shared_ptr<WorkspacePool> workspaces)
     : object_(&object),
       targets_(std::move(targets)),
       options_(options),
       limits_(object.robot(), object.scene().robot->joint_limit_margin,
               object.scene().robot->joint_limit_stiffness),
       weights_(object.scene().weights),
-      counters_(std::make_shared<TimingCounters>()) {
+      counters_(std::make_shared<TimingCounters>()),
+      workspaces_(workspaces ? std::move(workspaces) : WorkspacePool::create()) {
   check_targets(targets_, object.node_count(), "targets");
   if (object.scene().robot->collisions) collisions_ = *object.scene().robot->collisions;
 }
@@ -63,13 +74,13 @@ void ReducedObjective::count_gradient(double seconds) const {
 }
 
 void ReducedObjective::score(Evaluation& e) const {
-  e.error = shape_error(targets_, e.positions);
+  e.error = shape_error(targets_, e.positions());
   double sum = 0;
   for (int k = 0; k < targets_.size(); ++k)
-    sum += (e.positions.segment<3>(3 * targets_.nodes[k]) - targets_.positions[k]).squaredNorm();
+    sum += (e.positions().segment<3>(3 * targets_.nodes[k]) - targets_.positions[k]).squaredNorm();
   e.shape = weights_.shape * 0.5 * sum;
-  e.objective = e.statics.converged() ? e.shape + e.collision + e.joint_limits
-                                      : std::numeric_limits<double>::infinity();
+  e.objective = e.statics().converged() ? e.shape + e.collision + e.joint_limits
+                                        : std::numeric_limits<double>::infinity();
 }
 
 void ReducedObjective::rescore(Evaluation& e) const { score(e); }
@@ -77,15 +88,12 @@ void ReducedObjective::rescore(Evaluation& e) const { score(e); }
 Evaluation ReducedObjective::describe(ObjectState state) const {
   Evaluation e;
   e.state = std::make_shared<ObjectState>(std::move(state));
-  e.joints = e.state->joints();
-  e.positions = e.state->positions();
-  e.statics = e.state->statics();
   const KinematicsState& kinematics = e.state->kinematics();
   if (collisions_) {
     e.min_clearance = collisions_->min_clearance(kinematics);
     e.collision = weights_.collision * collisions_->value(object_->robot(), kinematics);
   }
-  e.joint_limits = weights_.joint_limits * limits_.value(e.joints);
+  e.joint_limits = weights_.joint_limits * limits_.value(e.joints());
   e.within_limits = limit_violations(object_->robot(), kinematics.joints).empty();
   score(e);
   return e;
@@ -96,35 +104,33 @@ Evaluation ReducedObjective::evaluate(const Eigen::VectorXd& joints, const Posit
                                       const StopRequest& stop) const {
   const auto t0 = Clock::now();
   const ObjectState* chord = from && options_.chord_steps ? from->state.get() : nullptr;
-  ObjectState state = object_->solve_from(joints, x, max_newton, chord, stop);
+  ObjectState state = object_->solve_from(joints, x, max_newton, chord, stop, workspaces_);
   count_statics(seconds_since(t0));
   return describe(std::move(state));
 }
 
 bool ReducedObjective::confirm_stable(Evaluation& e) const {
-  if (!e.statics.converged()) return false;
-  if (object_->stable(*e.state, options_.stale_factor_step)) return true;
-  e.statics.status = StaticsStatus::Unstable;
-  e.statics.reason = "unstable equilibrium: the Hessian there is not positive definite";
+  if (!e.statics().converged()) return false;
+  if (object_->confirm_stable(*e.state, options_.stale_factor_step)) return true;
   score(e);
   return false;
 }
 
 Eigen::VectorXd ReducedObjective::shape_gradient_x(const Evaluation& at) const {
-  Eigen::VectorXd g = Eigen::VectorXd::Zero(at.positions.size());
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(at.positions().size());
   for (int k = 0; k < targets_.size(); ++k) {
     const int i = targets_.nodes[k];
     g.segment<3>(3 * i) +=
-        weights_.shape * (at.positions.segment<3>(3 * i) - targets_.positions[k]);
+        weights_.shape * (at.positions().segment<3>(3 * i) - targets_.positions[k]);
   }
   return g;
 }
 
-Eigen::MatrixXd ReducedObjective::sensitivity(const Evaluation& at, bool allow_stale) const {
+Eigen::MatrixXd ReducedObjective::sensitivity(Evaluation& at, bool allow_stale) const {
   return object_->sensitivity(*at.state, allow_stale ? options_.stale_factor_step : 0.0);
 }
 
-Eigen::VectorXd ReducedObjective::gradient(const Evaluation& at, GradientMethod method) const {
+Eigen::VectorXd ReducedObjective::gradient(Evaluation& at, GradientMethod method) const {
   const auto t0 = Clock::now();
   Eigen::VectorXd g(joint_count());
   if (method == GradientMethod::FiniteDifference) {
@@ -132,10 +138,11 @@ Eigen::VectorXd ReducedObjective::gradient(const Evaluation& at, GradientMethod 
     // (counted as gradient work, not statics).
     const double h = options_.finite_difference_step;
     for (int j = 0; j < joint_count(); ++j) {
-      Eigen::VectorXd theta = at.joints;
+      Eigen::VectorXd theta = at.joints();
       theta[j] += h;
       const ObjectState* chord = options_.chord_steps ? at.state.get() : nullptr;
-      const Evaluation e = describe(object_->solve_from(theta, at.positions, 0, chord));
+      const Evaluation e =
+          describe(object_->solve_from(theta, at.positions(), 0, chord, {}, workspaces_));
       g[j] = (e.objective - at.objective) / h;
     }
   } else {
@@ -149,14 +156,14 @@ Eigen::VectorXd ReducedObjective::gradient(const Evaluation& at, GradientMethod 
       collisions_->value(object_->robot(), state, &barrier);
       g += weights_.collision * barrier;
     }
-    limits_.value(at.joints, &barrier);
+    limits_.value(at.joints(), &barrier);
     g += weights_.joint_limits * barrier;
   }
   count_gradient(seconds_since(t0));
   return g;
 }
 
-void ReducedObjective::least_squares(const Evaluation& at, Eigen::VectorXd& r, Eigen::MatrixXd& J,
+void ReducedObjective::least_squares(Evaluation& at, Eigen::VectorXd& r, Eigen::MatrixXd& J,
                                      Eigen::MatrixXd* dx_dtheta) const {
   const auto t0 = Clock::now();
   const Eigen::MatrixXd dx = sensitivity(at, true);
@@ -165,14 +172,14 @@ void ReducedObjective::least_squares(const Evaluation& at, Eigen::VectorXd& r, E
   Eigen::VectorXd r_collision, r_limits;
   Eigen::MatrixXd J_collision, J_limits;
   if (collisions_) collisions_->residuals(object_->robot(), state, r_collision, &J_collision);
-  limits_.residuals(at.joints, r_limits, &J_limits);
+  limits_.residuals(at.joints(), r_limits, &J_limits);
   const int n_shape = 3 * targets_.size();
   r.resize(n_shape + r_collision.size() + r_limits.size());
   J.resize(r.size(), m);
   const double ws = std::sqrt(weights_.shape);
   for (int k = 0; k < targets_.size(); ++k) {
     const int i = targets_.nodes[k];
-    r.segment<3>(3 * k) = ws * (at.positions.segment<3>(3 * i) - targets_.positions[k]);
+    r.segment<3>(3 * k) = ws * (at.positions().segment<3>(3 * i) - targets_.positions[k]);
     J.middleRows<3>(3 * k) = ws * dx.middleRows<3>(3 * i);
   }
   const double wc = std::sqrt(weights_.collision), wl = std::sqrt(weights_.joint_limits);

@@ -24,12 +24,12 @@ const char* to_string(GradientMethod method);
 bool parse(std::string_view name, GradientMethod* method);
 std::vector<std::string> gradient_names();
 
-// Everything known about one θ. Copies share one ObjectState (the equilibrium and its
-// factorization), which the derivatives at this θ use.
+// Everything known about one θ: its solved state and the score. The state (θ, x̂(θ), the
+// statics result, the factorization the derivatives at this θ use) is not copied: copies of an
+// Evaluation share it, and the accessors read it. A default Evaluation has none and reads as
+// empty and not converged.
 struct Evaluation {
-  Eigen::VectorXd joints;
-  Positions positions;  // x̂(θ)
-  StaticsResult statics;
+  std::shared_ptr<ObjectState> state;
   double shape = 0;  // weighted terms of the objective
   double collision = 0;
   double joint_limits = 0;
@@ -37,9 +37,12 @@ struct Evaluation {
   ShapeError error;
   double min_clearance = std::numeric_limits<double>::infinity();  // m, margin not subtracted
   bool within_limits = true;                                       // hard limits, no margin
-  std::shared_ptr<ObjectState> state;
+
+  const Eigen::VectorXd& joints() const;
+  const Positions& positions() const;  // x̂(θ)
+  const StaticsResult& statics() const;
   // A configuration we may hand to a robot.
-  bool safe() const { return statics.converged() && min_clearance >= 0 && within_limits; }
+  bool safe() const { return statics().converged() && min_clearance >= 0 && within_limits; }
 };
 
 struct ObjectiveTiming {
@@ -60,15 +63,20 @@ struct ObjectiveOptions {
 };
 
 // Immutable once made (the targets too: with_targets makes a new one); every call is const and
-// takes what it works on explicitly, so threads may share one. Only the timing counters change.
+// takes what it works on explicitly, so threads may share one. Only the timing counters and the
+// workspace pool (thread-safe, state side) change.
 class ReducedObjective {
  public:
   // The object must outlive this. Throws InputError ("targets: targets[k]...", see
   // check_targets) for a node out of range or a position not finite or beyond
   // max_target_distance.
+  // `workspaces`: the pool its states take workspaces from (null: a new one); pass the pool of
+  // an objective on an earlier model of the same object to keep its symbolic analyses.
   explicit ReducedObjective(const GrippedObject& object, ShapeTargets targets = {},
-                            ObjectiveOptions options = {});
-  // The same objective with other targets (checked as above); shares the timing counters.
+                            ObjectiveOptions options = {},
+                            std::shared_ptr<WorkspacePool> workspaces = nullptr);
+  // The same objective with other targets (checked as above); shares the timing counters and
+  // the workspace pool.
   ReducedObjective with_targets(ShapeTargets targets) const;
 
   const ShapeTargets& targets() const { return targets_; }
@@ -83,19 +91,23 @@ class ReducedObjective {
   Evaluation evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton = 0,
                       const Evaluation* from = nullptr, const StopRequest& stop = {}) const;
   // True if `e` is a stable equilibrium (the Hessian there positive definite); otherwise
-  // marks it Unstable, objective +inf. Optimizers ask before accepting a state: an unstable
-  // equilibrium is no shape a robot can hold. The factorization it needs is the one the next
-  // gradient reuses, so accepted states cost nothing extra.
+  // marks its state Unstable (GrippedObject::confirm_stable), objective +inf. The
+  // factorization it needs is the one the next gradient reuses, so accepted states cost
+  // nothing extra.
   bool confirm_stable(Evaluation& e) const;
   // Scores an evaluation (e.g. made under other targets) against this objective's targets.
   void rescore(Evaluation& e) const;
+  // The derivatives below factor `at`'s state unless it holds a factorization near enough
+  // (ObjectiveOptions::stale_factor_step), hence the non-const evaluation.
   // dÔ/dθ at `at`.
-  Eigen::VectorXd gradient(const Evaluation& at, GradientMethod method) const;
+  Eigen::VectorXd gradient(Evaluation& at, GradientMethod method) const;
   // Residuals r (½|r|² = Ô) and Jacobian dr/dθ at `at`; `dx_dtheta` receives dx̂/dθ if given.
-  void least_squares(const Evaluation& at, Eigen::VectorXd& r, Eigen::MatrixXd& J,
+  void least_squares(Evaluation& at, Eigen::VectorXd& r, Eigen::MatrixXd& J,
                      Eigen::MatrixXd* dx_dtheta = nullptr) const;
   // dx̂/dθ at `at` (exact unless `allow_stale`).
-  Eigen::MatrixXd sensitivity(const Evaluation& at, bool allow_stale) const;
+  Eigen::MatrixXd sensitivity(Evaluation& at, bool allow_stale) const;
+  // The pool the states it solves take their workspaces from (shared by with_targets).
+  const std::shared_ptr<WorkspacePool>& workspaces() const { return workspaces_; }
 
   ObjectiveTiming timing() const;
 
@@ -117,6 +129,7 @@ class ReducedObjective {
   JointLimits limits_;
   ObjectiveWeights weights_;
   std::shared_ptr<TimingCounters> counters_;
+  std::shared_ptr<WorkspacePool> workspaces_;
 };
 
 }  // namespace shapectl

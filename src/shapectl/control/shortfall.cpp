@@ -32,7 +32,7 @@ std::string format(const char* pattern, double a, double b = 0) {
 }
 
 // −J_sᵀ r_s: where the targets alone pull the joints.
-Eigen::VectorXd shape_descent(const ReducedObjective& objective, const Evaluation& at) {
+Eigen::VectorXd shape_descent(const ReducedObjective& objective, Evaluation& at) {
   Eigen::VectorXd r;
   Eigen::MatrixXd J;
   objective.least_squares(at, r, J);
@@ -50,10 +50,10 @@ std::string joint_limit(const ReducedObjective& objective, const Evaluation& at,
   const double noise = 0.01 * d.cwiseAbs().maxCoeff();
   std::string out;
   for (int j = 0; j < d.size(); ++j) {
-    const bool low = at.joints[j] - lower[j] <= near && d[j] < -noise;
-    const bool high = upper[j] - at.joints[j] <= near && d[j] > noise;
+    const bool low = at.joints()[j] - lower[j] <= near && d[j] < -noise;
+    const bool high = upper[j] - at.joints()[j] <= near && d[j] > noise;
     if (!low && !high) continue;
-    const double gap = low ? at.joints[j] - lower[j] : upper[j] - at.joints[j];
+    const double gap = low ? at.joints()[j] - lower[j] : upper[j] - at.joints()[j];
     out += (out.empty() ? "" : ", ") + names[j] + format(" %.1f° from its ", gap * 180 / M_PI) +
            (low ? "lower" : "upper") + " limit";
   }
@@ -69,7 +69,7 @@ std::string collision(const ReducedObjective& objective, const Evaluation& at,
   const KinematicsState& here = at.state->kinematics();
   const double clearance = collisions->min_clearance(here);
   if (clearance > collisions->margin() + kClearanceSlack) return {};
-  const Eigen::VectorXd probe = at.joints + kCollisionProbe * d.normalized();
+  const Eigen::VectorXd probe = at.joints() + kCollisionProbe * d.normalized();
   if (collisions->min_clearance(forward_kinematics(robot, probe)) >= clearance) return {};
   const SphereClearance pair = collisions->closest_pairs(here, 1).front();
   const auto& spheres = collisions->spheres();
@@ -111,17 +111,17 @@ std::string reach(const ReducedObjective& objective, const Evaluation& at) {
 }
 
 // Whether a step along d loses the equilibrium or snaps to another one.
-std::string buckling(const ReducedObjective& objective, const Evaluation& at,
-                     const Eigen::VectorXd& d, const StopRequest& stop) {
+std::string buckling(const ReducedObjective& objective, Evaluation& at, const Eigen::VectorXd& d,
+                     const StopRequest& stop) {
   if (d.norm() == 0) return {};
   const Eigen::VectorXd step = kBucklingProbe * d.normalized();
-  Evaluation next = objective.evaluate(at.joints + step, at.positions, 0, &at, stop);
-  if (!next.statics.converged() && stop && stop()) return {};  // out of time: not judged
+  Evaluation next = objective.evaluate(at.joints() + step, at.positions(), 0, &at, stop);
+  if (!next.statics().converged() && stop && stop()) return {};  // out of time: not judged
   if (!objective.confirm_stable(next)) return "no stable equilibrium 0.02 rad further";
   const Eigen::VectorXd predicted = objective.sensitivity(at, false) * step;
   double moved = 0, expected = 0;
   for (int i : objective.targets().nodes) {
-    moved = std::max(moved, (next.positions - at.positions).segment<3>(3 * i).norm());
+    moved = std::max(moved, (next.positions() - at.positions()).segment<3>(3 * i).norm());
     expected = std::max(expected, predicted.segment<3>(3 * i).norm());
   }
   if (moved > kSnapFactor * expected + kSnapFloor)
@@ -142,10 +142,10 @@ std::vector<std::string> shortfall_names(const std::vector<Shortfall>& shortfall
   return names;
 }
 
-ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluation& at,
+ShortfallReport find_shortfalls(const ReducedObjective& objective, Evaluation& at,
                                 const StopRequest& stop) {
   ShortfallReport report;
-  if (objective.targets().empty() || !at.statics.converged()) return report;
+  if (objective.targets().empty() || !at.statics().converged()) return report;
   const Eigen::VectorXd d = shape_descent(objective, at);
   const std::pair<Shortfall, std::string> found[] = {
       {Shortfall::JointLimit, joint_limit(objective, at, d)},
@@ -163,7 +163,7 @@ ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluat
   return report;
 }
 
-ShortfallReport find_run_shortfalls(const ReducedObjective& objective, const Evaluation& best,
+ShortfallReport find_run_shortfalls(const ReducedObjective& objective, Evaluation& best,
                                     Termination termination, const StopRequest& stop) {
   ShortfallReport report = find_shortfalls(objective, best, stop);
   const bool limited =

@@ -36,11 +36,12 @@ struct ShortfallReport {
 
 // The reasons that hold at `at` (a converged equilibrium) for `objective`'s targets. `stop` (a
 // time budget) may cut the buckling probe's statics short: buckling is then not reported.
-ShortfallReport find_shortfalls(const ReducedObjective& objective, const Evaluation& at,
+// Non-const: the derivatives factor `at`'s state (ReducedObjective::least_squares).
+ShortfallReport find_shortfalls(const ReducedObjective& objective, Evaluation& at,
                                 const StopRequest& stop = {});
 // The same for the best state of a run that ended with `termination`: a run its iteration or
 // time limit cut short, with no reason found, is said to be that, not a local minimum.
-ShortfallReport find_run_shortfalls(const ReducedObjective& objective, const Evaluation& best,
+ShortfallReport find_run_shortfalls(const ReducedObjective& objective, Evaluation& best,
                                     Termination termination, const StopRequest& stop = {});
 
 }  // namespace shapectl

@@ -327,8 +327,6 @@ void Session::load(const SceneEntry& entry) {
   controller_->start();
   scene_name_ = entry.name;
   targets_ = {};
-  paused_ = false;
-  jog_.reset();
   history_.clear();
   started_ = std::chrono::steady_clock::now();
   last_edit_time_ = -1e9;
@@ -429,27 +427,13 @@ void Session::apply(const Command& c) {
       targets_ = {};
       edited();
       break;
-    case T::SetPaused:
-      controller_->set_paused(c.paused);
-      paused_ = c.paused;
-      jog_.reset();
-      break;
-    case T::SetJoint:
-    case T::SetJoints: {
-      if (!paused_) throw InputError("message", "type", "jogging needs the optimizer paused first");
-      Eigen::VectorXd joints = c.joints;
-      if (c.type == T::SetJoint) {
-        joints = jog_ ? *jog_ : controller_->snapshot()->joints;
-        joints[c.joint] = c.value;
-      }
-      controller_->set_joints(joints);
-      jog_ = joints;
-      break;
-    }
+    case T::SetPaused: controller_->set_paused(c.paused); break;
+    // The Controller guards jogs (paused first, one step at most, quick jogs of two joints).
+    case T::SetJoint: controller_->set_joint(c.joint, c.value); break;
+    case T::SetJoints: controller_->set_joints(c.joints); break;
     case T::Reset:
       controller_->reset();
       targets_ = {};
-      jog_.reset();
       edited();
       break;
     case T::LoadScene: {

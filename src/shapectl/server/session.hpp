@@ -124,12 +124,7 @@ class Session {
   nlohmann::json scene_description_;  // the static part of scene_message()
   std::vector<std::filesystem::path> package_paths_;
   std::vector<VisualMesh> robot_meshes_;  // of the current scene's robot, found or not
-  bool paused_ = false;  // as the clients set it (the controller ignores jogs unless paused)
-  ShapeTargets targets_;
-  // Joints asked for by jogs since the last pause: quick jogs of two joints must not undo each
-  // other while the controller has not yet published the first.
-  std::optional<Eigen::VectorXd>
-      jog_;  // node targets as the clients set them (a centre-line clears them)
+  ShapeTargets targets_;  // node targets as the clients set them (a centre-line clears them)
   std::chrono::steady_clock::time_point started_;
   double last_edit_time_ = -1e9;
   std::deque<HistorySample> history_;

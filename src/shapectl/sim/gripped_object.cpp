@@ -2,8 +2,6 @@
 
 #include <stdexcept>
 
-#include <shapectl/sim/workspace_pool.hpp>
-
 namespace shapectl {
 
 namespace {
@@ -40,20 +38,23 @@ GrippedObject::GrippedObject(const Scene& scene) : scene_(scene) {
   std::vector<int> held;
   for (const auto& p : pairs) held.push_back(p.first);
   statics_ = std::make_unique<ObjectStatics>(scene_, held);
-  pool_ = WorkspacePool::create([statics = statics_.get()] { return statics->make_workspace(); });
 }
 
-ObjectState GrippedObject::make_state(const Eigen::VectorXd& joints, const Positions& x) const {
-  ObjectState s = unsolved_state(x);
+ObjectState GrippedObject::make_state(const Eigen::VectorXd& joints, const Positions& x,
+                                      std::shared_ptr<WorkspacePool> workspaces) const {
+  ObjectState s = unsolved_state(x, std::move(workspaces));
   s.joints_ = joints;
   s.kinematics_ = forward_kinematics(robot(), joints);
   return s;
 }
 
-ObjectState GrippedObject::unsolved_state(const Positions& x) const {
+ObjectState GrippedObject::unsolved_state(const Positions& x,
+                                          std::shared_ptr<WorkspacePool> workspaces) const {
   ObjectState s;
   s.positions_ = x;
-  s.workspace_ = pool_->acquire();
+  s.workspaces_ = std::move(workspaces);
+  s.workspace_ = s.workspaces_ ? s.workspaces_->acquire(statics_->solver())
+                               : std::make_shared<StaticsWorkspace>(statics_->make_workspace());
   return s;
 }
 
@@ -71,8 +72,10 @@ const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::Vecto
 
 ObjectState GrippedObject::solve_from(const Eigen::VectorXd& joints, const Positions& x,
                                       int max_iterations, const ObjectState* chord,
-                                      const StopRequest& stop) const {
-  ObjectState s = unsolved_state(x);  // solve() sets θ and the kinematics
+                                      const StopRequest& stop,
+                                      std::shared_ptr<WorkspacePool> workspaces) const {
+  if (!workspaces && chord) workspaces = chord->workspaces_;
+  ObjectState s = unsolved_state(x, std::move(workspaces));  // solve() sets θ, kinematics
   solve(s, joints, max_iterations, chord, stop);
   return s;
 }
@@ -97,6 +100,14 @@ bool GrippedObject::factored(ObjectState& state, double stale_step) const {
 
 bool GrippedObject::stable(ObjectState& state, double stale_step) const {
   return factored(state, stale_step);
+}
+
+bool GrippedObject::confirm_stable(ObjectState& state, double stale_step) const {
+  if (!state.statics_.converged()) return false;
+  if (stable(state, stale_step)) return true;
+  state.statics_.status = StaticsStatus::Unstable;
+  state.statics_.reason = "unstable equilibrium: the Hessian there is not positive definite";
+  return false;
 }
 
 Eigen::MatrixXd GrippedObject::sensitivity(ObjectState& state, double stale_step) const {

@@ -4,8 +4,10 @@
 //
 // Model and data, as in Pinocchio: GrippedObject is the fixed description (scene, robot, grip
 // springs, energies, fixed nodes, solver options), immutable and shareable across threads;
-// ObjectState is everything that changes. Every algorithm is a const member taking the state:
-// two threads may work on one GrippedObject with states of their own.
+// ObjectState is everything that changes, its workspace (symbolic analysis, buffers) included,
+// which comes from a WorkspacePool on the state side (docs/architecture.md, "Model and state").
+// Every algorithm is a const member taking the state: two threads may work on one
+// GrippedObject with states of their own.
 #include <memory>
 
 #include <shapectl/robot/kinematics.hpp>
@@ -13,10 +15,9 @@
 #include <shapectl/sim/object_state.hpp>
 #include <shapectl/sim/object_statics.hpp>
 #include <shapectl/sim/scene.hpp>
+#include <shapectl/sim/workspace_pool.hpp>
 
 namespace shapectl {
-
-class WorkspacePool;
 
 class GrippedObject {
  public:
@@ -36,8 +37,10 @@ class GrippedObject {
   const GripSprings& grips() const { return *grips_; }
   const ObjectStatics& statics() const { return *statics_; }
 
-  // A state at θ with positions x (not solved: statics() reports NotConverged, 0 iterations).
-  ObjectState make_state(const Eigen::VectorXd& joints, const Positions& x) const;
+  // A state at θ with positions x (not solved: statics() reports NotConverged, 0 iterations),
+  // its workspace from `workspaces` (null: one of its own).
+  ObjectState make_state(const Eigen::VectorXd& joints, const Positions& x,
+                         std::shared_ptr<WorkspacePool> workspaces = nullptr) const;
   // Equilibrium at θ = joints, Newton from the state's positions; `state` then describes it.
   // Newton tries steps with `chord`'s factorization first if it holds one (a nearby state's,
   // e.g. the one the warm start came from; it may be `state` itself). max_iterations > 0
@@ -46,8 +49,10 @@ class GrippedObject {
                              int max_iterations = 0, const ObjectState* chord = nullptr,
                              const StopRequest& stop = {}) const;
   // A new state solved at θ = joints from the warm start x, chord steps from `chord`'s factor.
+  // Its workspace comes from `workspaces`, else from the chord's pool, else is its own.
   ObjectState solve_from(const Eigen::VectorXd& joints, const Positions& x, int max_iterations = 0,
-                         const ObjectState* chord = nullptr, const StopRequest& stop = {}) const;
+                         const ObjectState* chord = nullptr, const StopRequest& stop = {},
+                         std::shared_ptr<WorkspacePool> workspaces = nullptr) const;
 
   // A warm start for the equilibrium at `to` from the one at `from`: every gripped node of `x`
   // is set to its position in `at_from` moved rigidly with its end effector from `from` to
@@ -62,6 +67,10 @@ class GrippedObject {
   // otherwise the state is factored at its positions first.
   // Whether the state is a stable equilibrium (the Hessian there positive definite).
   bool stable(ObjectState& state, double stale_step = 0) const;
+  // For a converged state: stable(), and if not, the state's statics() marked Unstable.
+  // False without factoring for a state that did not converge. Optimizers ask before
+  // accepting a state: an unstable equilibrium is no shape a robot can hold.
+  bool confirm_stable(ObjectState& state, double stale_step = 0) const;
   // dx̂/dθ (3n × m). Throws std::runtime_error at an unstable state.
   Eigen::MatrixXd sensitivity(ObjectState& state, double stale_step = 0) const;
   // H⁻¹ ∂F/∂p: the equilibrium's response dx̂/dp to parameters p that change the applied forces
@@ -75,12 +84,12 @@ class GrippedObject {
 
  private:
   bool factored(ObjectState& state, double stale_step) const;
-  ObjectState unsolved_state(const Positions& x) const;  // positions and a workspace only
+  // Positions and a workspace only.
+  ObjectState unsolved_state(const Positions& x, std::shared_ptr<WorkspacePool> workspaces) const;
 
   Scene scene_;
   std::unique_ptr<GripSprings> grips_;
   std::unique_ptr<ObjectStatics> statics_;
-  std::shared_ptr<WorkspacePool> pool_;
 };
 
 }  // namespace shapectl

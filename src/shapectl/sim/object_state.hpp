@@ -1,16 +1,18 @@
 #pragma once
 // The changing half of a gripped object (the fixed half is GrippedObject): joint angles θ, the
 // robot's kinematics at θ, the object's positions (the equilibrium x̂(θ) after a converged
-// solve), the last solve's result, and the factorization with the point it belongs to. Every
-// algorithm on a GrippedObject takes one explicitly; nothing else remembers a past call.
-// Made by GrippedObject::make_state; move-only (it owns its factorization); one thread at a
-// time changes it.
+// solve), the last solve's result, and the factorization with the point it belongs to (in a
+// workspace from the pool it was made with, if any). Every algorithm on a GrippedObject takes
+// one explicitly; nothing else remembers a past call. Made by GrippedObject::make_state or
+// solve_from; move-only (it owns its factorization); one thread at a time changes it.
 #include <memory>
 
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/sim/statics.hpp>
 
 namespace shapectl {
+
+class WorkspacePool;
 
 class ObjectState {
  public:
@@ -26,6 +28,9 @@ class ObjectState {
   // Whether it holds a factorization (of the Hessian at its positions, or at the last Newton
   // iterate before them).
   bool has_factor() const { return workspace_ && workspace_->has_factor; }
+  // The pool its workspace came from (null: a workspace of its own); states solved from this
+  // one (GrippedObject::solve_from with it as the chord) take theirs from it too.
+  const std::shared_ptr<WorkspacePool>& workspaces() const { return workspaces_; }
 
  private:
   friend class GrippedObject;
@@ -35,7 +40,8 @@ class ObjectState {
   KinematicsState kinematics_;
   Positions positions_;
   StaticsResult statics_;
-  std::shared_ptr<StaticsWorkspace> workspace_;  // from the object's pool
+  std::shared_ptr<WorkspacePool> workspaces_;
+  std::shared_ptr<StaticsWorkspace> workspace_;  // from workspaces_ if set
 };
 
 }  // namespace shapectl

@@ -28,7 +28,7 @@ std::vector<char> dof_mask(const std::vector<char>& fixed_node) {
     for (int k = 0; k < 3; ++k) dof[3 * i + k] = fixed_node[i];
   return dof;
 }
-std::atomic<long long> total_iterations{0}, total_factorizations{0};
+std::atomic<long long> total_iterations{0}, total_factorizations{0}, total_analyses{0};
 
 // Eisenstat and Walker's (1996) forcing term η, choice 2 with their safeguard (see
 // StaticsOptions::krylov_first_forcing).
@@ -58,7 +58,9 @@ std::string sci(double v) {
 }
 }  // namespace
 
-StaticsTotals statics_totals() { return {total_iterations.load(), total_factorizations.load()}; }
+StaticsTotals statics_totals() {
+  return {total_iterations.load(), total_factorizations.load(), total_analyses.load()};
+}
 
 StaticsSolver::StaticsSolver(int node_count, std::vector<char> fixed_node, StaticsOptions options)
     : node_count_(node_count), fixed_dof_(dof_mask(fixed_node)), options_(options) {}
@@ -120,6 +122,7 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
   auto analyze = [&] {
     ws.cholesky.analyze(ws.assembler.matrix(), &ws.assembler.node_pattern());
     ws.analyzed_pattern = ws.assembler.pattern_version();
+    ++total_analyses;
   };
   if (!assembled) {
     auto assemble = [&] { ws.assembler.assemble_values(terms, x, projected); };

@@ -147,10 +147,12 @@ using EnergyTerms = std::vector<const EnergyTerm*>;
 using StopRequest = std::function<bool()>;
 
 // Totals over the whole process since it started, for benchmarks (`shapectl bench --sizes`):
-// Newton and chord iterations, and numeric factorizations (stability checks included).
+// Newton and chord iterations, numeric factorizations (stability checks included), and
+// symbolic analyses (one per workspace and pattern: WorkspacePool shares them across solves).
 struct StaticsTotals {
   long long iterations = 0;
   long long factorizations = 0;
+  long long analyses = 0;
 };
 StaticsTotals statics_totals();
 
