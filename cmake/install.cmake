@@ -25,8 +25,9 @@ endforeach()
 
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/src/shapectl DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}
         FILES_MATCHING PATTERN "*.hpp")
-# -march=native travels with the targets (a PUBLIC compile option of every area): Eigen's
-# fixed-size types change layout with it, so consumers must compile with it too.
+# With SHAPECTL_NATIVE (OFF by default) -march=native travels with the targets (a PUBLIC compile
+# option of every area): Eigen's fixed-size types change layout with it, so consumers must compile
+# with it too. Without it, consumers are given no instruction-set flag (portable_install).
 install(TARGETS shapectl ${area_libraries} EXPORT shapectl-targets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
@@ -111,4 +112,10 @@ if(SHAPECTL_BUILD_TESTS)
     COMMAND bash ${PROJECT_SOURCE_DIR}/tests/install/install_test.sh ${PROJECT_BINARY_DIR}
             "${pc_cflags}" "${python_install_dir}")
   set_tests_properties(install_consumer PROPERTIES TIMEOUT 600)
+  if(NOT SHAPECTL_NATIVE)  # a native build runs only on CPUs like this one, by request
+    add_test(NAME portable_install
+      COMMAND bash ${PROJECT_SOURCE_DIR}/tests/install/portable_test.sh ${PROJECT_BINARY_DIR}
+              "${python_install_dir}")
+    set_tests_properties(portable_install PROPERTIES TIMEOUT 900)
+  endif()
 endif()

@@ -8,14 +8,14 @@ target_link_libraries(shapectl_server PUBLIC shapectl_calib shapectl_control nlo
 target_compile_definitions(shapectl_server PRIVATE SHAPECTL_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 
 shapectl_tests(server shapectl_server shapectl_link shapectl_scene_io Boost::headers)
-if(TARGET server_tests)
+if(TARGET server_tests AND NOT SHAPECTL_TSAN)  # the TSan tree runs no CLI
   add_dependencies(server_tests shapectl_cli)  # serve_cli_test runs the CLI
 endif()
 
 # The drag soak (issue 32, item 5): its own binary, not a discovered GoogleTest, so CTest can
 # label it, give it a longer timeout and start it first (COST). SHAPECTL_SOAK_SECONDS (default
 # 600) sets its duration; `ctest -L soak` runs it alone, `ctest -LE soak` everything else.
-if(SHAPECTL_BUILD_TESTS)
+if(SHAPECTL_BUILD_TESTS AND NOT SHAPECTL_TSAN)
   add_executable(drag_soak ${PROJECT_SOURCE_DIR}/tests/server/drag_soak.cpp)
   target_link_libraries(drag_soak PRIVATE shapectl_server shapectl_link shapectl_scene_io
                         shapectl_test_support GTest::gtest_main)

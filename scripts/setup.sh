@@ -16,6 +16,7 @@ packages=(
   libboost-dev chromium
   libprotobuf-dev protobuf-compiler
   clang-format
+  qemu-user  # portable_install runs the installed tree on an emulated CPU without AVX
   pybind11-dev python3-dev python3-numpy python3-pytest
   python3-matplotlib python3-dask python3-distributed
 )

@@ -4,6 +4,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <shapectl/hand_off.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -23,15 +25,17 @@ GradientGather::GradientGather(const ElementNodes& elements, int node_count)
 void GradientGather::add(const double* per_corner, Eigen::VectorXd& gradient) const {
   const int node_count = static_cast<int>(corner_offsets_.size()) - 1;
   assert(gradient.size() == 3 * node_count);
+  HandOff hand_off;
   tbb::parallel_for(tbb::blocked_range<int>(0, node_count, kNodeGrain),
-                    [&](const tbb::blocked_range<int>& range) {
+                    hand_off([&](const tbb::blocked_range<int>& range) {
                       for (int i = range.begin(); i != range.end(); ++i) {
                         Vec3 sum = gradient.segment<3>(3 * i);
                         for (int k = corner_offsets_[i]; k < corner_offsets_[i + 1]; ++k)
                           sum += Eigen::Map<const Vec3>(per_corner + 3 * corners_[k]);
                         gradient.segment<3>(3 * i) = sum;
                       }
-                    });
+                    }));
+  hand_off.joined();
 }
 
 }  // namespace shapectl

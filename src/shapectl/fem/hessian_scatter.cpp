@@ -8,6 +8,8 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include <shapectl/hand_off.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -46,8 +48,12 @@ constexpr int kPatternNodeGrain = 256;
 // Runs f(begin, end) over ranges of [0, node_count) on all cores.
 template <typename F>
 void for_node_ranges(int node_count, F&& f) {
+  HandOff hand_off;
   tbb::parallel_for(tbb::blocked_range<int>(0, node_count, kPatternNodeGrain),
-                    [&](const tbb::blocked_range<int>& range) { f(range.begin(), range.end()); });
+                    hand_off([&](const tbb::blocked_range<int>& range) {
+                      f(range.begin(), range.end());
+                    }));
+  hand_off.joined();
 }
 
 }  // namespace
@@ -287,10 +293,12 @@ void HessianScatter::add_blocks(std::size_t term_index, const ElementKernel& ker
   // one value, and each value sums its blocks in the same order on every run.
   for (std::size_t c = 0; c + 1 < term.colour_offsets.size(); ++c) {
     const int begin = term.colour_offsets[c], end = term.colour_offsets[c + 1];
+    HandOff hand_off;
     tbb::parallel_for(tbb::blocked_range<int>(begin, end, kColourGrain),
-                      [&](const tbb::blocked_range<int>& range) {
+                      hand_off([&](const tbb::blocked_range<int>& range) {
                         add_range(range.begin(), range.end());
-                      });
+                      }));
+    hand_off.joined();
   }
 }
 

@@ -9,6 +9,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <shapectl/hand_off.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -161,14 +163,17 @@ NeoHookean::NeoHookean(const TetMesh& mesh, const Material& material)
 
 double NeoHookean::value(const Positions& x) const {
   const auto& tets = mesh_.tets();
-  return tbb::parallel_deterministic_reduce(
+  HandOff hand_off;
+  const double energy = tbb::parallel_deterministic_reduce(
       tbb::blocked_range<std::size_t>(0, tets.size(), kGrain), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& r, double sum) {
+      hand_off([&](const tbb::blocked_range<std::size_t>& r, double sum) {
         for (std::size_t e = r.begin(); e != r.end(); ++e)
           sum += tet_energy(tets[e], material_, gather(x, tets[e]));
         return sum;
-      },
-      std::plus<>());
+      }),
+      hand_off(std::plus<>()));
+  hand_off.joined();
+  return energy;
 }
 
 // Element e's energy, and its corner gradients into corners[0 … 11] (NaN if it is inverted, so
@@ -186,11 +191,13 @@ double NeoHookean::tet_energy_and_gradient(const Positions& x, std::size_t e,
 void NeoHookean::add_gradient(const Positions& x, Eigen::VectorXd& gradient) const {
   const std::size_t tet_count = mesh_.tets().size();
   const std::unique_ptr<double[]> corners(new double[12 * tet_count]);  // every entry written
+  HandOff hand_off;
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tet_count, kGrain),
-                    [&](const tbb::blocked_range<std::size_t>& r) {
+                    hand_off([&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t e = r.begin(); e != r.end(); ++e)
                         tet_energy_and_gradient(x, e, &corners[12 * e]);
-                    });
+                    }));
+  hand_off.joined();
   gather_.add(corners.get(), gradient);
 }
 
@@ -198,14 +205,17 @@ double NeoHookean::value_and_add_gradient(const Positions& x, Eigen::VectorXd& g
   // value()'s reduction (same range, grain and order), so the sum is value()'s bit for bit.
   const std::size_t tet_count = mesh_.tets().size();
   const std::unique_ptr<double[]> corners(new double[12 * tet_count]);  // every entry written
-  const double energy = tbb::parallel_deterministic_reduce(
-      tbb::blocked_range<std::size_t>(0, tet_count, kGrain), 0.0,
-      [&](const tbb::blocked_range<std::size_t>& r, double sum) {
-        for (std::size_t e = r.begin(); e != r.end(); ++e)
-          sum += tet_energy_and_gradient(x, e, &corners[12 * e]);
-        return sum;
-      },
-      std::plus<>());
+  HandOff hand_off;
+  const double energy =
+      tbb::parallel_deterministic_reduce(tbb::blocked_range<std::size_t>(0, tet_count, kGrain), 0.0,
+                                         hand_off([&](const tbb::blocked_range<std::size_t>& r,
+                                                      double sum) {
+                                           for (std::size_t e = r.begin(); e != r.end(); ++e)
+                                             sum += tet_energy_and_gradient(x, e, &corners[12 * e]);
+                                           return sum;
+                                         }),
+                                         hand_off(std::plus<>()));
+  hand_off.joined();
   gather_.add(corners.get(), gradient);
   return energy;
 }

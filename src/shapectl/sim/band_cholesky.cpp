@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <shapectl/hand_off.hpp>
 #include <shapectl/sim/band_factor.hpp>
 #include <shapectl/sim/node_pattern.hpp>
 
@@ -249,9 +250,11 @@ tbb::blocked_range<Eigen::Index> band_pieces(Eigen::Index size) {
 bool BandCholesky::factorize(const SparseMatrix& lower) {
   band_single_current_ = false;
   band_.resize(static_cast<Eigen::Index>(bandwidth_ + 1) * size_);  // uninitialised
-  tbb::parallel_for(band_pieces(band_.size()), [&](const auto& piece) {
-    band_.segment(piece.begin(), piece.size()).setZero();
-  });
+  HandOff zeroing;
+  tbb::parallel_for(band_pieces(band_.size()), zeroing([&](const auto& piece) {
+                      band_.segment(piece.begin(), piece.size()).setZero();
+                    }));
+  zeroing.joined();
   const double* values = lower.valuePtr();
   for (std::size_t k = 0; k < slot_.size(); ++k) band_[slot_[k]] += values[k];
   const int rows = bandwidth_ + 1;
@@ -282,18 +285,22 @@ Eigen::VectorXd BandCholesky::solve_single_precision(const Eigen::VectorXd& rhs)
   // (fill far from the diagonal decays) are dropped, and the right-hand side is scaled to 1.
   // Both change the result by far less than single precision's rounding.
   if (!band_single_current_) {
+    HandOff largest_entry;
     const double largest = tbb::parallel_reduce(
-        band_pieces(band_.size()), 0.0,
-        [&](const auto& piece, double m) {
+        band_pieces(band_.size()), 0.0, largest_entry([&](const auto& piece, double m) {
           return std::max(m, band_.segment(piece.begin(), piece.size()).cwiseAbs().maxCoeff());
-        },
-        [](double a, double b) { return std::max(a, b); });
+        }),
+        largest_entry([](double a, double b) { return std::max(a, b); }));
+    largest_entry.joined();
     const double negligible = 1e-15 * largest;
     band_single_.resize(band_.size());
-    tbb::parallel_for(band_pieces(band_.size()), [&](const auto& piece) {
-      for (Eigen::Index k = piece.begin(); k != piece.end(); ++k)
-        band_single_[k] = std::abs(band_[k]) < negligible ? 0.0f : static_cast<float>(band_[k]);
-    });
+    HandOff rounding;
+    tbb::parallel_for(band_pieces(band_.size()), rounding([&](const auto& piece) {
+                        for (Eigen::Index k = piece.begin(); k != piece.end(); ++k)
+                          band_single_[k] =
+                              std::abs(band_[k]) < negligible ? 0.0f : static_cast<float>(band_[k]);
+                      }));
+    rounding.joined();
     band_single_current_ = true;
   }
   const double scale = rhs.size() > 0 ? rhs.cwiseAbs().maxCoeff() : 0.0;

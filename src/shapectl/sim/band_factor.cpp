@@ -7,6 +7,8 @@
 #include <cstddef>
 #include <vector>
 
+#include <shapectl/hand_off.hpp>
+
 extern "C" {  // LAPACK and BLAS (OpenBLAS)
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
 void dtrsm_(const char* side, const char* uplo, const char* trans, const char* diag, const int* m,
@@ -131,15 +133,17 @@ bool factor_band(double* ab, int n, int kd, int block, bool two_threads) {
       // run (preempted on a busy machine) holds this thread up for less; pieces nobody took,
       // this thread runs itself in wait().
       constexpr int kPieces = 4;
+      HandOff hand_off;
       tbb::task_group rest;
       for (int p = 0; p < kPieces; ++p) {
         const int from = equal_flops_column(b.rows, split, p, kPieces);
         const int to = equal_flops_column(b.rows, split, p + 1, kPieces);
-        rest.run([&, from, to] { update_trailing_columns(band, b, panel, from, to); });
+        rest.run(hand_off([&, from, to] { update_trailing_columns(band, b, panel, from, to); }));
       }
       update_trailing_columns(band, b, panel, 0, split);
       next_ok = factor_block_column(band, next, next_panel);
       rest.wait();
+      hand_off.joined();
     } else {
       update_trailing_columns(band, b, panel, 0, b.rows);
       next_ok = factor_block_column(band, next, next_panel);

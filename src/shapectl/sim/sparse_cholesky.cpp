@@ -10,6 +10,7 @@
 #include <tbb/parallel_invoke.h>
 #include <vector>
 
+#include <shapectl/hand_off.hpp>
 #include <shapectl/sim/band_cholesky.hpp>
 #include <shapectl/sim/node_pattern.hpp>
 #include <shapectl/sim/permuted_cholmod.hpp>
@@ -139,7 +140,10 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower,
     }
   };
   // The two analyses are independent: one on each core.
-  tbb::parallel_invoke([&] { impl_->band.analyze(lower, nodes); }, estimate_sparse);
+  HandOff hand_off;
+  tbb::parallel_invoke(hand_off([&] { impl_->band.analyze(lower, nodes); }),
+                       hand_off(estimate_sparse));
+  hand_off.joined();
   const double allowance = small ? kLdltAllowance : kCholmodAllowance;
   const bool band = impl_->band.flops() <= allowance * sparse_flops &&
                     impl_->band.storage_bytes() <= kBandBytesLimit;

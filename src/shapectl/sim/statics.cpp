@@ -6,6 +6,7 @@
 #include <sstream>
 #include <tbb/parallel_invoke.h>
 
+#include <shapectl/hand_off.hpp>
 #include <shapectl/sim/rigid_motion.hpp>
 
 namespace shapectl {
@@ -128,9 +129,13 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
     auto assemble = [&] { ws.assembler.assemble_values(terms, x, projected); };
     // A new pattern: its symbolic analysis, which reads the pattern alone, beside the assembly
     // of the values; the two share the cores.
-    if (ws.assembler.learn_pattern(terms) != ws.analyzed_pattern)
-      tbb::parallel_invoke(analyze, assemble);
-    else assemble();
+    if (ws.assembler.learn_pattern(terms) != ws.analyzed_pattern) {
+      HandOff hand_off;
+      tbb::parallel_invoke(hand_off(analyze), hand_off(assemble));
+      hand_off.joined();
+    } else {
+      assemble();
+    }
   }
   const SparseMatrix& H = ws.assembler.matrix();
   if (ws.analyzed_pattern != ws.assembler.pattern_version()) analyze();

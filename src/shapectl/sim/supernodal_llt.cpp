@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include <shapectl/hand_off.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -114,16 +116,20 @@ void forward_backward(const SupernodalPattern& pattern, const std::vector<int>& 
   X other = x;
   for (int k = 0; k < supernodes.count(); ++k)
     if (team[k] == kAboveBoth) rows_of(k, other).setZero();
-  tbb::parallel_invoke([&] { forward(supernodes, team, 0, x); },
-                       [&] { forward(supernodes, team, 1, other); });
+  HandOff forward_teams;
+  tbb::parallel_invoke(forward_teams([&] { forward(supernodes, team, 0, x); }),
+                       forward_teams([&] { forward(supernodes, team, 1, other); }));
+  forward_teams.joined();
   for (int k = 0; k < supernodes.count(); ++k) {
     if (team[k] == 1) rows_of(k, x) = rows_of(k, other);
     if (team[k] == kAboveBoth) rows_of(k, x) += rows_of(k, other);
   }
   forward(supernodes, team, kAboveBoth, x);
   backward(supernodes, team, kAboveBoth, x);
-  tbb::parallel_invoke([&] { backward(supernodes, team, 0, x); },
-                       [&] { backward(supernodes, team, 1, x); });
+  HandOff backward_teams;
+  tbb::parallel_invoke(backward_teams([&] { backward(supernodes, team, 0, x); }),
+                       backward_teams([&] { backward(supernodes, team, 1, x); }));
+  backward_teams.joined();
 }
 
 // Team 0 or 1 for each supernode in one of two disjoint subtrees, kAboveBoth for the rest: from
@@ -304,9 +310,13 @@ bool factorize_supernodal(const SparseMatrix& lower, const SupernodalPattern& pa
     for (int k = 0; k < supernodes.count() && factored[t]; ++k)
       if (team[k] == t) factored[t] = left_looking.factor(k, lanes[t]);
   };
-  if (std::count(team.begin(), team.end(), 1) > 0)
-    tbb::parallel_invoke([&] { factor_team(0); }, [&] { factor_team(1); });
-  else factor_team(0);
+  if (std::count(team.begin(), team.end(), 1) > 0) {
+    HandOff hand_off;
+    tbb::parallel_invoke(hand_off([&] { factor_team(0); }), hand_off([&] { factor_team(1); }));
+    hand_off.joined();
+  } else {
+    factor_team(0);
+  }
   if (!factored[0] || !factored[1]) return false;
   left_looking.join(lanes[0], lanes[1]);
   for (int k = 0; k < supernodes.count(); ++k)
