@@ -57,6 +57,11 @@ std::string sci(double v) {
   s << v;
   return s.str();
 }
+
+// The end of the reasons solve() gives: " after 3 iterations".
+std::string after_iterations(int iterations) {
+  return " after " + std::to_string(iterations) + " iterations";
+}
 }  // namespace
 
 StaticsTotals statics_totals() {
@@ -368,169 +373,226 @@ bool StaticsSolver::decreases(const Point& from, double slope, double alpha, dou
          gradient.squaredNorm() <= (1 - 1e-4 * alpha) * from.gradient.squaredNorm();
 }
 
-StaticsResult StaticsSolver::stopped(StaticsResult& result, const Point& at, int it) const {
-  result.status = StaticsStatus::NotConverged;
-  result.reason = "stopped (time limit): residual " + sci(at.residual) + " N after " +
-                  std::to_string(it) + " iterations";
-  return result;
-}
+// The state solve()'s phases share. Named flags for what the loop may try next.
+struct StaticsSolver::Run {
+  // The watchdog's reference (see the header): the state before its relaxed step.
+  struct Watch {
+    Positions x;
+    Point at;
+    double slope = 0;  // ∇E·dx of the relaxed step
+    int iteration = 0;
+  };
 
-StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& ws, Positions& x,
-                                   int max_iterations, const StaticsWorkspace* chord,
-                                   const StopRequest& stop) const {
-  if (max_iterations <= 0) max_iterations = options_.max_iterations;
-  StaticsResult result;
-  Point at;
-  at.energy = energy_and_gradient(terms, x, at.gradient);
-  if (!std::isfinite(at.energy)) {
-    result.status = StaticsStatus::Inverted;
-    result.reason = "the starting state has an inverted element or a non-finite energy";
-    return result;
-  }
-  at.residual = max_force(at.gradient);
-  const double tolerance = effective_tolerance();
-  if (!(tolerance < std::numeric_limits<double>::infinity())) {
-    result.status = StaticsStatus::NotConverged;
+  Run(Positions& x, int max_iterations, const StopRequest& stop, const StaticsOptions& options)
+      : x(x),
+        max_iterations(max_iterations),
+        stop(stop),
+        forcing(options.krylov_first_forcing, options.krylov_tolerance) {}
+  bool stop_requested() const { return stop && stop(); }
+  // A solve that ends unconverged during the watch returns the state before the relaxed step.
+  void restore() {
+    x = std::move(watch->x);
+    at = std::move(watch->at);
+    watch.reset();
     result.residual = at.residual;
     result.energy = at.energy;
-    result.reason = "not converged: the force tolerance " + sci(tolerance) + " N is non-finite";
-    return result;
+  }
+  // The watchdog gives up at iteration `it`: back to its reference, logged as a step.
+  void go_back(int it) {
+    restore();
+    result.log.push_back(
+        {.iteration = it, .residual = at.residual, .energy = at.energy, .went_back = true});
+  }
+  void end(StaticsStatus status, std::string reason) {
+    result.status = status;
+    result.reason = std::move(reason);
+  }
+  // Ended by a stop request at iteration `it` (from the state before the watched step, if any).
+  void stopped(int it) {
+    if (watch) restore();
+    end(StaticsStatus::NotConverged,
+        "stopped (time limit): residual " + sci(at.residual) + " N" + after_iterations(it));
+  }
+
+  Positions& x;
+  Point at;  // energy, gradient and residual at x
+  StaticsResult result;
+  double tolerance = 0;  // effective_tolerance()
+  int max_iterations;
+  const StopRequest& stop;
+  // The nearby factorization chord and Krylov steps use while they take full steps; null once
+  // the solve factors anew (or when it was given none).
+  const StaticsWorkspace* nearby = nullptr;
+  bool warm = false;  // given a nearby factorization; else cold: Krylov steps if cold_krylov_steps
+  bool own_factor_fits = false;  // ws holds a factorization this solve made that Krylov may use
+  // ws's assembler holds the true Hessian at x (a failed exact Krylov step's): Newton factors it.
+  bool true_hessian_assembled = false;
+  ForcingTerm forcing;
+  bool may_relax = false;  // the next Newton step is the watchdog's relaxed one
+  std::optional<Watch> watch;
+};
+
+bool StaticsSolver::start(const EnergyTerms& terms, Run& run, const StaticsWorkspace* chord) const {
+  Point& at = run.at;
+  at.energy = energy_and_gradient(terms, run.x, at.gradient);
+  if (!std::isfinite(at.energy)) {
+    run.end(StaticsStatus::Inverted,
+            "the starting state has an inverted element or a non-finite energy");
+    return false;
+  }
+  at.residual = max_force(at.gradient);
+  run.tolerance = effective_tolerance();
+  if (!(run.tolerance < std::numeric_limits<double>::infinity())) {
+    run.result.residual = at.residual;
+    run.result.energy = at.energy;
+    run.end(StaticsStatus::NotConverged,
+            "not converged: the force tolerance " + sci(run.tolerance) + " N is non-finite");
+    return false;
   }
   // Chord steps first: the true Hessian's factor of a nearby state is used while it works.
   // This saves the factorization, the dominant cost, on warm re-solves. Once the solve factors
   // anew it stays with Newton steps (solved by Krylov with its own factor first): chord steps
   // from a factor of an earlier iterate stalled Newton near buckling (seconds instead of
   // milliseconds in `shapectl bench`).
-  bool may_chord = chord && chord->has_factor && chord->factor_x.size() == x.size();
-  const bool warm = may_chord;  // else cold: Krylov steps only if cold_krylov_steps
-  bool may_refine = false;      // ws holds a factorization this solve made
-  ForcingTerm forcing(options_.krylov_first_forcing, options_.krylov_tolerance);
+  if (chord && chord->has_factor && chord->factor_x.size() == run.x.size()) run.nearby = chord;
+  run.warm = run.nearby != nullptr;
   // The watchdog (see the header): a cold solve's first Newton step is taken in full while no
   // element inverts, even where it raises the energy; the solve returns to the state before it
   // (and to the descent rule, for good) unless the energy falls below that state's Armijo level
   // within watchdog_iterations iterations.
-  struct Reference {
-    Positions x;
-    Point at;
-    double slope = 0;  // ∇E·dx of the relaxed step
-    int iteration = 0;
-  };
-  std::optional<Reference> watch;
-  bool may_relax = !chord && options_.watchdog_iterations > 0;
-  // A solve that ends unconverged during the watch returns the state before the relaxed step.
-  auto restore = [&] {
-    x = std::move(watch->x);
-    at = std::move(watch->at);
-    watch.reset();
-    result.residual = at.residual;
-    result.energy = at.energy;
-  };
-  auto go_back = [&](int it) {
-    restore();
-    result.log.push_back(
-        {.iteration = it, .residual = at.residual, .energy = at.energy, .went_back = true});
-  };
+  run.may_relax = !chord && options_.watchdog_iterations > 0;
+  return true;
+}
+
+void StaticsSolver::watchdog_verdict(Run& run, int it) const {
+  if (!run.watch) return;
+  const Point& at = run.at;
+  if (decreases(run.watch->at, run.watch->slope, 1, at.energy, at.gradient)) run.watch.reset();
+  else if (it - run.watch->iteration >= options_.watchdog_iterations ||
+           at.residual <= run.tolerance || !std::isfinite(at.residual))
+    run.go_back(it);  // not below the start in time, or an equilibrium above it
+}
+
+bool StaticsSolver::convergence_test(Run& run, int it) const {
+  watchdog_verdict(run, it);
+  const Point& at = run.at;
+  run.result.iterations = it;
+  run.result.residual = at.residual;
+  run.result.energy = at.energy;
+  if (!std::isfinite(at.residual)) {
+    run.end(StaticsStatus::NotConverged, "not converged: non-finite force" + after_iterations(it));
+  } else if (at.residual <= run.tolerance && run.x.allFinite()) {
+    run.end(StaticsStatus::Converged, "residual " + sci(at.residual) + " N" + after_iterations(it));
+  } else if (it == run.max_iterations) {
+    if (run.watch) run.restore();  // `at` is then the state before the watched step
+    run.end(StaticsStatus::NotConverged,
+            "not converged: residual " + sci(at.residual) + " N" + after_iterations(it));
+  } else if (run.stop_requested()) {
+    run.stopped(it);
+  } else {
+    return false;
+  }
+  return true;
+}
+
+bool StaticsSolver::reuse_step(const EnergyTerms& terms, StaticsWorkspace& ws, Run& run,
+                               NewtonIterate& log) const {
+  // A Krylov step's residual: η |∇E|, but no less than a quarter of the tolerance. Every
+  // nodal force is at most |∇E|, so below that the step's linear model is already converged,
+  // and solving further is wasted. A cold solve's Krylov steps stand in for its Newton steps:
+  // they solve as far as the tolerance, so the iterates are Newton's (cold_krylov_steps).
+  const double gradient_norm = run.at.gradient.norm();
+  const double exact_target = 0.25 * run.tolerance;
+  const double krylov_target =
+      std::max(run.forcing.next(gradient_norm) * gradient_norm, exact_target);
+  if (run.nearby && options_.chord_steps && chord_step(terms, *run.nearby, run.x, run.at, log))
+    return true;
+  // Then a Newton step solved by conjugate gradients with the chord's factor: kept while it
+  // takes full steps (a shorter one means the factor no longer fits: Newton factors anew).
+  // After a factorization of its own, the solve's next Newton steps are first solved so,
+  // preconditioned with it (the same rule). A warm solve's only with a factor that is cheap
+  // to solve with (SparseCholesky::cheap_to_solve); a cold solve's exact steps with any: each
+  // that succeeds saves a whole factorization.
+  const StaticsWorkspace* preconditioner = run.nearby            ? run.nearby
+                                           : run.own_factor_fits ? &ws
+                                                                 : nullptr;
+  const bool try_krylov =
+      preconditioner &&
+      (run.warm ? options_.krylov_steps && preconditioner->cholesky.cheap_to_solve()
+                : options_.cold_krylov_steps);
+  if (try_krylov && krylov_step(terms, ws, *preconditioner, run.warm ? krylov_target : exact_target,
+                                !run.warm, run.x, run.at, log)) {
+    if (log.step_length != 1) run.nearby = nullptr;
+    run.own_factor_fits = run.own_factor_fits && log.step_length == 1;
+    return true;
+  }
+  run.true_hessian_assembled = try_krylov && !run.warm && !log.negative_curvature;
+  return false;
+}
+
+StaticsSolver::Outcome StaticsSolver::newton_step(const EnergyTerms& terms, StaticsWorkspace& ws,
+                                                  Run& run, NewtonIterate& log) const {
+  run.nearby = nullptr;
+  run.own_factor_fits = false;
+  // The stability check: the true Hessian if it factors, else the projected one.
+  const Eigen::VectorXd dx =
+      newton_direction(terms, ws, run.x, run.at.gradient, log, run.result.factorizations,
+                       run.true_hessian_assembled, run.stop);
+  const int it = log.iteration;
+  if (dx.size() == 0) {
+    if (run.stop_requested()) {
+      run.stopped(it);
+      return Outcome::Ended;
+    }
+    if (run.watch) {
+      run.go_back(it);
+      return Outcome::WentBack;
+    }
+    run.end(StaticsStatus::Singular, singular_reason(ws));
+    return Outcome::Ended;
+  }
+  return line_search_step(terms, ws, run, dx, log);
+}
+
+StaticsSolver::Outcome StaticsSolver::line_search_step(const EnergyTerms& terms,
+                                                       const StaticsWorkspace& ws, Run& run,
+                                                       const Eigen::VectorXd& dx,
+                                                       NewtonIterate& log) const {
+  const int it = log.iteration;
+  const double residual_before = run.at.residual;
+  const bool relax = run.may_relax;
+  run.may_relax = false;
+  if (relax) run.watch = Run::Watch{run.x, run.at, run.at.gradient.dot(dx), it};
+  if (!line_search(terms, dx, run.x, run.at, log, relax)) {
+    if (run.watch) {
+      run.go_back(it);
+      return Outcome::WentBack;
+    }
+    run.end(StaticsStatus::NotConverged,
+            "line search failed at residual " + sci(residual_before) + " N" + after_iterations(it));
+    return Outcome::Ended;
+  }
+  log.relaxed = relax;
+  // In a cold solve, exact Krylov steps follow a full Newton step with the true Hessian only:
+  // after a shorter or a projected one the Hessian has changed too much for its factor.
+  run.own_factor_fits =
+      ws.has_preconditioner && (run.warm || (log.step_length == 1 && !log.projected));
+  return Outcome::Stepped;
+}
+
+StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& ws, Positions& x,
+                                   int max_iterations, const StaticsWorkspace* chord,
+                                   const StopRequest& stop) const {
+  Run run(x, max_iterations > 0 ? max_iterations : options_.max_iterations, stop, options_);
+  if (!start(terms, run, chord)) return std::move(run.result);
   for (int it = 0;; ++it) {
-    if (watch) {
-      if (decreases(watch->at, watch->slope, 1, at.energy, at.gradient)) watch.reset();
-      else if (it - watch->iteration >= options_.watchdog_iterations || at.residual <= tolerance ||
-               !std::isfinite(at.residual))
-        go_back(it);  // not below the start in time, or an equilibrium above it
-    }
-    result.iterations = it;
-    result.residual = at.residual;
-    result.energy = at.energy;
-    if (!std::isfinite(at.residual)) {
-      result.status = StaticsStatus::NotConverged;
-      result.reason = "not converged: non-finite force after " + std::to_string(it) + " iterations";
-      return result;
-    }
-    if (at.residual <= tolerance && x.allFinite()) {
-      result.status = StaticsStatus::Converged;
-      result.reason =
-          "residual " + sci(at.residual) + " N after " + std::to_string(it) + " iterations";
-      return result;
-    }
-    if (it == max_iterations) {
-      if (watch) restore();
-      result.status = StaticsStatus::NotConverged;
-      result.reason = "not converged: residual " + sci(at.residual) + " N after " +
-                      std::to_string(it) + " iterations";
-      return result;
-    }
-    if (stop && stop()) {
-      if (watch) restore();
-      return stopped(result, at, it);
-    }
-    NewtonIterate log{.iteration = it, .residual = at.residual, .energy = at.energy};
+    if (convergence_test(run, it)) return std::move(run.result);
+    NewtonIterate log{.iteration = it, .residual = run.at.residual, .energy = run.at.energy};
     ++total_iterations;
-    // A Krylov step's residual: η |∇E|, but no less than a quarter of the tolerance. Every
-    // nodal force is at most |∇E|, so below that the step's linear model is already converged,
-    // and solving further is wasted.
-    const double gradient_norm = at.gradient.norm();
-    const double krylov_target =
-        std::max(forcing.next(gradient_norm) * gradient_norm, 0.25 * tolerance);
-    // A cold solve's Krylov steps stand in for its Newton steps: they solve as far as the
-    // tolerance, so the iterates are Newton's (StaticsOptions::cold_krylov_steps).
-    const double exact_target = 0.25 * tolerance;
-    if (may_chord && options_.chord_steps && chord_step(terms, *chord, x, at, log)) {
-      result.log.push_back(log);
-      continue;
-    }
-    // Then a Newton step solved by conjugate gradients with the chord's factor: kept while it
-    // takes full steps (a shorter one means the factor no longer fits: Newton factors anew).
-    // After a factorization of its own, the solve's next Newton steps are first solved so,
-    // preconditioned with it (the same rule). A warm solve's only with a factor that is cheap
-    // to solve with (SparseCholesky::cheap_to_solve); a cold solve's exact steps with any: each
-    // that succeeds saves a whole factorization.
-    const StaticsWorkspace* preconditioner = may_chord ? chord : may_refine ? &ws : nullptr;
-    const bool try_krylov =
-        preconditioner && (warm ? options_.krylov_steps && preconditioner->cholesky.cheap_to_solve()
-                                : options_.cold_krylov_steps);
-    if (try_krylov && krylov_step(terms, ws, *preconditioner, warm ? krylov_target : exact_target,
-                                  !warm, x, at, log)) {
-      may_chord = may_chord && log.step_length == 1;
-      may_refine = may_refine && log.step_length == 1;
-      result.log.push_back(log);
-      continue;
-    }
-    may_chord = may_refine = false;
-    // A failed exact Krylov step leaves the true Hessian at x assembled in ws: Newton factors it.
-    const bool assembled = try_krylov && !warm && !log.negative_curvature;
-    const Eigen::VectorXd dx =
-        newton_direction(terms, ws, x, at.gradient, log, result.factorizations, assembled, stop);
-    if (dx.size() == 0 && stop && stop()) {
-      if (watch) restore();
-      return stopped(result, at, it);
-    }
-    if (dx.size() == 0 && watch) {
-      go_back(it);
-      continue;
-    }
-    if (dx.size() == 0) {
-      result.status = StaticsStatus::Singular;
-      result.reason = singular_reason(ws);
-      return result;
-    }
-    const double residual_before = at.residual;
-    const bool relax = may_relax;
-    may_relax = false;
-    if (relax) watch = Reference{x, at, at.gradient.dot(dx), it};
-    if (!line_search(terms, dx, x, at, log, relax)) {
-      if (watch) {
-        go_back(it);
-        continue;
-      }
-      result.status = StaticsStatus::NotConverged;
-      result.reason = "line search failed at residual " + sci(residual_before) + " N after " +
-                      std::to_string(it) + " iterations";
-      return result;
-    }
-    log.relaxed = relax;
-    // In a cold solve, exact Krylov steps follow a full Newton step with the true Hessian only:
-    // after a shorter or a projected one the Hessian has changed too much for its factor.
-    may_refine = ws.has_preconditioner && (warm || (log.step_length == 1 && !log.projected));
-    result.log.push_back(log);
+    const Outcome outcome =
+        reuse_step(terms, ws, run, log) ? Outcome::Stepped : newton_step(terms, ws, run, log);
+    if (outcome == Outcome::Ended) return std::move(run.result);
+    if (outcome == Outcome::Stepped) run.result.log.push_back(log);
   }
 }
 

@@ -236,8 +236,29 @@ class StaticsSolver {
                                    const Positions& x, const Eigen::VectorXd& g, NewtonIterate& log,
                                    int& factorizations, bool assembled,
                                    const StopRequest& stop) const;
-  // `result` ended by a stop request at iteration `it`.
-  StaticsResult stopped(StaticsResult& result, const Point& at, int it) const;
+  // solve() in phases; Run is the state they share (statics.cpp).
+  struct Run;
+  // How an iteration ended: a step taken (logged), the watchdog went back (its own log entry),
+  // or the solve ended (run.result says how).
+  enum class Outcome { Stepped, WentBack, Ended };
+  // The energy, residual and tolerance at the start, and which steps the solve may try; false
+  // when the start already ends the solve (run.result says why).
+  bool start(const EnergyTerms& terms, Run& run, const StaticsWorkspace* chord) const;
+  // Before iteration `it`: the watchdog's verdict (kept, still watched, or gone back), then
+  // non-finite, converged, the iteration limit, a stop request; true when the solve ends there.
+  bool convergence_test(Run& run, int it) const;
+  void watchdog_verdict(Run& run, int it) const;
+  // A step without a new factorization: chord, else Krylov; false when neither is taken.
+  bool reuse_step(const EnergyTerms& terms, StaticsWorkspace& ws, Run& run,
+                  NewtonIterate& log) const;
+  // Newton's step: the true Hessian if it factors, else the projected one (the stability check;
+  // neither: Singular), then the line search along it.
+  Outcome newton_step(const EnergyTerms& terms, StaticsWorkspace& ws, Run& run,
+                      NewtonIterate& log) const;
+  // The line search along Newton's direction dx: the watchdog's relaxed step in a cold solve's
+  // first Newton step; a failure during the watch goes back, otherwise ends the solve.
+  Outcome line_search_step(const EnergyTerms& terms, const StaticsWorkspace& ws, Run& run,
+                           const Eigen::VectorXd& dx, NewtonIterate& log) const;
   // The first of α = 1, 1/2, 1/4, ... whose state lowers the energy enough; relaxed: whose
   // state is finite (no element inverted; the watchdog's step).
   bool line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x, Point& at,
