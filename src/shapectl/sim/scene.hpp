@@ -11,10 +11,10 @@
 #include <Eigen/Geometry>
 
 #include <shapectl/fem/material.hpp>
+#include <shapectl/linalg/cholesky_backend.hpp>
 #include <shapectl/mesh/tet_mesh.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/robot_model.hpp>
-#include <shapectl/sim/cholesky_backend.hpp>
 
 namespace shapectl {
 

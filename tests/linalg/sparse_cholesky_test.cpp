@@ -1,4 +1,4 @@
-#include <shapectl/sim/sparse_cholesky.hpp>
+#include <shapectl/linalg/sparse_cholesky.hpp>
 
 #include <gtest/gtest.h>
 
@@ -9,11 +9,11 @@
 #include <set>
 #include <tuple>
 
+#include <shapectl/linalg/band_cholesky.hpp>
+#include <shapectl/linalg/node_pattern.hpp>
+#include <shapectl/linalg/permuted_cholmod.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
-#include <shapectl/sim/band_cholesky.hpp>
-#include <shapectl/sim/node_pattern.hpp>
 #include <shapectl/sim/object_statics.hpp>
-#include <shapectl/sim/permuted_cholmod.hpp>
 
 namespace shapectl {
 namespace {

@@ -1,5 +1,5 @@
 #pragma once
-// Which sparse Cholesky factors the statics Hessian (sim/sparse_cholesky.hpp), in a header of
+// Which sparse Cholesky factors the statics Hessian (linalg/sparse_cholesky.hpp), in a header of
 // its own: a Scene names one without pulling in the solver.
 #include <string_view>
 

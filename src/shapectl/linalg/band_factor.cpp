@@ -1,4 +1,4 @@
-#include <shapectl/sim/band_factor.hpp>
+#include <shapectl/linalg/band_factor.hpp>
 
 #include <tbb/task_group.h>
 

@@ -1,4 +1,4 @@
-#include <shapectl/sim/band_cholesky.hpp>
+#include <shapectl/linalg/band_cholesky.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -7,8 +7,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
-#include <shapectl/sim/band_factor.hpp>
-#include <shapectl/sim/node_pattern.hpp>
+#include <shapectl/linalg/band_factor.hpp>
+#include <shapectl/linalg/node_pattern.hpp>
 
 extern "C" {  // LAPACK and BLAS (OpenBLAS)
 void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);

@@ -1,4 +1,4 @@
-#include <shapectl/sim/permuted_cholmod.hpp>
+#include <shapectl/linalg/permuted_cholmod.hpp>
 
 #include <Eigen/CholmodSupport>
 #include <algorithm>
@@ -6,9 +6,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <shapectl/sim/node_pattern.hpp>
-#include <shapectl/sim/supernodal_llt.hpp>
-#include <shapectl/sim/supernodal_pattern.hpp>
+#include <shapectl/linalg/node_pattern.hpp>
+#include <shapectl/linalg/supernodal_llt.hpp>
+#include <shapectl/linalg/supernodal_pattern.hpp>
 
 namespace shapectl {
 

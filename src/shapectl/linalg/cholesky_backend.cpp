@@ -1,4 +1,4 @@
-#include <shapectl/sim/cholesky_backend.hpp>
+#include <shapectl/linalg/cholesky_backend.hpp>
 
 #include <shapectl/enum_names.hpp>
 

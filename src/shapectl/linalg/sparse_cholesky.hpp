@@ -8,7 +8,7 @@
 #include <memory>
 #include <optional>
 
-#include <shapectl/sim/cholesky_backend.hpp>
+#include <shapectl/linalg/cholesky_backend.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {

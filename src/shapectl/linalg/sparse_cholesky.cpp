@@ -1,4 +1,4 @@
-#include <shapectl/sim/sparse_cholesky.hpp>
+#include <shapectl/linalg/sparse_cholesky.hpp>
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCholesky>
@@ -10,10 +10,10 @@
 #include <tbb/parallel_invoke.h>
 #include <vector>
 
-#include <shapectl/sim/band_cholesky.hpp>
-#include <shapectl/sim/node_pattern.hpp>
-#include <shapectl/sim/permuted_cholmod.hpp>
-#include <shapectl/sim/serial_openmp.hpp>
+#include <shapectl/linalg/band_cholesky.hpp>
+#include <shapectl/linalg/node_pattern.hpp>
+#include <shapectl/linalg/permuted_cholmod.hpp>
+#include <shapectl/linalg/serial_openmp.hpp>
 
 namespace shapectl {
 
