@@ -8,9 +8,12 @@
 #include <cstdlib>
 #include <stdexcept>
 #include <tbb/parallel_invoke.h>
+#include <utility>
 #include <vector>
 
 #include <shapectl/linalg/band_cholesky.hpp>
+#include <shapectl/linalg/cholmod_library.hpp>
+#include <shapectl/linalg/factorization.hpp>
 #include <shapectl/linalg/node_pattern.hpp>
 #include <shapectl/linalg/permuted_cholmod.hpp>
 #include <shapectl/linalg/serial_openmp.hpp>
@@ -73,40 +76,127 @@ double ldlt_flops_by_nodes(const SparseMatrix& nodes) {
   return 27 * (2 * info[AMD_NMULTSUBS_LDL] + info[AMD_LNZ] + n);
 }
 
-struct SparseCholesky::Impl {
-  CountingLdlt ldlt;
-  BandCholesky band;
-  PermutedCholmod cholmod;
-  bool cholmod_blas_threads = false;  // see factorize()
-  bool cholmod_analysed = false;      // by choose(): analyze() need not analyse again
+namespace {
+
+// Eigen's simplicial LDLᵀ.
+class LdltFactorization final : public Factorization {
+ public:
+  void analyze(const SparseMatrix& lower, const SparseMatrix*) override {
+    ldlt_.analyzePattern(lower);
+  }
+  bool factorize(const SparseMatrix& lower) override {
+    ldlt_.factorize(lower);
+    if (ldlt_.info() != Eigen::Success) return false;
+    // LDLᵀ also "succeeds" on indefinite matrices: positive definite means every pivot > 0,
+    // and a pivot tiny next to the largest means the matrix is singular in double precision.
+    const auto& D = ldlt_.vectorD();
+    return D.minCoeff() > 1e-13 * D.cwiseAbs().maxCoeff();
+  }
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const override { return ldlt_.solve(rhs); }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const override { return ldlt_.solve(rhs); }
+
+ private:
+  CountingLdlt ldlt_;
 };
 
+// The band (band_cholesky.hpp), possibly analysed already by the automatic choice.
+class BandFactorization final : public Factorization {
+ public:
+  explicit BandFactorization(BandCholesky band = {}) : band_(std::move(band)) {}
+  // The band finds the node pattern itself (as a fixed band always has).
+  void analyze(const SparseMatrix& lower, const SparseMatrix*) override { band_.analyze(lower); }
+  bool factorize(const SparseMatrix& lower) override {
+    constexpr int kThreadedBandFrom = 256;  // sub-diagonals; measured crossover on 2 cores (solve)
+    // The band factorization runs its own two threads over single-threaded BLAS calls
+    // (band_factor.hpp); the solves keep OpenBLAS's threads on wide bands.
+    use_blas_threads(false);
+    const bool positive_definite = band_.factorize(lower);
+    use_blas_threads(band_.bandwidth() >= kThreadedBandFrom);
+    return positive_definite;
+  }
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const override {
+    return band_.solve(rhs).col(0);
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const override { return band_.solve(rhs); }
+  // The band's factor in single precision (BandCholesky::solve_single_precision).
+  Eigen::VectorXd solve_preconditioner(const Eigen::VectorXd& rhs) const override {
+    return band_.solve_single_precision(rhs);
+  }
+
+ private:
+  BandCholesky band_;
+};
+
+// Supernodal LLᵀ on CHOLMOD's analysis (permuted_cholmod.hpp), possibly analysed already by the
+// automatic choice.
+class CholmodFactorization final : public Factorization {
+ public:
+  CholmodFactorization() = default;
+  explicit CholmodFactorization(PermutedCholmod analysed) : cholmod_(std::move(analysed)) {
+    blas_threads_ = !cholmod_.own_kernels();
+  }
+  void analyze(const SparseMatrix& lower, const SparseMatrix* nodes) override {
+    analyze_sparse(cholmod_, lower, nodes);
+    blas_threads_ = !cholmod_.own_kernels();
+  }
+  bool factorize(const SparseMatrix& lower) override {
+    // Below PermutedCholmod::kOwnKernelsBelowFlops our own kernels factor, on this thread.
+    // Above it CHOLMOD does: its OpenMP on one thread (serial_openmp.hpp), its BLAS on all
+    // cores, for large factorizations are big dense blocks (docs/benchmarks.md, "CHOLMOD's
+    // OpenMP threads": all cores 10-15 % faster from 8e9 flops, 5-15 % slower to 1.3e9).
+    use_blas_threads(blas_threads_);
+    SerialOpenMp serial;
+    return cholmod_.factorize(lower);
+  }
+  Eigen::VectorXd solve(const Eigen::VectorXd& rhs) const override { return cholmod_.solve(rhs); }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& rhs) const override { return cholmod_.solve(rhs); }
+  // CHOLMOD's solve is not cheap (SparseCholesky::cheap_to_solve).
+  bool cheap_to_solve() const override { return false; }
+
+ private:
+  PermutedCholmod cholmod_;
+  bool blas_threads_ = false;
+};
+
+// CHOLMOD on its own (cholmod_library.hpp), its BLAS on as many threads as where CHOLMOD
+// factors for `cholmod`: all cores from PermutedCholmod::kOwnKernelsBelowFlops, else one (on a
+// loaded machine OpenBLAS's spinning threads made a sweep of 1.3k-unknown solves 12x slower).
+class CholmodLibraryFactorization final : public CholmodLibrary {
+ public:
+  bool factorize(const SparseMatrix& lower) override {
+    use_blas_threads(flops() >= PermutedCholmod::kOwnKernelsBelowFlops);
+    return CholmodLibrary::factorize(lower);
+  }
+};
+
+std::unique_ptr<Factorization> make_factorization(CholeskyBackend backend) {
+  switch (backend) {
+    case CholeskyBackend::SimplicialLDLT: return std::make_unique<LdltFactorization>();
+    case CholeskyBackend::Band: return std::make_unique<BandFactorization>();
+    case CholeskyBackend::CholmodSupernodal: return std::make_unique<CholmodFactorization>();
+    case CholeskyBackend::CholmodLibrary: return std::make_unique<CholmodLibraryFactorization>();
+  }
+  throw std::logic_error("SparseCholesky: unknown back-end");
+}
+
+}  // namespace
+
 SparseCholesky::SparseCholesky(std::optional<Backend> backend)
-    : automatic_(!backend),
-      backend_(backend.value_or(Backend::SimplicialLDLT)),
-      impl_(std::make_unique<Impl>()) {}
+    : automatic_(!backend), backend_(backend.value_or(Backend::SimplicialLDLT)) {
+  if (backend) factorization_ = make_factorization(*backend);
+}
 
 SparseCholesky::~SparseCholesky() = default;
 SparseCholesky::SparseCholesky(SparseCholesky&&) noexcept = default;
 SparseCholesky& SparseCholesky::operator=(SparseCholesky&&) noexcept = default;
 
 void SparseCholesky::analyze(const SparseMatrix& lower, const SparseMatrix* nodes) {
-  impl_->cholmod_analysed = false;
-  if (automatic_) backend_ = choose(lower, nodes);
-  switch (backend_) {
-    case Backend::SimplicialLDLT: impl_->ldlt.analyzePattern(lower); break;
-    case Backend::Band:
-      if (!automatic_) impl_->band.analyze(lower);  // choose() did
-      break;
-    case Backend::CholmodSupernodal:
-      if (!impl_->cholmod_analysed) analyze_sparse(impl_->cholmod, lower, nodes);
-      impl_->cholmod_blas_threads = !impl_->cholmod.own_kernels();
-      break;
-  }
+  if (automatic_) factorization_ = choose(lower, nodes);
+  else factorization_->analyze(lower, nodes);
 }
 
-SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower,
-                                               const SparseMatrix* nodes) {
+std::unique_ptr<Factorization> SparseCholesky::choose(const SparseMatrix& lower,
+                                                      const SparseMatrix* nodes) {
   // The band Cholesky after reverse Cuthill–McKee runs at several times the flop rate of the
   // sparse ones (dense kernels), so it is the faster while it does at most a few times their
   // flops. Measured on 2 cores with CHOLMOD on one thread (docs/benchmarks.md, "the back-end
@@ -124,6 +214,8 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower,
   // CHOLMOD's come from its analysis, kept if it wins.
   std::optional<SparseMatrix> found;
   if (!nodes && (found = node_pattern(lower))) nodes = &*found;
+  BandCholesky band;
+  PermutedCholmod cholmod;
   double sparse_flops = 0;
   auto estimate_sparse = [&] {
     if (nodes && small) {
@@ -133,73 +225,43 @@ SparseCholesky::Backend SparseCholesky::choose(const SparseMatrix& lower,
       ldlt.analyzePattern(lower);
       sparse_flops = ldlt.flops();
     } else {
-      analyze_sparse(impl_->cholmod, lower, nodes);
-      impl_->cholmod_analysed = true;
-      sparse_flops = impl_->cholmod.flops();
+      analyze_sparse(cholmod, lower, nodes);
+      sparse_flops = cholmod.flops();
     }
   };
   // The two analyses are independent: one on each core.
-  tbb::parallel_invoke([&] { impl_->band.analyze(lower, nodes); }, estimate_sparse);
+  tbb::parallel_invoke([&] { band.analyze(lower, nodes); }, estimate_sparse);
   const double allowance = small ? kLdltAllowance : kCholmodAllowance;
-  const bool band = impl_->band.flops() <= allowance * sparse_flops &&
-                    impl_->band.storage_bytes() <= kBandBytesLimit;
-  if (!band) impl_->band = BandCholesky();       // its layout (an index per entry) is not needed
-  if (band) impl_->cholmod = PermutedCholmod();  // nor CHOLMOD's analysis
-  impl_->cholmod_analysed = impl_->cholmod_analysed && !band;
-  return band ? Backend::Band : small ? Backend::SimplicialLDLT : Backend::CholmodSupernodal;
+  if (band.flops() <= allowance * sparse_flops && band.storage_bytes() <= kBandBytesLimit) {
+    backend_ = Backend::Band;
+    return std::make_unique<BandFactorization>(std::move(band));
+  }
+  if (!small) {
+    backend_ = Backend::CholmodSupernodal;
+    return std::make_unique<CholmodFactorization>(std::move(cholmod));
+  }
+  backend_ = Backend::SimplicialLDLT;
+  auto ldlt = std::make_unique<LdltFactorization>();
+  ldlt->analyze(lower, nodes);
+  return ldlt;
 }
 
 bool SparseCholesky::factorize(const SparseMatrix& lower) {
-  constexpr int kThreadedBandFrom = 256;  // sub-diagonals; measured crossover on 2 cores (solve)
-  switch (backend_) {
-    case Backend::Band: {
-      // The band factorization runs its own two threads over single-threaded BLAS calls
-      // (band_factor.hpp); the solves keep OpenBLAS's threads on wide bands.
-      use_blas_threads(false);
-      const bool positive_definite = impl_->band.factorize(lower);
-      use_blas_threads(impl_->band.bandwidth() >= kThreadedBandFrom);
-      return positive_definite;
-    }
-    case Backend::CholmodSupernodal: {
-      // Below PermutedCholmod::kOwnKernelsBelowFlops our own kernels factor, on this thread.
-      // Above it CHOLMOD does: its OpenMP on one thread (serial_openmp.hpp), its BLAS on all
-      // cores, for large factorizations are big dense blocks (docs/benchmarks.md, "CHOLMOD's
-      // OpenMP threads": all cores 10-15 % faster from 8e9 flops, 5-15 % slower to 1.3e9).
-      use_blas_threads(impl_->cholmod_blas_threads);
-      SerialOpenMp serial;
-      return impl_->cholmod.factorize(lower);
-    }
-    case Backend::SimplicialLDLT: break;
-  }
-  impl_->ldlt.factorize(lower);
-  if (impl_->ldlt.info() != Eigen::Success) return false;
-  // LDLᵀ also "succeeds" on indefinite matrices: positive definite means every pivot > 0,
-  // and a pivot tiny next to the largest means the matrix is singular in double precision.
-  const auto& D = impl_->ldlt.vectorD();
-  return D.minCoeff() > 1e-13 * D.cwiseAbs().maxCoeff();
+  return factorization_->factorize(lower);
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& rhs) const {
-  switch (backend_) {
-    case Backend::Band: return impl_->band.solve(rhs);
-    case Backend::CholmodSupernodal: return impl_->cholmod.solve(rhs);
-    case Backend::SimplicialLDLT: break;
-  }
-  return impl_->ldlt.solve(rhs);
+  return factorization_->solve(rhs);
 }
 
 Eigen::VectorXd SparseCholesky::solve_preconditioner(const Eigen::VectorXd& rhs) const {
-  if (backend_ == Backend::Band) return impl_->band.solve_single_precision(rhs);
-  return solve(rhs);
+  return factorization_->solve_preconditioner(rhs);
 }
 
 Eigen::VectorXd SparseCholesky::solve(const Eigen::VectorXd& rhs) const {
-  switch (backend_) {
-    case Backend::Band: return impl_->band.solve(rhs).col(0);
-    case Backend::CholmodSupernodal: return impl_->cholmod.solve(rhs);
-    case Backend::SimplicialLDLT: break;
-  }
-  return impl_->ldlt.solve(rhs);
+  return factorization_->solve(rhs);
 }
+
+bool SparseCholesky::cheap_to_solve() const { return factorization_->cheap_to_solve(); }
 
 }  // namespace shapectl

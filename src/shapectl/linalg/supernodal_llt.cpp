@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include <shapectl/linalg/own_kernel_calls.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -287,6 +289,7 @@ class LeftLooking {
 
 bool factorize_supernodal(const SparseMatrix& lower, const SupernodalPattern& pattern,
                           const std::vector<int>& team, double* values) {
+  count_own_kernel_call();
   const Supernodes supernodes(pattern, values);
   const int n = pattern.size();
   if (lower.rows() != n || lower.cols() != n || !lower.isCompressed())
@@ -320,11 +323,13 @@ std::vector<int> supernodal_teams(const SupernodalPattern& pattern) {
 
 void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
                                Eigen::VectorXd& x, const std::vector<int>& teams) {
+  count_own_kernel_call();
   forward_backward(pattern, teams, values, x);
 }
 
 void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
                                Eigen::MatrixXd& x, const std::vector<int>& teams) {
+  count_own_kernel_call();
   forward_backward(pattern, teams, values, x);
 }
 

@@ -340,8 +340,7 @@ StaticsSettings read_statics(const JsonInput& s) {
     const std::string name = s.at("linear_solver").string();
     CholeskyBackend backend;
     if (parse(name, &backend)) statics.backend = backend;
-    else if (name != "auto")
-      s.at("linear_solver").fail("\"auto\", \"ldlt\", \"band\" or \"cholmod\"");
+    else if (name != "auto") s.at("linear_solver").fail(linear_solver_choices());
   }
   if (s.has("max_iterations"))
     statics.max_iterations = static_cast<int>(s.at("max_iterations").integer_in(1, 100000));

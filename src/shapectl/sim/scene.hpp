@@ -36,7 +36,7 @@ struct NodeSelection {
 struct StaticsSettings {
   int max_iterations = 100;
   double relative_tolerance = 1e-6;        // force tolerance as a fraction of the object's weight
-  std::optional<CholeskyBackend> backend;  // "ldlt" | "band" | "cholmod"; default: from the matrix
+  std::optional<CholeskyBackend> backend;  // linear_solver_choices(); default: from the matrix
   // Newton steps by conjugate gradients preconditioned with a nearby state's factorization
   // (StaticsOptions::krylov_steps and cold_krylov_steps); off only to measure what they save
   // (`bench --no-krylov`).
