@@ -4,8 +4,8 @@
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 
+#include <shapectl/linalg/band_cholesky.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
-#include <shapectl/sim/band_cholesky.hpp>
 #include <shapectl/sim/object_statics.hpp>
 
 namespace shapectl {

@@ -1,8 +1,10 @@
 # The area_dependencies test: each area library declares (cmake/<area>.cmake) exactly the areas
-# its sources include, no fewer and no more.
+# its sources include, no fewer and no more, and includes only areas listed before it in
+# DECLARED (CMakeLists.txt's shapectl_areas, lowest first): no include upward, hence no cycle.
 #   cmake -DSOURCE_DIR=<repo> -DDECLARED="io:|mesh:io|fem:mesh|..." -P check_area_dependencies.cmake
 string(REPLACE "|" ";" entries "${DECLARED}")
 set(problems "")
+set(below "")  # the areas listed before this one
 foreach(entry IN LISTS entries)
   string(REGEX MATCH "^([a-z_]+):(.*)$" matched "${entry}")
   set(area ${CMAKE_MATCH_1})
@@ -20,13 +22,24 @@ foreach(entry IN LISTS entries)
   list(REMOVE_DUPLICATES included)
   list(SORT included)
   list(SORT declared)
+  set(upward ${included})
+  if(below)
+    list(REMOVE_ITEM upward ${below})
+  endif()
   if(NOT included STREQUAL declared)
     string(REPLACE ";" " " included "${included}")
     string(REPLACE ";" " " declared "${declared}")
     string(APPEND problems "\n  shapectl_${area}: sources include areas [${included}], "
                            "cmake/${area}.cmake links [${declared}]")
   endif()
+  if(upward)
+    string(REPLACE ";" " " upward "${upward}")
+    string(APPEND problems "\n  shapectl_${area}: sources include [${upward}], which is not below "
+                           "it (CMakeLists.txt's shapectl_areas lists it later, or not at all): "
+                           "an include upward")
+  endif()
+  list(APPEND below ${area})
 endforeach()
 if(problems)
-  message(FATAL_ERROR "area dependencies differ from includes:${problems}")
+  message(FATAL_ERROR "area dependencies differ from includes or point upward:${problems}")
 endif()

@@ -22,7 +22,8 @@ add_link_options(-fsanitize=thread)
 
 # GoogleTest filters by area (test binary).
 set(shapectl_tsan_fem "NeoHookean.*:GradientGather.*")
-set(shapectl_tsan_sim "SupernodalLlt.*Subtrees*:FactorBand.*:BandCholesky.*:SerialOpenMp.*:SparseCholesky.AutomaticChoice*:ObjectState.TwoThreads*:Statics.ClampedBar*:Statics.ChordSteps*")
+set(shapectl_tsan_linalg "SupernodalLlt.*Subtrees*:FactorBand.*:BandCholesky.*:SerialOpenMp.*:SparseCholesky.AutomaticChoice*")
+set(shapectl_tsan_sim "ObjectState.TwoThreads*:*StaticsEachSolver.ClampedBar*:Statics.ChordSteps*")
 set(shapectl_tsan_control "Controller.*")
 set(shapectl_tsan_calib "OnlineCalibrationTest.*")
 set(shapectl_tsan_link "SimLink.*:EgmLoopback.*")

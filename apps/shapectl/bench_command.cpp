@@ -24,6 +24,7 @@
 #include "bench_scaling.hpp"
 #include "bench_targets.hpp"
 #include "commands.hpp"
+#include "linear_solver_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 
@@ -43,6 +44,7 @@ struct BenchArgs {
   bool no_krylov = false;
   bool double_chord = false;
   std::string json;  // --json: the figures also as JSON (bench_json.hpp)
+  std::string linear_solver;
 };
 
 // Timings of one reduced-gradient variant, seconds.
@@ -249,7 +251,8 @@ void bench_calibration(const Scene& scene, const BenchArgs& args, nlohmann::json
 }
 
 void bench_scene(const std::string& file, const BenchArgs& args, nlohmann::json& record) {
-  const Scene scene = load_scene(file);
+  Scene scene = load_scene(file);
+  apply_linear_solver_option(args.linear_solver, scene);
   print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(file, "robot", "a scene with a robot (missing key)");
   GrippedObject object(scene);
@@ -289,6 +292,7 @@ void add_bench_command(CLI::App& app) {
   cmd->add_option("--trials", args->trials, "random target sets per measurement")
       ->check(CLI::Range(1, 10000));
   cmd->add_option("--seed", args->seed, "random seed");
+  add_linear_solver_option(*cmd, args->linear_solver);
   add_package_path_option(*cmd, args->package_paths);
   cmd->add_option("--sizes", args->sizes,
                   "instead: the scaling table, the scene's box mesh refined to about these tet "
@@ -305,13 +309,15 @@ void add_bench_command(CLI::App& app) {
       std::string("the scaling table at ") + kDefaultSizes + " tets (--sizes " + kDefaultSizes +
           ")");
   cmd->callback([args, scenes] {
+    check_linear_solver_option("bench", args->linear_solver);
     nlohmann::json record = nlohmann::json::object();
     if (!args->sizes.empty()) {
       const auto counts = parse_tet_counts(args->sizes, "--sizes");
       bench_scaling(scenes->count() ? args->scenes.front() : "scenes/yumi_bar.json", counts,
                     args->trials, args->seed,
                     {.krylov_steps = !args->no_krylov,
-                     .single_precision_chord = !args->double_chord},
+                     .single_precision_chord = !args->double_chord,
+                     .linear_solver = args->linear_solver},
                     record["sizes"]);
       write_bench_record(args->json, record);
       return;

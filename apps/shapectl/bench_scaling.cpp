@@ -11,6 +11,7 @@
 #include <shapectl/scene_io/scene_file.hpp>
 
 #include "bench_targets.hpp"
+#include "linear_solver_option.hpp"
 
 namespace shapectl::cli {
 
@@ -207,6 +208,7 @@ void bench_scaling(const std::string& scene_file, const std::vector<int>& tet_co
   Scene scene = load_scene(scene_file);
   scene.statics.krylov_steps = levers.krylov_steps;
   scene.statics.single_precision_chord = levers.single_precision_chord;
+  apply_linear_solver_option(levers.linear_solver, scene);
   if (!scene.robot) throw InputError(scene_file, "robot", "a scene with a robot (missing key)");
   const auto cells = box_cells(*scene.object_mesh);
   const bool refines = std::any_of(tet_counts.begin(), tet_counts.end(),

@@ -21,6 +21,7 @@ std::vector<int> parse_tet_counts(const std::string& text, const std::string& op
 struct ScalingLevers {
   bool krylov_steps = true;            // conjugate-gradient steps (`--no-krylov`)
   bool single_precision_chord = true;  // chord/Krylov solves in float (`--double-chord`)
+  std::string linear_solver;           // `--linear-solver`, checked (empty: the scene's)
 };
 
 // Runs and prints the table for the scene file (to refine, its object must be a box mesh

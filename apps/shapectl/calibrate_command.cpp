@@ -14,6 +14,7 @@
 #include <shapectl/scene_io/scene_writer.hpp>
 
 #include "commands.hpp"
+#include "linear_solver_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 
@@ -25,6 +26,7 @@ struct CalibrateArgs {
   std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::string scene, observations, out, report;
   std::string fit;  // default: default_fit(scene)
+  std::string linear_solver;
   int max_iterations = 30;
   double max_seconds = 300;  // the whole command
 };
@@ -113,7 +115,9 @@ void run_calibrate(const CalibrateArgs& args) {
   if (!(args.max_seconds > 0))
     throw InputError("calibrate", "--max-seconds", "a positive number of seconds",
                      args.max_seconds);
-  const Scene scene = load_scene(args.scene);
+  check_linear_solver_option("calibrate", args.linear_solver);
+  Scene scene = load_scene(args.scene);
+  apply_linear_solver_option(args.linear_solver, scene);
   print_scene_notes(scene, args.package_paths);
   const FitSelection fit = fit_selection(args, scene);
   const Observations observations =
@@ -165,6 +169,7 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--max-seconds", args->max_seconds,
                   "time limit of the whole command: the fit stops with the best values so far")
       ->capture_default_str();
+  add_linear_solver_option(*cmd, args->linear_solver);
   add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] { run_calibrate(*args); });
 }

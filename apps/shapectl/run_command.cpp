@@ -35,6 +35,7 @@
 
 #include "closed_loop_options.hpp"
 #include "commands.hpp"
+#include "linear_solver_option.hpp"
 #include "link_options.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
@@ -63,6 +64,7 @@ struct RunArgs {
   // A real camera's frames: one JSON frame per UDP datagram (calib/observation_receiver.hpp).
   int observations_udp = -1;  // port; -1: none
   std::string observations_address = "127.0.0.1";
+  std::string linear_solver;
 };
 
 // Whether frames will arrive: only then do feedback and calibration matter.
@@ -132,7 +134,10 @@ std::unique_ptr<SimulatedWorld> make_world(const RunArgs& args, const Scene& mod
 
 // The scene (with a robot) and the targets, checked; the link settings completed from them.
 RunInputs load_run_inputs(RunArgs& args) {
+  check_linear_solver_option("run", args.linear_solver);
   Scene scene = load_scene(args.scene);
+  apply_linear_solver_option(args.linear_solver,
+                             scene);  // the controller's, the fits', the world's
   print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(args.scene, "robot", "run needs a scene with a robot");
   TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
@@ -436,6 +441,7 @@ void add_run_command(CLI::App& app) {
   cmd->add_option("--timeout", args->timeout, "seconds before giving up (0: none)")
       ->capture_default_str();
   add_tolerance_option(*cmd, args->tolerance);
+  add_linear_solver_option(*cmd, args->linear_solver);
   add_link_options(*cmd, args->link_options);
   add_closed_loop_options(*cmd, args->loop, /*feedback_flag=*/true);
   cmd->add_option("--observations-udp", args->observations_udp,

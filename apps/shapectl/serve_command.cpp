@@ -14,6 +14,7 @@
 
 #include "closed_loop_options.hpp"
 #include "commands.hpp"
+#include "linear_solver_option.hpp"
 #include "link_options.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
@@ -38,6 +39,7 @@ struct ServeArgs {
   ClosedLoopArgs loop;      // the simulated real object, the online calibration
   // --package-path: the URDF's package:// meshes
   std::vector<std::string> package_paths;
+  std::string linear_solver;
 };
 
 // The session log if --log names one, opened with a "session" event; else null.
@@ -54,6 +56,7 @@ std::shared_ptr<SessionLog> open_serve_log(const ServeArgs& args,
 }
 
 void run_serve(const ServeArgs& args) {
+  check_linear_solver_option("serve", args.linear_solver);
   server::ServerOptions options;
   options.host = args.host;
   options.port = static_cast<unsigned short>(args.port);
@@ -88,6 +91,7 @@ void run_serve(const ServeArgs& args) {
   }
   ControllerOptions controller_options;
   controller_options.tolerance = args.tolerance;
+  controller_options.linear_solver = linear_solver_override(args.linear_solver);
   server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(),
                           controller_options, online_calibration_options(args.loop, "serve"),
                           package_paths(args.package_paths));
@@ -98,7 +102,9 @@ void run_serve(const ServeArgs& args) {
       throw InputError("serve", "--world", "--robot sim (a real robot holds a real object)");
     // Markers on the target nodes, set at every tick.
     const SimulatedCamera camera = simulated_camera(args.loop, "serve");
-    session.set_world(simulated_world(args.loop, load_scene(scene), camera));
+    Scene world = load_scene(scene);
+    apply_linear_solver_option(args.linear_solver, world);
+    session.set_world(simulated_world(args.loop, world, camera));
   }
   server::Server server(session, options);
   std::cout << "shapectl serve: open " << server.url() << " (scene " << session.scene_name()
@@ -144,6 +150,7 @@ void add_serve_command(CLI::App& app) {
       ->capture_default_str();
   add_package_path_option(*cmd, args->package_paths);
   add_tolerance_option(*cmd, args->tolerance);
+  add_linear_solver_option(*cmd, args->linear_solver);
   cmd->callback([args] { run_serve(*args); });
 }
 

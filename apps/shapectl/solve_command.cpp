@@ -20,6 +20,7 @@
 #include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
+#include "linear_solver_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 #include "surface_option.hpp"
@@ -31,6 +32,7 @@ namespace {
 struct SolveArgs {
   std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::string scene, targets, out, vtu, surface;
+  std::string linear_solver;
   std::string optimizer = "gauss-newton";
   std::string gradient = "sensitivity";
   int max_iterations = 100;
@@ -70,7 +72,9 @@ void run_solve(const SolveArgs& args) {
   const double aim = 0.9 * args.max_seconds;
   const StopRequest out_of_time = [&] { return elapsed() > aim; };
   check_surface_option("solve", args.surface);
-  const Scene scene = load_scene(args.scene);
+  check_linear_solver_option("solve", args.linear_solver);
+  Scene scene = load_scene(args.scene);
+  apply_linear_solver_option(args.linear_solver, scene);
   print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(args.scene, "robot", "a robot to optimize (missing key)");
   GrippedObject object(scene);
@@ -165,6 +169,7 @@ void add_solve_command(CLI::App& app) {
   cmd->add_option("--vtu", args->vtu,
                   "also write the deformed mesh at the best joints as VTU (ParaView)");
   add_surface_option(*cmd, args->surface);
+  add_linear_solver_option(*cmd, args->linear_solver);
   cmd->add_option("--optimizer", args->optimizer, "gauss-newton (default) or lbfgs")
       ->check(CLI::IsMember(optimizer_names()));
   cmd->add_option("--gradient", args->gradient,

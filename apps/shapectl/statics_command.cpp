@@ -15,6 +15,7 @@
 #include <shapectl/sim/gripped_object.hpp>
 
 #include "commands.hpp"
+#include "linear_solver_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 #include "surface_option.hpp"
@@ -30,6 +31,7 @@ struct StaticsArgs {
   std::string out;
   std::string vtu;
   std::string surface;
+  std::string linear_solver;
 };
 
 // Writes RESULT.json (and the VTU) even when Newton failed, so the failure can be inspected,
@@ -65,7 +67,9 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 void run_statics(const StaticsArgs& args) {
   check_surface_option("statics", args.surface);
-  const Scene scene = load_scene(args.scene);
+  check_linear_solver_option("statics", args.linear_solver);
+  Scene scene = load_scene(args.scene);
+  apply_linear_solver_option(args.linear_solver, scene);
   print_scene_notes(scene, args.package_paths);
   const auto start = std::chrono::steady_clock::now();  // the files are read
   const Positions rest = scene.world_rest_positions();
@@ -97,6 +101,7 @@ void add_statics_command(CLI::App& app) {
   cmd->add_option("--out", args->out, "RESULT.json to write")->required();
   cmd->add_option("--vtu", args->vtu, "also write the deformed mesh as VTU (ParaView)");
   add_surface_option(*cmd, args->surface);
+  add_linear_solver_option(*cmd, args->linear_solver);
   add_package_path_option(*cmd, args->package_paths);
   cmd->callback([args] { run_statics(*args); });
 }

@@ -6,6 +6,7 @@
 #include <shapectl/mesh/box_mesh.hpp>
 
 #include "support/derivative_check.hpp"
+#include "support/linear_solvers.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
@@ -30,8 +31,11 @@ Positions equilibrium(const Scene& scene, const Eigen::VectorXd& joints, const P
   return state.positions();
 }
 
-TEST(ParameterSensitivity, EveryFittableParameterMatchesCentralDifferences) {
-  const Scene scene = offset_scene();
+// Force responses from each linear solver's factor (support/linear_solvers.hpp).
+class ParameterSensitivity : public test::EachLinearSolver {};
+
+TEST_P(ParameterSensitivity, EveryFittableParameterMatchesCentralDifferences) {
+  const Scene scene = with_solver(offset_scene());
   const FitSelection all{.youngs_modulus = true,
                          .poisson_ratio = true,
                          .density = true,
@@ -89,8 +93,8 @@ Positions clamped_equilibrium(const Scene& scene) {
 
 // The pose's columns: its rigid motion plus the response to the gravity it turns, without which
 // the rotations about x and y would be off by 34 % and 4 % (measured errors ~1e-10).
-TEST(ParameterSensitivity, MaterialAndPoseOfAClampedBarMatchCentralDifferences) {
-  const Scene scene = clamped_scene();
+TEST_P(ParameterSensitivity, MaterialAndPoseOfAClampedBarMatchCentralDifferences) {
+  const Scene scene = with_solver(clamped_scene());
   const ParameterSpace space(
       scene, {.youngs_modulus = true, .poisson_ratio = true, .density = true, .object_pose = true});
   ASSERT_EQ(space.size(), 3 + 6);
@@ -123,6 +127,9 @@ TEST(ParameterSensitivity, MaterialAndPoseOfAClampedBarMatchCentralDifferences) 
     }
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Each, ParameterSensitivity, testing::ValuesIn(test::kLinearSolvers),
+                         test::linear_solver_name);
 
 TEST(ParameterSpace, AppliedParametersRoundTripThroughTheScene) {
   const Scene scene = offset_scene();

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <csignal>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include <shapectl/scene_io/scene_file.hpp>
 
@@ -115,6 +116,89 @@ TEST(StaticsCli, UnknownKeyIsNamedWithTheKnownOnes) {
   EXPECT_NE(run.err.find("typo.json: object.materail: unknown key; known: mesh, material"),
             std::string::npos)
       << run.err;
+}
+
+// The clamped bar with "statics": {"linear_solver": `name`}.
+std::string bar_with_linear_solver(const std::string& name) {
+  std::string text = kBarScene;
+  text.replace(text.find("\"gravity\""), 9,
+               "\"statics\": {\"linear_solver\": \"" + name + "\"}, \"gravity\"");
+  return text;
+}
+
+// The positions of RESULT.json, stacked.
+std::vector<double> result_positions(const std::filesystem::path& result) {
+  const nlohmann::json json = nlohmann::json::parse(test::read_text(result));
+  std::vector<double> x;
+  for (const auto& p : json["positions"])
+    for (const auto& c : p) x.push_back(c.get<double>());
+  return x;
+}
+
+// --linear-solver overrides the scene's "statics.linear_solver": the result is the one of a
+// scene naming that solver, to the last bit, and CHOLMOD's own factorization reaches LDLᵀ's
+// equilibrium within 1e-8 m (by another rounding: the option is not ignored).
+TEST(StaticsCli, LinearSolverOptionOverridesTheScenes) {
+  TempDir dir;
+  const auto ldlt_scene = dir.write("ldlt.json", bar_with_linear_solver("ldlt"));
+  const auto library_scene = dir.write("library.json", bar_with_linear_solver("cholmod-library"));
+  const auto solve = [&](const std::filesystem::path& scene, std::vector<std::string> extra) {
+    const auto out = dir.path() / "result.json";
+    std::vector<std::string> args = {"statics", scene.string(), "--out", out.string()};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto run = run_cli(args);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return result_positions(out);
+  };
+  const std::vector<double> ldlt = solve(ldlt_scene, {});
+  const std::vector<double> overridden = solve(ldlt_scene, {"--linear-solver", "cholmod-library"});
+  const std::vector<double> library = solve(library_scene, {});
+  ASSERT_EQ(ldlt.size(), 81u * 3u);
+  EXPECT_EQ(overridden, library);
+  EXPECT_NE(overridden, ldlt);
+  double largest = 0;
+  for (std::size_t k = 0; k < ldlt.size(); ++k)
+    largest = std::max(largest, std::abs(overridden[k] - ldlt[k]));
+  EXPECT_LE(largest, 1e-8);
+  // And back: the option's "ldlt" over the scene's CHOLMOD.
+  EXPECT_EQ(solve(library_scene, {"--linear-solver", "ldlt"}), ldlt);
+}
+
+TEST(StaticsCli, UnknownLinearSolverIsRefusedWithTheChoices) {
+  TempDir dir;
+  const auto out = (dir.path() / "r.json").string();
+  const auto scene = dir.write("bar.json", kBarScene);
+  const auto option = run_cli({"statics", scene.string(), "--out", out, "--linear-solver", "qr"});
+  EXPECT_EQ(option.exit_code, 1);
+  EXPECT_NE(option.err.find("--linear-solver: expected \"auto\", \"ldlt\", \"band\", \"cholmod\" "
+                            "or \"cholmod-library\", got"),
+            std::string::npos)
+      << option.err;
+  const auto key = dir.write("key.json", bar_with_linear_solver("qr"));
+  const auto file = run_cli({"statics", key.string(), "--out", out});
+  EXPECT_EQ(file.exit_code, 1);
+  EXPECT_NE(file.err.find("statics.linear_solver"), std::string::npos) << file.err;
+  EXPECT_NE(file.err.find("\"cholmod-library\""), std::string::npos) << file.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// Every command with --linear-solver checks it before reading any file.
+TEST(StaticsCli, EveryCommandWithTheLinearSolverOptionRefusesAnUnknownName) {
+  const std::string none = "/nonexistent/x.json";
+  const std::vector<std::vector<std::string>> commands = {{"solve", none, "--targets", none,
+                                                           "--out", none},
+                                                          {"calibrate", none, "--observations",
+                                                           none, "--out", none},
+                                                          {"bench", none},
+                                                          {"run", none, "--targets", none},
+                                                          {"serve", none}};
+  for (std::vector<std::string> command : commands) {
+    command.insert(command.end(), {"--linear-solver", "qr"});
+    const auto run = run_cli(command);
+    EXPECT_EQ(run.exit_code, 1) << command[0] << ": " << run.err;
+    EXPECT_NE(run.err.find("--linear-solver: expected"), std::string::npos) << run.err;
+    EXPECT_NE(run.err.find("\"cholmod-library\""), std::string::npos) << run.err;
+  }
 }
 
 TEST(StaticsCli, NonFiniteAndUnphysicalNumbersAreRejected) {

@@ -7,9 +7,12 @@
 #include <limits>
 #include <numeric>
 #include <random>
+#include <string>
+#include <tuple>
 
 #include <shapectl/scene_io/scene_file.hpp>
 
+#include "support/linear_solvers.hpp"
 #include "support/test_support.hpp"
 #include "support/two_arm_scene.hpp"
 
@@ -41,10 +44,17 @@ ShapeTargets grips_swapped(const Scene& scene, const Positions& x0, double shift
   return t;
 }
 
-class OptimizeTest : public ::testing::TestWithParam<OptimizerKind> {};
+// Each optimizer with each linear solver (support/linear_solvers.hpp).
+class OptimizeTest : public ::testing::TestWithParam<std::tuple<OptimizerKind, CholeskyBackend>> {
+ protected:
+  OptimizerKind kind() const { return std::get<0>(GetParam()); }
+  Scene with_solver(Scene scene) const {
+    return test::with_solver(std::move(scene), std::get<1>(GetParam()));
+  }
+};
 
 TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
-  const Scene scene = test::two_arm_scene({24, 2, 2});
+  const Scene scene = with_solver(test::two_arm_scene({24, 2, 2}));
   GrippedObject object(scene);
   ReducedObjective objective(object);
   for (unsigned seed : {1u, 2u, 3u, 4u}) {
@@ -59,7 +69,7 @@ TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
     const Evaluation start =
         objective.evaluate(object.reference_joints(), object.reference_positions());
     ASSERT_GT(start.error.mean, 3e-3) << "the targets should be a real change";
-    auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
+    auto optimizer = make_optimizer(kind(), GradientMethod::Sensitivity);
     const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 200});
     EXPECT_LT(result.best.error.mean, 1e-3) << "seed " << seed << ": " << result.reason;
     EXPECT_TRUE(result.best.safe());
@@ -68,14 +78,14 @@ TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
 
 TEST_P(OptimizeTest, TargetsThroughEachOtherEndSafe) {
   // Pull the left end to the right of the right end and vice versa: the arms would cross.
-  const Scene scene = test::two_arm_scene();
+  const Scene scene = with_solver(test::two_arm_scene());
   GrippedObject object(scene);
   ReducedObjective objective(object);
   const Positions x0 = object.reference_positions();
   objective = objective.with_targets(grips_swapped(scene, x0, 0.4));
   const Evaluation start = objective.evaluate(object.reference_joints(), x0);
   ASSERT_TRUE(start.safe());
-  auto optimizer = make_optimizer(GetParam(), GradientMethod::Adjoint);
+  auto optimizer = make_optimizer(kind(), GradientMethod::Adjoint);
   const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 100});
   EXPECT_GE(result.best.min_clearance, 0.0);
   EXPECT_TRUE(result.best.within_limits);
@@ -85,7 +95,7 @@ TEST_P(OptimizeTest, TargetsThroughEachOtherEndSafe) {
 }
 
 TEST_P(OptimizeTest, UnreachableTargetsGiveAnHonestBestEffort) {
-  const Scene scene = test::two_arm_scene();
+  const Scene scene = with_solver(test::two_arm_scene());
   GrippedObject object(scene);
   ReducedObjective objective(object);
   ShapeTargets t;
@@ -94,7 +104,7 @@ TEST_P(OptimizeTest, UnreachableTargetsGiveAnHonestBestEffort) {
   objective = objective.with_targets(t);
   const Evaluation start =
       objective.evaluate(object.reference_joints(), object.reference_positions());
-  auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
+  auto optimizer = make_optimizer(kind(), GradientMethod::Sensitivity);
   const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 60});
   EXPECT_TRUE(result.best.safe());
   EXPECT_TRUE(result.best.positions().allFinite());
@@ -108,7 +118,7 @@ TEST_P(OptimizeTest, UnreachableTargetsGiveAnHonestBestEffort) {
 // just cleared. Now no optimizer steps, and none says "converged".
 TEST_P(OptimizeTest, NonFiniteObjectiveNeitherCrashesNorConverges) {
   for (const double weight : {1e305, std::numeric_limits<double>::quiet_NaN()}) {
-    Scene scene = test::two_arm_scene();
+    Scene scene = with_solver(test::two_arm_scene());
     scene.weights.shape = weight;
     GrippedObject object(scene);
     ReducedObjective objective(object);
@@ -121,7 +131,7 @@ TEST_P(OptimizeTest, NonFiniteObjectiveNeitherCrashesNorConverges) {
     ASSERT_TRUE(start.statics().converged());
     ASSERT_FALSE(std::isfinite(start.objective)) << "the test needs a non-finite objective";
     for (const GradientMethod method : {GradientMethod::Sensitivity, GradientMethod::Adjoint}) {
-      auto optimizer = make_optimizer(GetParam(), method);
+      auto optimizer = make_optimizer(kind(), method);
       Evaluation current = start;
       EXPECT_EQ(optimizer->step(objective, current), StepOutcome::Stuck) << weight;
       EXPECT_EQ(current.joints(), start.joints());
@@ -137,7 +147,7 @@ TEST_P(OptimizeTest, NonFiniteObjectiveNeitherCrashesNorConverges) {
 // gradients). Every solve and gradient is preceded by a budget check, so the work ends at most
 // one unit past the budget, whatever the budget and wherever in a step it runs out.
 TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
-  const Scene scene = test::two_arm_scene();
+  const Scene scene = with_solver(test::two_arm_scene());
   GrippedObject object(scene);
   ReducedObjective objective(object);
   std::mt19937 rng(5);
@@ -160,7 +170,7 @@ TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
       return static_cast<double>(now.statics_solves - before.statics_solves +
                                  now.gradient_evaluations - before.gradient_evaluations);
     };
-    auto optimizer = make_optimizer(GetParam(), GradientMethod::Sensitivity);
+    auto optimizer = make_optimizer(kind(), GradientMethod::Sensitivity);
     const OptimizeResult result =
         optimize(fresh, *optimizer, start,
                  {.max_iterations = 1000, .max_seconds = max_seconds, .clock = work});
@@ -180,12 +190,19 @@ TEST_P(OptimizeTest, TimeBudgetIsOverrunByAtMostOneSolveOrGradient) {
   }
 }
 
+// Test names: the optimizer and the linear solver, "GaussNewton_ldlt".
+std::string optimizer_and_solver(
+    const testing::TestParamInfo<std::tuple<OptimizerKind, CholeskyBackend>>& info) {
+  return std::string(std::get<0>(info.param) == OptimizerKind::GaussNewton ? "GaussNewton"
+                                                                           : "Lbfgs") +
+         "_" + test::linear_solver_suffix(std::get<1>(info.param));
+}
+
 INSTANTIATE_TEST_SUITE_P(BothOptimizers, OptimizeTest,
-                         ::testing::Values(OptimizerKind::GaussNewton, OptimizerKind::Lbfgs),
-                         [](const auto& info) {
-                           return info.param == OptimizerKind::GaussNewton ? "GaussNewton"
-                                                                           : "Lbfgs";
-                         });
+                         ::testing::Combine(::testing::Values(OptimizerKind::GaussNewton,
+                                                              OptimizerKind::Lbfgs),
+                                            ::testing::ValuesIn(test::kLinearSolvers)),
+                         optimizer_and_solver);
 
 }  // namespace
 }  // namespace shapectl
@@ -199,7 +216,14 @@ class YumiBar : public ::testing::Test {
   Scene scene = load_scene(test::source_path("scenes/yumi_bar.json"));
 };
 
-TEST_F(YumiBar, ReachableTargetsAreReachedOverSeveralSeeds) {
+// Reaching targets with each linear solver; the 2.6 s collision case below with the automatic
+// choice only.
+class YumiBarEachSolver : public test::EachLinearSolver {
+ protected:
+  Scene scene = with_solver(load_scene(test::source_path("scenes/yumi_bar.json")));
+};
+
+TEST_P(YumiBarEachSolver, ReachableTargetsAreReachedOverSeveralSeeds) {
   GrippedObject object(scene);
   ReducedObjective objective(object);
   const Evaluation reference =
@@ -224,6 +248,9 @@ TEST_F(YumiBar, ReachableTargetsAreReachedOverSeveralSeeds) {
     EXPECT_TRUE(result.best.safe());
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Each, YumiBarEachSolver, testing::ValuesIn(test::kLinearSolvers),
+                         test::linear_solver_name);
 
 TEST_F(YumiBar, TargetsPullingTheGrippersThroughEachOtherEndCollisionFree) {
   GrippedObject object(scene);

@@ -8,6 +8,7 @@
 #include <shapectl/io/input_error.hpp>
 
 #include "support/derivative_check.hpp"
+#include "support/linear_solvers.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
@@ -24,8 +25,11 @@ ShapeTargets some_targets(const GrippedObject& object, std::mt19937& rng) {
   return t;
 }
 
-TEST(ReducedObjective, GradientAgreesAllThreeWaysWithCentralDifferences) {
-  Scene scene = test::two_arm_scene();
+// Gradients from each linear solver's factor (support/linear_solvers.hpp).
+class ReducedObjectiveEachSolver : public test::EachLinearSolver {};
+
+TEST_P(ReducedObjectiveEachSolver, GradientAgreesAllThreeWaysWithCentralDifferences) {
+  Scene scene = with_solver(test::two_arm_scene());
   scene.statics.relative_tolerance = 1e-11;
   GrippedObject object(scene);
   std::mt19937 rng(11);
@@ -58,8 +62,8 @@ TEST(ReducedObjective, GradientAgreesAllThreeWaysWithCentralDifferences) {
   }
 }
 
-TEST(ReducedObjective, LeastSquaresFormMatchesObjectiveAndGradient) {
-  Scene scene = test::two_arm_scene();
+TEST_P(ReducedObjectiveEachSolver, LeastSquaresFormMatchesObjectiveAndGradient) {
+  Scene scene = with_solver(test::two_arm_scene());
   scene.statics.relative_tolerance = 1e-11;
   GrippedObject object(scene);
   std::mt19937 rng(12);
@@ -85,6 +89,9 @@ TEST(ReducedObjective, LeastSquaresFormMatchesObjectiveAndGradient) {
   EXPECT_TRUE(test::derivative_matches(J, test::central_difference_jacobian(residuals, theta, 1e-6),
                                        1e-5, "least-squares Jacobian"));
 }
+
+INSTANTIATE_TEST_SUITE_P(Each, ReducedObjectiveEachSolver, testing::ValuesIn(test::kLinearSolvers),
+                         test::linear_solver_name);
 
 TEST(ReducedObjective, ConfirmStableRejectsAStateWhoseHessianIsIndefinite) {
   const Scene scene = test::two_arm_scene();

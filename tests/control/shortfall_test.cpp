@@ -10,6 +10,7 @@
 
 #include <shapectl/robot/collision_spheres.hpp>
 
+#include "support/linear_solvers.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
@@ -39,8 +40,11 @@ Eigen::VectorXd joints(double l1, double l2, double l3, double r1, double r2, do
   return theta;
 }
 
-TEST(Shortfall, JointAtItsLimitThatTheTargetsPushFurther) {
-  Scene scene = test::two_arm_scene();
+// Each reason found alike with each linear solver (support/linear_solvers.hpp).
+class ShortfallEachSolver : public test::EachLinearSolver {};
+
+TEST_P(ShortfallEachSolver, JointAtItsLimitThatTheTargetsPushFurther) {
+  Scene scene = with_solver(test::two_arm_scene());
   // l3 may bend only to 0.95 rad; the reference holds it at 0.9, inside the 0.05 margin.
   std::string urdf = test::two_arm_urdf();
   const std::string limit = "<limit lower='-2.5' upper='2.5'";
@@ -69,9 +73,9 @@ TEST(Shortfall, JointAtItsLimitThatTheTargetsPushFurther) {
                    Shortfall::JointLimit));
 }
 
-TEST(Shortfall, SpheresWithinTheMarginThatTheTargetsPushTogether) {
+TEST_P(ShortfallEachSolver, SpheresWithinTheMarginThatTheTargetsPushTogether) {
   // The third links' spheres 4 mm apart at the reference, inside the 5 mm margin.
-  const Scene scene = test::two_arm_scene_with_clearance(0.004);
+  const Scene scene = with_solver(test::two_arm_scene_with_clearance(0.004));
   const GrippedObject object(scene);
   const ReducedObjective probe(object);
   const Evaluation at = probe.evaluate(object.reference_joints(), object.reference_positions());
@@ -91,8 +95,8 @@ TEST(Shortfall, SpheresWithinTheMarginThatTheTargetsPushTogether) {
                    Shortfall::Collision));
 }
 
-TEST(Shortfall, ArmsStretchedTowardsTargetsBeyondTheirReach) {
-  const Scene scene = test::two_arm_scene();
+TEST_P(ShortfallEachSolver, ArmsStretchedTowardsTargetsBeyondTheirReach) {
+  const Scene scene = with_solver(test::two_arm_scene());
   const GrippedObject object(scene);
   const ReducedObjective probe(object);
   // Both arms straight up (their full 0.55 m), the targets 20 cm above the bar held there.
@@ -112,8 +116,8 @@ TEST(Shortfall, ArmsStretchedTowardsTargetsBeyondTheirReach) {
   EXPECT_FALSE(has(bent, Shortfall::Reach)) << bent.detail;
 }
 
-TEST(Shortfall, NoneOfTheFourIsALocalMinimumSaidAsSuch) {
-  const Scene scene = test::two_arm_scene();
+TEST_P(ShortfallEachSolver, NoneOfTheFourIsALocalMinimumSaidAsSuch) {
+  const Scene scene = with_solver(test::two_arm_scene());
   const GrippedObject object(scene);
   const ReducedObjective probe(object);
   // A target 5 cm below the bar's middle at the reference: nothing limits the arms there.
@@ -125,6 +129,9 @@ TEST(Shortfall, NoneOfTheFourIsALocalMinimumSaidAsSuch) {
   EXPECT_TRUE(r.reasons.empty()) << r.detail;
   EXPECT_NE(r.detail.find("local minimum"), std::string::npos);
 }
+
+INSTANTIATE_TEST_SUITE_P(Each, ShortfallEachSolver, testing::ValuesIn(test::kLinearSolvers),
+                         test::linear_solver_name);
 
 }  // namespace
 }  // namespace shapectl

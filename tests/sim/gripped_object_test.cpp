@@ -5,6 +5,7 @@
 #include <random>
 
 #include "support/derivative_check.hpp"
+#include "support/linear_solvers.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
@@ -87,8 +88,11 @@ TEST(GrippedObject, CarriedGrippedNodesKeepTheirSpringLengths) {
     }
 }
 
-TEST(GrippedObject, SensitivityMatchesCentralDifferencesOfStatics) {
-  Scene scene = test::two_arm_scene();
+// Sensitivities from each linear solver's factor (support/linear_solvers.hpp).
+class GrippedObjectEachSolver : public test::EachLinearSolver {};
+
+TEST_P(GrippedObjectEachSolver, SensitivityMatchesCentralDifferencesOfStatics) {
+  Scene scene = with_solver(test::two_arm_scene());
   scene.statics.relative_tolerance = 1e-11;  // FD of equilibria needs them tight
   GrippedObject object(scene);
   std::mt19937 rng(3);
@@ -113,6 +117,9 @@ TEST(GrippedObject, SensitivityMatchesCentralDifferencesOfStatics) {
                                          "adjoint (dx/dθ)ᵀv"));
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Each, GrippedObjectEachSolver, testing::ValuesIn(test::kLinearSolvers),
+                         test::linear_solver_name);
 
 // The same check with the perturbed equilibria re-solved by Krylov steps (conjugate gradients
 // preconditioned with x̂(θ)'s factorization, each to Eisenstat–Walker's relative residual

@@ -8,8 +8,8 @@
 
 #include <shapectl/fem/gravity.hpp>
 #include <shapectl/fem/neo_hookean.hpp>
+#include <shapectl/linalg/node_pattern.hpp>
 #include <shapectl/sim/gripped_object.hpp>
-#include <shapectl/sim/node_pattern.hpp>
 
 #include "support/derivative_check.hpp"
 #include "support/two_arm_scene.hpp"

@@ -11,6 +11,7 @@
 
 #include <shapectl/mesh/box_mesh.hpp>
 
+#include "support/linear_solvers.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
@@ -33,16 +34,21 @@ std::vector<double> log_spaced(double from, double to, int count) {
   return v;
 }
 
-void expect_converges(const Scene& scene, const std::string& what) {
-  ObjectStatics statics(scene);
-  Positions x = scene.world_rest_positions();
-  const StaticsResult r = statics.solve(x);
-  EXPECT_TRUE(r.converged()) << what << ": " << r.reason;
-  EXPECT_TRUE(std::isfinite(r.residual) && r.residual <= statics.force_tolerance()) << what;
-  EXPECT_TRUE(x.allFinite()) << what;
-}
+// Each sweep with each linear solver (support/linear_solvers.hpp).
+class StaticsSweep : public test::EachLinearSolver {
+ protected:
+  void expect_converges(const Scene& described, const std::string& what) const {
+    const Scene scene = with_solver(described);
+    ObjectStatics statics(scene);
+    Positions x = scene.world_rest_positions();
+    const StaticsResult r = statics.solve(x);
+    EXPECT_TRUE(r.converged()) << what << ": " << r.reason;
+    EXPECT_TRUE(std::isfinite(r.residual) && r.residual <= statics.force_tolerance()) << what;
+    EXPECT_TRUE(x.allFinite()) << what;
+  }
+};
 
-TEST(StaticsSweep, ClampedFoamBarConvergesForEveryMaterial) {
+TEST_P(StaticsSweep, ClampedFoamBarConvergesForEveryMaterial) {
   // The scene's own mesh (16 x 4 x 4 cells, 1,536 tets), 10 x 10 materials: the dense sweep in
   // which 8 of 100 failed before.
   for (double E : log_spaced(5e4, 5e9, 10))
@@ -51,14 +57,14 @@ TEST(StaticsSweep, ClampedFoamBarConvergesForEveryMaterial) {
                        "E " + std::to_string(E) + " Pa, density " + std::to_string(rho));
 }
 
-TEST(StaticsSweep, CoarseClampedBarConvergesForEveryMaterial) {
+TEST_P(StaticsSweep, CoarseClampedBarConvergesForEveryMaterial) {
   for (double E : log_spaced(5e4, 5e9, 7))
     for (double rho : log_spaced(0.1, 100, 5))
       expect_converges(clamped_foam_bar({8, 2, 2}, E, rho),
                        "E " + std::to_string(E) + " Pa, density " + std::to_string(rho));
 }
 
-TEST(StaticsSweep, CantileverMeshesConvergeForRandomValidMaterials) {
+TEST_P(StaticsSweep, CantileverMeshesConvergeForRandomValidMaterials) {
   // The cantilever test's meshes (it failed on an AMD machine at 9.45e-8 N after 100
   // iterations, round-off, not divergence) with random valid materials around its own.
   std::mt19937 rng(2026);
@@ -76,7 +82,7 @@ TEST(StaticsSweep, CantileverMeshesConvergeForRandomValidMaterials) {
   }
 }
 
-TEST(StaticsSweep, TolerancesBelowRoundoffStillConvergeHonestly) {
+TEST_P(StaticsSweep, TolerancesBelowRoundoffStillConvergeHonestly) {
   // An absolute tolerance below what doubles can meet: the round-off floor takes over, and the
   // answer is as exact as the default one (never "not converged after 100 iterations").
   for (double relative : {1e-9, 1e-12, 1e-15})
@@ -88,7 +94,7 @@ TEST(StaticsSweep, TolerancesBelowRoundoffStillConvergeHonestly) {
     }
 }
 
-TEST(StaticsSweep, ClampedFoamBarConvergesAtTheReportedProblemPoints) {
+TEST_P(StaticsSweep, ClampedFoamBarConvergesAtTheReportedProblemPoints) {
   // The scene's own mesh: E = 2e5 Pa at 4 kg/m³ stalled at 1.16x the tolerance, and
   // E/ρ ≈ 5e4 m²/s² failed chaotically in the parameters, so jitter around it.
   expect_converges(clamped_foam_bar({16, 4, 4}, 2e5, 4), "E 2e5, density 4");
@@ -104,7 +110,7 @@ TEST(StaticsSweep, ClampedFoamBarConvergesAtTheReportedProblemPoints) {
     expect_converges(clamped_foam_bar({16, 4, 4}, E, 30), "E " + std::to_string(E));
 }
 
-TEST(StaticsSweep, RoundoffFloorLeavesOrdinaryFoamAtTheWeightTolerance) {
+TEST_P(StaticsSweep, RoundoffFloorLeavesOrdinaryFoamAtTheWeightTolerance) {
   // The floor only lifts tolerances that doubles cannot meet; foam keeps 1e-6 x its weight.
   const Scene scene = clamped_foam_bar({16, 4, 4}, 2e5, 40);
   ObjectStatics statics(scene);
@@ -118,10 +124,10 @@ TEST(StaticsSweep, RoundoffFloorLeavesOrdinaryFoamAtTheWeightTolerance) {
   EXPECT_LT(stiff_statics.force_tolerance() / (5e9 * 0.02), 100 * 0.16 * 2.2e-16);
 }
 
-TEST(StaticsSweep, HeldBarConvergesForEveryMaterial) {
+TEST_P(StaticsSweep, HeldBarConvergesForEveryMaterial) {
   for (double E : log_spaced(5e4, 5e9, 4))
     for (double rho : log_spaced(0.1, 100, 3)) {
-      Scene scene = test::two_arm_scene({12, 2, 2});
+      Scene scene = with_solver(test::two_arm_scene({12, 2, 2}));
       scene.material = material_from_youngs(E, 0.3, rho);
       GrippedObject object(scene);
       const ObjectState state =
@@ -134,6 +140,9 @@ TEST(StaticsSweep, HeldBarConvergesForEveryMaterial) {
       EXPECT_TRUE(x.allFinite()) << what;
     }
 }
+
+INSTANTIATE_TEST_SUITE_P(Each, StaticsSweep, testing::ValuesIn(test::kLinearSolvers),
+                         test::linear_solver_name);
 
 }  // namespace
 }  // namespace shapectl

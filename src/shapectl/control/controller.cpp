@@ -15,6 +15,12 @@ namespace shapectl {
 namespace {
 using Clock = std::chrono::steady_clock;
 
+// `scene` with the linear solver `options` set, if it sets one (ControllerOptions).
+Scene with_linear_solver(Scene scene, const ControllerOptions& options) {
+  if (options.linear_solver) scene.statics.backend = *options.linear_solver;
+  return scene;
+}
+
 // Requests from other threads, applied by the worker before its next iteration.
 struct Inbox {
   std::optional<ShapeTargets> targets;
@@ -463,7 +469,7 @@ void Controller::State::run() {
 Controller::Controller(const Scene& scene, ControllerOptions options)
     : state_(std::make_unique<State>()) {
   State& s = *state_;
-  s.scene = scene;
+  s.scene = with_linear_solver(scene, options);
   s.options = options;
   s.loaded = std::make_shared<const GrippedObject>(s.scene);
   s.object = s.loaded;
@@ -629,7 +635,7 @@ void Controller::set_model(const Scene& model) {
   if (!model.robot || model.robot->model->active_count() != loaded.robot->model->active_count())
     other("robot");
   if (model.grips.size() != loaded.grips.size()) other("grips");
-  post(*state_, [&](Inbox& in) { in.model = model; });
+  post(*state_, [&](Inbox& in) { in.model = with_linear_solver(model, state_->options); });
 }
 
 void Controller::reset() {

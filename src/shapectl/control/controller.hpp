@@ -21,6 +21,7 @@
 #include <shapectl/control/shape_targets.hpp>
 #include <shapectl/control/shortfall.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
+#include <shapectl/sim/scene.hpp>
 
 namespace shapectl {
 
@@ -34,6 +35,9 @@ struct ControllerOptions {
   // A jog (set_joints) may move each joint at most this far from the current (or last
   // requested) joints, rad; farther is refused. A slider click must not swing an arm.
   double max_jog_step = 0.05;
+  // The statics' linear solver over the scene's and every model's (`--linear-solver`): unset
+  // keeps theirs; set to nullopt is "auto".
+  std::optional<std::optional<CholeskyBackend>> linear_solver;
 };
 
 // An observation of the real object for the closed loop: tracked markers at mesh nodes (world

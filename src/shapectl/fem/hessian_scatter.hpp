@@ -28,7 +28,7 @@ class HessianScatter {
   void add_blocks(std::size_t term, const ElementKernel& kernel, double* values) const;
   // The pattern's node pairs: (i, j), i ≥ j, where some entry between their dofs lands; every
   // node's diagonal. nodes × nodes, lower triangle, compressed, zero values (as node_pattern()
-  // in sim/node_pattern.hpp makes it from the dof pattern, for fill-reducing orders).
+  // in linalg/node_pattern.hpp makes it from the dof pattern, for fill-reducing orders).
   const SparseMatrix& node_pattern() const { return node_pattern_; }
   // Value index of the diagonal entry of each fixed dof.
   const std::vector<int>& fixed_diagonal_slots() const { return fixed_diagonal_slots_; }

@@ -11,13 +11,13 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_input.hpp>
+#include <shapectl/linalg/cholesky_backend.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/mesh/load_mesh.hpp>
 #include <shapectl/mesh/mesh_limits.hpp>
 #include <shapectl/mesh/surface_mesher.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/robot_model.hpp>
-#include <shapectl/sim/cholesky_backend.hpp>
 #include <shapectl/sim/object_statics.hpp>
 #include <shapectl/sim/scene_checks.hpp>
 
@@ -340,8 +340,7 @@ StaticsSettings read_statics(const JsonInput& s) {
     const std::string name = s.at("linear_solver").string();
     CholeskyBackend backend;
     if (parse(name, &backend)) statics.backend = backend;
-    else if (name != "auto")
-      s.at("linear_solver").fail("\"auto\", \"ldlt\", \"band\" or \"cholmod\"");
+    else if (name != "auto") s.at("linear_solver").fail(linear_solver_choices());
   }
   if (s.has("max_iterations"))
     statics.max_iterations = static_cast<int>(s.at("max_iterations").integer_in(1, 100000));

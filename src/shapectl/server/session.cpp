@@ -323,7 +323,9 @@ void Session::load(const SceneEntry& entry) {
   calibration_.reset();  // it refers to the old controller
   if (controller_) controller_->stop();
   controller_ = std::move(controller);
-  calibration_ = std::make_unique<OnlineCalibration>(*controller_, scene, calibration_options_);
+  // The controller's scene: with the linear solver of its options.
+  calibration_ =
+      std::make_unique<OnlineCalibration>(*controller_, controller_->scene(), calibration_options_);
   controller_->start();
   scene_name_ = entry.name;
   targets_ = {};

@@ -11,10 +11,10 @@
 #include <Eigen/Geometry>
 
 #include <shapectl/fem/material.hpp>
+#include <shapectl/linalg/cholesky_backend.hpp>
 #include <shapectl/mesh/tet_mesh.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/robot_model.hpp>
-#include <shapectl/sim/cholesky_backend.hpp>
 
 namespace shapectl {
 
@@ -36,7 +36,7 @@ struct NodeSelection {
 struct StaticsSettings {
   int max_iterations = 100;
   double relative_tolerance = 1e-6;        // force tolerance as a fraction of the object's weight
-  std::optional<CholeskyBackend> backend;  // "ldlt" | "band" | "cholmod"; default: from the matrix
+  std::optional<CholeskyBackend> backend;  // linear_solver_choices(); default: from the matrix
   // Newton steps by conjugate gradients preconditioned with a nearby state's factorization
   // (StaticsOptions::krylov_steps and cold_krylov_steps); off only to measure what they save
   // (`bench --no-krylov`).

@@ -33,8 +33,8 @@
 #include <vector>
 
 #include <shapectl/fem/energy_term.hpp>
+#include <shapectl/linalg/sparse_cholesky.hpp>
 #include <shapectl/sim/hessian_assembler.hpp>
-#include <shapectl/sim/sparse_cholesky.hpp>
 
 namespace shapectl {
 

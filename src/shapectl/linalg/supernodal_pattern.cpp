@@ -1,4 +1,4 @@
-#include <shapectl/sim/supernodal_pattern.hpp>
+#include <shapectl/linalg/supernodal_pattern.hpp>
 
 #include <stdexcept>
 

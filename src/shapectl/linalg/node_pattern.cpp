@@ -1,4 +1,4 @@
-#include <shapectl/sim/node_pattern.hpp>
+#include <shapectl/linalg/node_pattern.hpp>
 
 #include <algorithm>
 

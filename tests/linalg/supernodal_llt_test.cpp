@@ -1,4 +1,4 @@
-#include <shapectl/sim/supernodal_llt.hpp>
+#include <shapectl/linalg/supernodal_llt.hpp>
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include <shapectl/sim/supernodal_llt.hpp>
+#include <shapectl/linalg/supernodal_llt.hpp>
 
 #include <Eigen/Cholesky>
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <shapectl/hand_off.hpp>
+#include <shapectl/linalg/own_kernel_calls.hpp>
 
 namespace shapectl {
 
@@ -293,6 +294,7 @@ class LeftLooking {
 
 bool factorize_supernodal(const SparseMatrix& lower, const SupernodalPattern& pattern,
                           const std::vector<int>& team, double* values) {
+  count_own_kernel_call();
   const Supernodes supernodes(pattern, values);
   const int n = pattern.size();
   if (lower.rows() != n || lower.cols() != n || !lower.isCompressed())
@@ -330,11 +332,13 @@ std::vector<int> supernodal_teams(const SupernodalPattern& pattern) {
 
 void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
                                Eigen::VectorXd& x, const std::vector<int>& teams) {
+  count_own_kernel_call();
   forward_backward(pattern, teams, values, x);
 }
 
 void solve_supernodal_in_place(const SupernodalPattern& pattern, const double* values,
                                Eigen::MatrixXd& x, const std::vector<int>& teams) {
+  count_own_kernel_call();
   forward_backward(pattern, teams, values, x);
 }
 

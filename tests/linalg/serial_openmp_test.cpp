@@ -1,4 +1,4 @@
-#include <shapectl/sim/serial_openmp.hpp>
+#include <shapectl/linalg/serial_openmp.hpp>
 
 #include <gtest/gtest.h>
 

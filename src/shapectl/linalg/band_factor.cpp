@@ -1,4 +1,4 @@
-#include <shapectl/sim/band_factor.hpp>
+#include <shapectl/linalg/band_factor.hpp>
 
 #include <tbb/task_group.h>
 
@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <shapectl/hand_off.hpp>
+#include <shapectl/linalg/own_kernel_calls.hpp>
 
 extern "C" {  // LAPACK and BLAS (OpenBLAS)
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
@@ -118,6 +119,7 @@ int equal_flops_column(int rows, int from, int p, int pieces) {
 // block column k + 1 and then factors that block column while another thread updates the
 // rest. One synchronisation per block column. With one thread, the whole update in one go.
 bool factor_band(double* ab, int n, int kd, int block, bool two_threads) {
+  count_own_kernel_call();
   const BandView band{ab, n, kd};
   const int nb = std::clamp(block, 1, std::max(kd, 1));
   if (n == 0) return true;

@@ -1,4 +1,4 @@
-#include <shapectl/sim/serial_openmp.hpp>
+#include <shapectl/linalg/serial_openmp.hpp>
 
 // The OpenMP runtime's, if one is loaded (weak: absent otherwise). Zero active levels makes
 // every parallel region run on the thread that opens it.

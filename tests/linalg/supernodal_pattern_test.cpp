@@ -1,4 +1,4 @@
-#include <shapectl/sim/supernodal_pattern.hpp>
+#include <shapectl/linalg/supernodal_pattern.hpp>
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <Eigen/Dense>
 #include <random>
 
-#include <shapectl/sim/supernodal_llt.hpp>
+#include <shapectl/linalg/supernodal_llt.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {

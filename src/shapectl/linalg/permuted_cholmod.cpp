@@ -1,28 +1,17 @@
-#include <shapectl/sim/permuted_cholmod.hpp>
+#include <shapectl/linalg/permuted_cholmod.hpp>
 
-#include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <stdexcept>
 
-#include <shapectl/sim/node_pattern.hpp>
-#include <shapectl/sim/supernodal_llt.hpp>
-#include <shapectl/sim/supernodal_pattern.hpp>
+#include <shapectl/linalg/cholmod_view.hpp>
+#include <shapectl/linalg/node_pattern.hpp>
+#include <shapectl/linalg/own_kernel_calls.hpp>
+#include <shapectl/linalg/supernodal_llt.hpp>
+#include <shapectl/linalg/supernodal_pattern.hpp>
 
 namespace shapectl {
-
-namespace {
-
-cholmod_sparse lower_view(const SparseMatrix& lower) {
-  return Eigen::viewAsCholmod(lower.selfadjointView<Eigen::Lower>());
-}
-
-void throw_if_failed(bool ok, const char* what) {
-  if (!ok) throw std::runtime_error(std::string("CHOLMOD could not ") + what + " (out of memory?)");
-}
-
-}  // namespace
 
 struct PermutedCholmod::Impl {
   cholmod_common common{};
@@ -53,9 +42,9 @@ struct PermutedCholmod::Impl {
     common.nmethods = ordering < 0 ? 0 : 1;
     common.method[0].ordering = ordering < 0 ? CHOLMOD_AMD : ordering;
     common.postorder = postorder;
-    cholmod_sparse a = lower_view(lower);
+    cholmod_sparse a = cholmod_lower_view(lower);
     cholmod_factor* f = cholmod_analyze(&a, &common);
-    throw_if_failed(f != nullptr, "analyse the Hessian");
+    throw_if_cholmod_failed(f != nullptr, "analyse the Hessian");
     return f;
   }
   const double* factor_values() const {
@@ -266,6 +255,7 @@ void PermutedCholmod::finish_analysis() {
 }
 
 bool PermutedCholmod::factorize(const SparseMatrix& lower) {
+  count_own_kernel_call();  // the gather into our order, whoever factors
   Impl& m = *impl_;
   if (m.order.empty() || static_cast<std::size_t>(lower.nonZeros()) != m.slot.size())
     throw std::logic_error("PermutedCholmod: factorize a matrix of the analysed pattern");
@@ -283,7 +273,7 @@ bool PermutedCholmod::factorize(const SparseMatrix& lower) {
     m.factored = factorize_supernodal(m.permuted, m.pattern, m.teams, m.values.get());
     return m.factored;
   }
-  cholmod_sparse a = lower_view(m.permuted);
+  cholmod_sparse a = cholmod_lower_view(m.permuted);
   // On a matrix that is not positive definite CHOLMOD stops at column `minor` < n.
   m.factored = cholmod_factorize(&a, m.factor, &m.common) && m.factor->minor == m.factor->n;
   return m.factored;

@@ -1,8 +1,8 @@
-#include <shapectl/sim/band_cholesky.hpp>
+#include <shapectl/linalg/band_cholesky.hpp>
 
 #include <gtest/gtest.h>
 
-#include <shapectl/sim/band_factor.hpp>
+#include <shapectl/linalg/band_factor.hpp>
 
 #include <Eigen/Eigenvalues>
 #include <cmath>

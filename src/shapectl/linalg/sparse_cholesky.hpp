@@ -1,17 +1,20 @@
 #pragma once
-// Sparse Cholesky with the symbolic analysis done once per pattern and reused. Three
-// backends: simplicial LDLᵀ (Eigen), a dense band after reverse Cuthill–McKee (LAPACK; the
-// fastest for bars, box frames and small blocks) and supernodal LLᵀ (CHOLMOD's analysis, our
-// kernels or, for large factorizations, CHOLMOD's: permuted_cholmod.hpp; for compact and
-// unstructured meshes). Chosen from the matrix unless fixed; the rule's numbers come from
+// Sparse Cholesky with the symbolic analysis done once per pattern and reused. Four
+// back-ends (factorization.hpp): simplicial LDLᵀ (Eigen), a dense band after reverse
+// Cuthill–McKee (LAPACK; the fastest for bars, box frames and small blocks), supernodal LLᵀ
+// (CHOLMOD's analysis, our kernels or, for large factorizations, CHOLMOD's: permuted_cholmod.hpp;
+// for compact and unstructured meshes) and CHOLMOD on its own (cholmod_library.hpp, a reference,
+// never chosen automatically). Chosen from the matrix unless fixed; the rule's numbers come from
 // bench/statics_bench.cpp and docs/benchmarks.md.
 #include <memory>
 #include <optional>
 
-#include <shapectl/sim/cholesky_backend.hpp>
+#include <shapectl/linalg/cholesky_backend.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {
+
+class Factorization;
 
 // The flops of Eigen's LDLᵀ (as Σ_j (|L_j| + 1)² over its columns, diagonal included) of a
 // matrix in node blocks, estimated from its node pattern (node_pattern.hpp) ordered by AMD: a
@@ -45,15 +48,14 @@ class SparseCholesky {
   // preconditioned with the factor pay: the band's single-precision solve does; CHOLMOD's
   // solve does not (a 60x60x1 plate took 19 Newton iterations and 1.25 s with such steps,
   // 7 and 0.70 s without; docs/benchmarks.md, "the back-end choice, again").
-  bool cheap_to_solve() const { return backend_ != Backend::CholmodSupernodal; }
+  bool cheap_to_solve() const;
 
  private:
-  // The automatic choice; leaves the band analyzed.
-  Backend choose(const SparseMatrix& lower, const SparseMatrix* nodes);
-  struct Impl;
+  // The automatic choice (sets backend_), analysed.
+  std::unique_ptr<Factorization> choose(const SparseMatrix& lower, const SparseMatrix* nodes);
   bool automatic_;
   Backend backend_;
-  std::unique_ptr<Impl> impl_;
+  std::unique_ptr<Factorization> factorization_;
 };
 
 }  // namespace shapectl

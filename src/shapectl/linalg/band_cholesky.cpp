@@ -1,4 +1,4 @@
-#include <shapectl/sim/band_cholesky.hpp>
+#include <shapectl/linalg/band_cholesky.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -8,8 +8,9 @@
 #include <tbb/parallel_reduce.h>
 
 #include <shapectl/hand_off.hpp>
-#include <shapectl/sim/band_factor.hpp>
-#include <shapectl/sim/node_pattern.hpp>
+#include <shapectl/linalg/band_factor.hpp>
+#include <shapectl/linalg/node_pattern.hpp>
+#include <shapectl/linalg/own_kernel_calls.hpp>
 
 extern "C" {  // LAPACK and BLAS (OpenBLAS)
 void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);
@@ -248,6 +249,7 @@ tbb::blocked_range<Eigen::Index> band_pieces(Eigen::Index size) {
 }  // namespace
 
 bool BandCholesky::factorize(const SparseMatrix& lower) {
+  count_own_kernel_call();
   band_single_current_ = false;
   band_.resize(static_cast<Eigen::Index>(bandwidth_ + 1) * size_);  // uninitialised
   HandOff zeroing;
@@ -281,6 +283,7 @@ bool BandCholesky::factorize(const SparseMatrix& lower) {
 }
 
 Eigen::VectorXd BandCholesky::solve_single_precision(const Eigen::VectorXd& rhs) const {
+  count_own_kernel_call();
   // Subnormal floats are slow on most CPUs: entries of L a factor 1e-15 below its largest
   // (fill far from the diagonal decays) are dropped, and the right-hand side is scaled to 1.
   // Both change the result by far less than single precision's rounding.
@@ -317,6 +320,7 @@ Eigen::VectorXd BandCholesky::solve_single_precision(const Eigen::VectorXd& rhs)
 }
 
 Eigen::MatrixXd BandCholesky::solve(const Eigen::MatrixXd& rhs) const {
+  count_own_kernel_call();
   const int columns = static_cast<int>(rhs.cols());
   // Column by column, contiguously: along a row of a tall column-major matrix consecutive
   // elements are ~64 kB apart at 12k tets.

@@ -13,7 +13,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include <shapectl/sim/supernodal_pattern.hpp>
+#include <shapectl/linalg/supernodal_pattern.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {
