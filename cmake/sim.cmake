@@ -8,7 +8,7 @@ find_package(TBB REQUIRED)  # the band factorization's two-thread split
 
 shapectl_area(sim)
 target_link_libraries(shapectl_sim PUBLIC shapectl_fem shapectl_mesh shapectl_robot
-                      PRIVATE shapectl_io TBB::tbb ${CHOLMOD_LIB} ${AMD_LIB} ${LAPACK_LIBRARIES} ${BLAS_LIBRARIES})
+                      PRIVATE shapectl_io shapectl_runtime TBB::tbb ${CHOLMOD_LIB} ${AMD_LIB} ${LAPACK_LIBRARIES} ${BLAS_LIBRARIES})
 target_include_directories(shapectl_sim PRIVATE ${SUITESPARSE_INCLUDE})
 
 shapectl_tests(sim shapectl_sim)
