@@ -4,8 +4,8 @@
 #include <cstdlib>
 #include <string>
 
-// OpenBLAS's thread control and, for the idle timeout, three of its internals (exported by
-// every build since 0.2: the environment reader, the value it read, the pool's shutdown).
+// OpenBLAS's thread control and, for the idle timeout, three functions its shared library
+// exports (0.3.21: `nm -D`): the environment reader, the value it read, the pool's shutdown.
 extern "C" void openblas_set_num_threads(int threads) __attribute__((weak));
 extern "C" int openblas_get_num_threads() __attribute__((weak));
 extern "C" int openblas_get_num_procs() __attribute__((weak));

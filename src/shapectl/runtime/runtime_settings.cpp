@@ -32,13 +32,4 @@ RuntimeSettings settings_from_environment() {
   return settings;
 }
 
-std::string describe(const RuntimeSettings& settings) {
-  const auto count = [](int n, const char* zero) { return n > 0 ? std::to_string(n) : zero; };
-  return "threads=" + count(settings.threads, "per-core") +
-         " blas_threads=" + count(settings.blas_threads, "per-factorization") +
-         " blas_idle_timeout=" + count(settings.blas_idle_timeout, "openblas") +
-         " keep_freed_heap=" + (settings.keep_freed_heap ? "yes" : "no") +
-         " start_threads=" + (settings.start_threads ? "yes" : "no");
-}
-
 }  // namespace shapectl::runtime

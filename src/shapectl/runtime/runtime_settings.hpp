@@ -3,7 +3,6 @@
 // library's heap. Each setting, why, and what it measured: docs/runtime.md.
 // runtime_policy.hpp applies them; every program that runs the solvers does so at its start
 // (the CLI and so `serve`, the server, the Python module at import, each Dask worker).
-#include <string>
 
 namespace shapectl::runtime {
 
@@ -36,8 +35,5 @@ struct RuntimeSettings {
 // MALLOC_MMAP_THRESHOLD_ and MALLOC_TRIM_THRESHOLD_ win over `keep_freed_heap` (heap_settings).
 // InputError for a SHAPECTL_THREADS that is not a whole number >= 0.
 RuntimeSettings settings_from_environment();
-
-// One line: "threads=2 blas_threads=per-factorization blas_idle_timeout=4 ...".
-std::string describe(const RuntimeSettings& settings);
 
 }  // namespace shapectl::runtime
