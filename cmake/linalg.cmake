@@ -9,7 +9,7 @@ find_package(LAPACK REQUIRED)  # OpenBLAS's: band Cholesky
 find_package(TBB REQUIRED)  # the band factorization's two-thread split
 
 shapectl_area(linalg)
-target_link_libraries(shapectl_linalg PRIVATE TBB::tbb ${CHOLMOD_LIB} ${AMD_LIB} ${LAPACK_LIBRARIES}
+target_link_libraries(shapectl_linalg PRIVATE shapectl_runtime TBB::tbb ${CHOLMOD_LIB} ${AMD_LIB} ${LAPACK_LIBRARIES}
                       ${BLAS_LIBRARIES})
 target_include_directories(shapectl_linalg PRIVATE ${SUITESPARSE_INCLUDE})
 

@@ -38,7 +38,7 @@ set_target_properties(shapectl_python PROPERTIES
   OUTPUT_NAME _shapectl
   LIBRARY_OUTPUT_DIRECTORY ${shapectl_python_dir}/shapectl
   UNITY_BUILD ${SHAPECTL_UNITY_BUILD})
-target_link_libraries(shapectl_python PRIVATE shapectl_calib shapectl_control shapectl_scene_io shapectl_sim shapectl_robot shapectl_io)
+target_link_libraries(shapectl_python PRIVATE shapectl_calib shapectl_control shapectl_scene_io shapectl_sim shapectl_robot shapectl_runtime shapectl_io)
 target_compile_options(shapectl_python PRIVATE -Wno-subobject-linkage)
 
 # The pure-Python part of the package (and its stubs) beside the compiled module.

@@ -3,17 +3,12 @@
 #include <iostream>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/runtime/runtime_policy.hpp>
 
 #include "commands.hpp"
-#include "heap_settings.hpp"
-#include "quiet_blas_threads.hpp"
 #include "shapectl_version.hpp"
-#include "worker_threads.hpp"
 
 int main(int argc, char** argv) {
-  shapectl::cli::restart_with_quiet_blas_threads(argv);
-  shapectl::cli::keep_freed_heap_memory();
-  shapectl::cli::start_worker_threads();
   // A file size limit (ulimit -f) makes a result write fail with an error, not kill us midway.
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"shapectl: interactive robotic shape control of elastic objects"};
@@ -29,6 +24,8 @@ int main(int argc, char** argv) {
   shapectl::cli::add_serve_command(app);
   shapectl::cli::add_link_commands(app);
   try {
+    // Threads, OpenBLAS's idle threads, the heap (docs/runtime.md): before any command runs.
+    shapectl::runtime::apply_runtime_policy(shapectl::runtime::settings_from_environment());
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 1;

@@ -12,6 +12,8 @@ Bad input raises ValueError with the CLI's message, or TypeError for a value of 
 (a bool, str, complex number, object or masked array: nothing is coerced); a computation that
 fails raises SolverError.
 Long computations release the GIL, so other Python threads run meanwhile.
+Importing the module applies the CLI's process-wide tuning (thread counts, OpenBLAS's idle
+threads, the heap; docs/runtime.md); configure_runtime(...) changes it, runtime_settings() shows it.
 
     import shapectl
     scene = shapectl.Scene.load("scenes/yumi_bar.json")
@@ -40,7 +42,9 @@ from ._shapectl import (
     StaticsSolution,
     UnidentifiedDirection,
     calibrate,
+    configure_runtime,
     kinematics,
+    runtime_settings,
     solve,
     statics,
 )
@@ -67,7 +71,9 @@ __all__ = [
     "StaticsSolution",
     "UnidentifiedDirection",
     "calibrate",
+    "configure_runtime",
     "kinematics",
+    "runtime_settings",
     "solve",
     "statics",
 ]

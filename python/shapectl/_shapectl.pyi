@@ -238,3 +238,9 @@ Observations = Union[str, os.PathLike, Mapping[str, Any]]
 def calibrate(scene: Scene, observations: Observations, *,
               fit: Optional[Union[str, Sequence[str]]] = None,
               max_iterations: int = 30) -> CalibrationResult: ...
+
+def configure_runtime(*, threads: Optional[int] = None, blas_threads: Optional[int] = None,
+                      blas_idle_timeout: Optional[int] = None,
+                      keep_freed_heap: Optional[bool] = None,
+                      start_threads: Optional[bool] = None) -> Dict[str, Union[int, bool]]: ...
+def runtime_settings() -> Dict[str, Union[int, bool]]: ...

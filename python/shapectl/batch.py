@@ -14,6 +14,11 @@ The scene travels with the tasks as a dict (Scene.to_dict(): file names absolute
 worker process loads it once. On a multi-machine cluster the files it names (URDF, collision
 spheres, mesh files) must be at the same paths on every node: shared storage, or shapectl's data
 installed under the same prefix everywhere; the bundled scenes' meshes are boxes, inside the dict.
+
+Each worker process runs shapectl's tuning (docs/runtime.md) with TBB's threads at the worker's
+thread count, so workers sharing a machine do not each start a thread per core: solve_many
+registers a worker plugin for it; workers started by hand get it from
+`dask-worker --preload shapectl.batch ...` (dask_setup below) as well.
 """
 
 import contextlib
@@ -52,6 +57,31 @@ def connect(scheduler=None, workers=2, threads_per_worker=1):
     with LocalCluster(n_workers=workers, threads_per_worker=threads_per_worker, processes=True,
                       dashboard_address=None) as cluster, Client(cluster) as client:
         yield client
+
+
+def _configure_worker(worker):
+    state = getattr(worker, "state", worker)  # Dask >= 2022.8 keeps nthreads in worker.state
+    shapectl.configure_runtime(threads=state.nthreads)
+
+
+def dask_setup(worker):
+    """`dask-worker --preload shapectl.batch`: the worker's tuning at its thread count."""
+    _configure_worker(worker)
+
+
+class RuntimePlugin:
+    """A Dask worker plugin: shapectl's tuning in each worker process, TBB's threads at the
+    worker's thread count. Workers inside the client's process (LocalCluster(processes=False))
+    share its threads and keep its tuning."""
+
+    name = "shapectl-runtime"
+
+    def __init__(self):
+        self.client_pid = os.getpid()
+
+    def setup(self, worker):
+        if os.getpid() != self.client_pid:
+            _configure_worker(worker)
 
 
 def _scene(scene_dict):
@@ -113,6 +143,8 @@ def solve_many(client, scene, target_sets, progress=sys.stderr, **options):
     progress: where the counter goes (None: nowhere)."""
     scene_dict = scene.to_dict() if isinstance(scene, shapectl.Scene) else scene
     from distributed import as_completed
+
+    client.register_worker_plugin(RuntimePlugin())
 
     # The scene once to every worker, not once per task.
     [scene_on_workers] = client.scatter([scene_dict], broadcast=True, hash=False)

@@ -115,5 +115,6 @@ void bind_kinematics(py::module_& m);
 void bind_solve(py::module_& m);
 void bind_controller(py::module_& m);
 void bind_calibration(py::module_& m);
+void bind_runtime(py::module_& m);
 
 }  // namespace shapectl::python

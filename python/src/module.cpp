@@ -4,6 +4,7 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_input.hpp>
 #include <shapectl/robot/kinematics.hpp>
+#include <shapectl/runtime/runtime_policy.hpp>
 
 #include "bindings.hpp"
 
@@ -56,6 +57,8 @@ std::vector<LimitViolation> violations_at(const RobotModel& robot, const Eigen::
 
 PYBIND11_MODULE(_shapectl, m) {
   using namespace shapectl::python;
+  // The process's tuning (docs/runtime.md), as the CLI has it, unless the program chose its own.
+  shapectl::runtime::ensure_runtime_policy();
   m.doc() =
       "shapectl: statics, kinematics, shape optimization and the continuous controller of "
       "elastic objects held by a robot (the compiled part of the `shapectl` package).";
@@ -79,4 +82,5 @@ PYBIND11_MODULE(_shapectl, m) {
   bind_solve(m);
   bind_controller(m);
   bind_calibration(m);
+  bind_runtime(m);
 }

@@ -29,6 +29,8 @@ def test_every_task_has_its_row_even_when_it_raises_something_unexpected(bar_sce
     assert rows[0]["error_mean"] < 1e-3 and rows[0]["joints"] == rows[3]["joints"]
     lines = progress.getvalue().split("\n")  # not a terminal: a line per count, no \r
     assert len(lines) == 5 and lines[-2] == "batch: 4/4 solves, 2 failed" and "\r" not in lines[0]
+    # Workers inside this process share its threads: its tuning is left as it was.
+    assert shapectl.runtime_settings()["threads"] == 0
 
     batch.write_table(rows, tmp_path / "t", bar_scene.joint_names)
     table = np.load(tmp_path / "t.npz")
@@ -38,3 +40,16 @@ def test_every_task_has_its_row_even_when_it_raises_something_unexpected(bar_sce
         lines = list(csv.reader(f))
     assert lines[0] == list(batch.FIELDS[:-1]) + bar_scene.joint_names + ["error"]
     assert len(lines) == 5 and lines[2][-1] == rows[1]["error"]
+
+
+def test_each_worker_process_runs_the_tuning_at_its_thread_count(bar_scene):
+    positions = shapectl.statics(bar_scene).positions
+    lifted = {"targets": [{"node": 212, "position": positions[212] + [0, 0, 0.01]}]}
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, Client(cluster) as client:
+        rows = batch.solve_many(client, bar_scene, [lifted], progress=None, max_iterations=3)
+        [settings] = client.run(lambda: shapectl.runtime_settings()).values()
+    assert rows[0]["status"] == "done"
+    assert settings["threads"] == 1 and settings["tbb_thread_limit"] == 1
+    assert settings["blas_idle_timeout"] == 4 and settings["keep_freed_heap"]
+    assert shapectl.runtime_settings()["threads"] == 0  # the client's process: its own

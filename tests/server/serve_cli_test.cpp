@@ -69,6 +69,22 @@ bool wait_for_url(pid_t pid, const std::filesystem::path& out) {
   return false;
 }
 
+// The tuning is applied in-process (docs/runtime.md): the program is not run a second time with
+// OPENBLAS_THREAD_TIMEOUT added, which /proc shows as the environment the process began with.
+TEST(ServeCli, StartsWithoutRestartingItself) {
+  TempDir dir;
+  const pid_t pid = start_process(cli_command({"serve", "--port", "0"}), dir.path() / "out",
+                                  dir.path() / "err", [] { unsetenv("OPENBLAS_THREAD_TIMEOUT"); });
+  const bool started = wait_for_url(pid, dir.path() / "out");
+  const std::string environment = read_text("/proc/" + std::to_string(pid) + "/environ");
+  kill(pid, SIGTERM);
+  const int exit_code = wait_for_exit(pid);
+  ASSERT_TRUE(started) << read_text(dir.path() / "err");
+  EXPECT_EQ(exit_code, 0) << read_text(dir.path() / "err");
+  EXPECT_NE(environment.find("PATH="), std::string::npos) << "no environment read";
+  EXPECT_EQ(environment.find("OPENBLAS_THREAD_TIMEOUT="), std::string::npos);
+}
+
 TEST(ServeCli, EveryLinkOptionOfRunIsTakenAndTheLogReplays) {
   TempDir dir;
   const auto log = dir.path() / "session.jsonl";

@@ -4,7 +4,6 @@
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <amd.h>
-#include <atomic>
 #include <cstdlib>
 #include <stdexcept>
 #include <tbb/parallel_invoke.h>
@@ -18,24 +17,12 @@
 #include <shapectl/linalg/node_pattern.hpp>
 #include <shapectl/linalg/permuted_cholmod.hpp>
 #include <shapectl/linalg/serial_openmp.hpp>
+#include <shapectl/runtime/blas_threads.hpp>
 
 namespace shapectl {
 
-// OpenBLAS's thread control, if the BLAS is OpenBLAS (weak: absent otherwise).
-extern "C" void openblas_set_num_threads(int threads) __attribute__((weak));
-extern "C" int openblas_get_num_procs() __attribute__((weak));
-
 namespace {
-// OpenBLAS threads pay off only for large dense blocks; on small ones they cost more in
-// hand-offs and spinning than they save (`shapectl bench` on the YuMi bar: 10 % faster with
-// one thread; a 50k-tet band factorization: 22 % slower). OPENBLAS_NUM_THREADS, if set, wins.
-void use_blas_threads(bool many) {
-  static const bool user_set = std::getenv("OPENBLAS_NUM_THREADS") != nullptr;
-  static std::atomic<int> current{0};
-  if (user_set || !openblas_set_num_threads || !openblas_get_num_procs) return;
-  const int threads = many ? openblas_get_num_procs() : 1;
-  if (current.exchange(threads) != threads) openblas_set_num_threads(threads);
-}
+using runtime::use_blas_threads;  // one thread, or one per core (runtime/blas_threads.hpp)
 
 // Eigen's LDLᵀ, plus the flop count of its factorization from the symbolic analysis.
 struct CountingLdlt : Eigen::SimplicialLDLT<SparseMatrix, Eigen::Lower> {

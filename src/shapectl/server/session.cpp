@@ -11,6 +11,7 @@
 #include <shapectl/io/session_log.hpp>
 #include <shapectl/link/robot_link.hpp>
 #include <shapectl/robot/kinematics.hpp>
+#include <shapectl/runtime/runtime_policy.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/server/http_rules.hpp>  // robot_mesh_prefix
 
@@ -284,6 +285,8 @@ Session::Session(const std::filesystem::path& scene, std::vector<SceneEntry> sce
       options_(options),
       calibration_options_(std::move(calibration)),
       package_paths_(std::move(package_paths)) {
+  // The process's tuning (docs/runtime.md), unless its program chose it: before any solve runs.
+  runtime::ensure_runtime_policy();
   const std::string name = scene.filename().string();
   auto same = [&](const SceneEntry& e) { return e.name == name; };
   auto it = std::find_if(scenes_.begin(), scenes_.end(), same);
