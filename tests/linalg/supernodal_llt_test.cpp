@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/CholmodSupport>
 #include <algorithm>
 #include <limits>

@@ -7,6 +7,7 @@
 #include <shapectl/robot/robot_model.hpp>
 
 #include "support/test_support.hpp"
+#include "support/wait_bound.hpp"
 
 namespace shapectl::test {
 
@@ -20,9 +21,10 @@ inline RobotModel yumi_arms() {
   return robot;
 }
 
-// Polls `done` every 2 ms; false if it did not become true within `seconds`.
+// Polls `done` every 2 ms; false if it did not become true within wait_bound(seconds).
 inline bool wait_until(const std::function<bool()>& done, double seconds) {
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  const auto end =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_bound(seconds));
   while (!done()) {
     if (std::chrono::steady_clock::now() > end) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
