@@ -69,8 +69,16 @@ namespace {
 // Eigen's simplicial LDLᵀ.
 class LdltFactorization final : public Factorization {
  public:
+  // Eigen's ordering copies the values with the pattern: the analysis gets a copy of the
+  // pattern with zeros, so that statics can assemble the values beside it.
   void analyze(const SparseMatrix& lower, const SparseMatrix*) override {
-    ldlt_.analyzePattern(lower);
+    if (!lower.isCompressed()) return ldlt_.analyzePattern(lower);  // not statics' matrix
+    SparseMatrix pattern(lower.rows(), lower.cols());
+    pattern.resizeNonZeros(lower.nonZeros());
+    std::copy_n(lower.outerIndexPtr(), lower.outerSize() + 1, pattern.outerIndexPtr());
+    std::copy_n(lower.innerIndexPtr(), lower.nonZeros(), pattern.innerIndexPtr());
+    std::fill_n(pattern.valuePtr(), lower.nonZeros(), 0.0);
+    ldlt_.analyzePattern(pattern);
   }
   bool factorize(const SparseMatrix& lower) override {
     ldlt_.factorize(lower);
