@@ -259,7 +259,7 @@ TEST(Controller, FeedbackMovesNoJointBeyondTheTrustRegionButTheUserCan) {
     const Evaluation e = probe_objective.evaluate(joints, probe.reference_positions());
     ShapeTargets t;
     for (int i = 0; i < probe.node_count(); i += 7)
-      t.nodes.push_back(i), t.positions.push_back(e.positions.segment<3>(3 * i));
+      t.nodes.push_back(i), t.positions.push_back(e.positions().segment<3>(3 * i));
     return t;
   };
   const auto stopped = [](Controller& c) {  // steps until the request is applied and walked
