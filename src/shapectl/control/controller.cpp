@@ -477,6 +477,9 @@ void Controller::State::publish() {
   s->observation_problem = observation_problem;
   s->gate = feedback->gate_counts();
   s->authority = feedback->authority();
+  s->authority.trust_region = options.trust_region;
+  if (loop_start)
+    s->authority.joint_offset = (current.joints() - *loop_start).cwiseAbs().maxCoeff();
   s->status = status();
   s->tolerance = options.tolerance;
   s->jog_refused_links = jog_refused_links;
