@@ -26,6 +26,10 @@ void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args, bool feedback_
   if (feedback_flag)
     cmd.add_flag("--feedback,!--no-feedback", args.feedback,
                  "with observations: model-error feedback on their markers (default) or not");
+  cmd.add_option("--trust-region", args.trust_region,
+                 "with observations: how far (rad, each joint) what they say may move the joints "
+                 "from where the optimizer stopped for the user's last request")
+      ->capture_default_str();
   cmd.add_flag("--online-calibration,!--no-online-calibration", args.online_calibration,
                "with observations: re-calibrate --fit in the background (default) or not");
   cmd.add_option("--fit", args.fit, "parameters the online calibration fits")
@@ -46,6 +50,13 @@ SimulatedCamera simulated_camera(const ClosedLoopArgs& args, const std::string& 
   camera.surface_points = args.camera_points;
   camera.outlier_fraction = args.camera_outliers;
   return camera;
+}
+
+double feedback_trust_region(const ClosedLoopArgs& args, const std::string& command) {
+  // Past π a box bounds nothing a revolute joint can do.
+  if (!(args.trust_region > 0 && args.trust_region <= 3.15))
+    throw InputError(command, "--trust-region", "0 < radius <= 3.15 rad", args.trust_region);
+  return args.trust_region;
 }
 
 OnlineCalibrationOptions online_calibration_options(const ClosedLoopArgs& args,

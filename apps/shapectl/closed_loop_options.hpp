@@ -19,6 +19,7 @@ struct ClosedLoopArgs {
   int camera_points = 0;         // surface points per frame (a depth camera)
   double camera_outliers = 0;    // fraction of them that are outliers
   bool feedback = true;
+  double trust_region = 0.02;  // rad (ControllerOptions::trust_region)
   bool online_calibration = true;
   std::string fit = "youngs_modulus,grip_offsets";
 };
@@ -29,6 +30,8 @@ void add_closed_loop_options(CLI::App& cmd, ClosedLoopArgs& args, bool feedback_
 // The world's camera (markers on the target nodes, set by the caller); InputError naming the
 // option of `command` that is out of range.
 SimulatedCamera simulated_camera(const ClosedLoopArgs& args, const std::string& command);
+// --trust-region, checked; InputError naming it when out of range.
+double feedback_trust_region(const ClosedLoopArgs& args, const std::string& command);
 OnlineCalibrationOptions online_calibration_options(const ClosedLoopArgs& args,
                                                     const std::string& command);
 // The world of --world (non-empty) holding `model`'s mesh with its robot: InputError when

@@ -398,11 +398,13 @@ nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_sta
 }
 
 void run(RunArgs args) {
+  const double trust_region = feedback_trust_region(args.loop, "run");
   RunInputs inputs = load_run_inputs(args);
   const std::shared_ptr<SessionLog> log = open_session_log(args, inputs.scene);
   const auto link = make_run_link(args, inputs.scene, log);
   ControllerOptions options;
   options.tolerance = args.tolerance;
+  options.trust_region = trust_region;
   Controller controller(inputs.scene, options);
   set_run_targets(controller, inputs.targets, log.get());
   if (observed(args)) controller.set_feedback(args.loop.feedback);

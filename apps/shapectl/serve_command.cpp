@@ -66,6 +66,8 @@ void run_serve(const ServeArgs& args) {
   if (!std::filesystem::is_regular_file(options.web_root / "index.html"))
     throw InputError("serve", "--web-root", "a directory with index.html",
                      options.web_root.string());
+  ControllerOptions controller_options;
+  controller_options.trust_region = feedback_trust_region(args.loop, "serve");
   const std::filesystem::path scenes_dir = args.scenes_dir.empty()
                                                ? server::default_scenes_dir()
                                                : std::filesystem::path(args.scenes_dir);
@@ -89,7 +91,6 @@ void run_serve(const ServeArgs& args) {
       link->start();
     }
   }
-  ControllerOptions controller_options;
   controller_options.tolerance = args.tolerance;
   controller_options.linear_solver = linear_solver_override(args.linear_solver);
   server::Session session(scene, server::find_bundled_scenes(scenes_dir), link.get(),

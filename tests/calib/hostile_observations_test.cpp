@@ -1,8 +1,9 @@
 // Lying observations against an armed robot (issue 32): the simulated world is held by the sim
 // robot at its measured joints, its camera's frames are falsified before they reach the loop
-// (feedback and online calibration), and the world's true error must stay within the open
-// loop's error plus the feedback's authority bound (docs/calibration.md, "What an observation
-// can make the robot do"), with the gate counting what it refused.
+// (feedback and online calibration), and at every sample, in transit too, the robot's joints
+// must stay in the trust region around the open loop's and the world's true error within the
+// open loop's plus the bound B that region allows (docs/calibration.md, "Safety: what an
+// observation can make the robot do"), with the gate counting what it refused.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -53,16 +54,42 @@ class HostileObservations : public ::testing::Test {
     return std::exp(std::uniform_real_distribution<double>(std::log(0.005), std::log(0.3))(sizes));
   }
 
+  // The bound B on how much the world's true error (a mean over the target nodes) may exceed
+  // the open loop's while every joint stays within `radius` of `joints`: the largest mean
+  // displacement of the target nodes over that box, to first order, r · max over the box's
+  // corners of mean_k |Σ_j ±∂y_k/∂θ_j| (a norm of a linear map is largest at a corner). The
+  // world's own sensitivity, at the joints the loop starts from, not a number copied from the
+  // docs (48 mm there for this world).
+  double bound(const Eigen::VectorXd& joints, const Positions& near, double radius) const {
+    const GrippedObject truth(test::different_world(model));
+    ObjectState at = truth.solve_from(joints, near);
+    EXPECT_TRUE(at.statics().converged()) << at.statics().reason;
+    const Eigen::MatrixXd dy = truth.sensitivity(at);
+    const auto m = dy.cols();
+    double largest = 0;
+    for (long corner = 0; corner < (1L << m); ++corner) {
+      double sum = 0;
+      for (int node : targets.nodes) {
+        Vec3 d = Vec3::Zero();
+        for (Eigen::Index j = 0; j < m; ++j)
+          d += ((corner >> j) & 1 ? 1.0 : -1.0) * dy.block<3, 1>(3 * node, j);
+        sum += d.norm();
+      }
+      largest = std::max(largest, sum / targets.size());
+    }
+    return radius * largest;
+  }
+
   // The sim robot, armed, follows the controller; the world settles at its measured joints.
-  // Open loop first (feedback off, nothing observed) until the robot has arrived: its true
-  // error is the reference. Then at least `seconds`, and 30 frames judged, with feedback on and
-  // every frame through `lie`; returns the largest true error seen then.
+  // Open loop first (feedback off, nothing observed) until the robot has arrived: its joints
+  // are where the loop starts, its true error the reference. Then at least `seconds`, and 30
+  // frames judged, with feedback on and every frame through `lie`; every sample is judged.
   struct Outcome {
-    double open_loop = NAN, worst = 0, last = NAN;
-    // At the poses the loop leads the robot to (robot arrived there), and how often it was seen:
-    // on the way between two poses the object passes through shapes no target bounds.
-    double worst_arrived = 0;
-    int arrived_samples = 0, blocked_samples = 0;
+    double open_loop = NAN, bound = NAN, worst = 0, last = NAN;
+    // The smallest margin open loop + bound − true error, and the largest joint distance (rad)
+    // of the measured and the commanded joints from where the loop started, at any sample.
+    double margin = INFINITY, measured_step = 0, commanded_step = 0;
+    int samples = 0, arrived_samples = 0, blocked_samples = 0, unsolved_samples = 0;
     std::shared_ptr<const ControllerSnapshot> snapshot;
     LinkStatus link;
     OnlineCalibrationStatus calibration;
@@ -93,26 +120,55 @@ class HostileObservations : public ::testing::Test {
     std::uint64_t seen = 0;
     double hostile_since = -1;
     int frames = 0;
-    while (elapsed() < 90) {
+    const double radius = ControllerOptions{}.trust_region;
+    Eigen::VectorXd start_joints;
+    // A budget, not a speed test: with a 30 s online fit on the same two cores at load 16 the
+    // controller judged 18 frames in 85 s (it takes only the newest while it iterates).
+    while (elapsed() < 240) {
       const auto snap = controller.wait_for_snapshot(seen, 0.02);
       if (snap->sequence > seen) seen = snap->sequence, link->set_target(snap->joints, snap->safe);
       const LinkStatus st = link->status();
       if (st.measured.size() != snap->joints.size()) continue;
-      std::optional<ObservationFrame> frame = world.step(elapsed(), st.measured);
-      const double true_error = world.true_error(targets);
+      std::optional<ObservationFrame> frame;
+      bool solved = true;
+      try {
+        frame = world.step(elapsed(), st.measured);
+      } catch (const NoEquilibrium&) {
+        // The world's own Newton, not the loop: in a patch of joints about 1e-4 rad across,
+        // 0.006 rad from this pose, it stalls at 7.66e-6 N whichever linear solver or step
+        // (seen in 2 of ~25 runs; the world may be near a fold there). Its true error is then
+        // unknown: the sample is counted, not judged, and no frame is taken.
+        solved = false;
+      }
+      const double true_error = solved ? world.true_error(targets) : NAN;
       if (hostile_since < 0) {  // the open loop, until the robot stands at the optimizer's joints
-        if (st.arrived && snap->status != ControllerStatus::Optimizing) {
+        // Stopped for the targets: not the first snapshot's "idle" at the reference joints,
+        // where the robot starts (that open loop is another, before the optimizer's walk).
+        const bool stopped = snap->status == ControllerStatus::Reached ||
+                             snap->status == ControllerStatus::BestEffort;
+        if (st.arrived && stopped && solved) {
           out.open_loop = true_error;
+          start_joints = snap->joints;  // the trust region's centre: where the optimizer stopped
+          out.bound = bound(start_joints, world.positions(), radius);
           controller.set_feedback(true);
           hostile_since = elapsed();
         }
         continue;
       }
-      out.worst = std::max(out.worst, true_error);
+      if (solved) {
+        out.worst = std::max(out.worst, true_error);
+        out.margin = std::min(out.margin, out.open_loop + out.bound - true_error);
+        out.last = true_error;
+      } else {
+        ++out.unsolved_samples;
+      }
+      out.measured_step =
+          std::max(out.measured_step, (st.measured - start_joints).cwiseAbs().maxCoeff());
+      out.commanded_step =
+          std::max(out.commanded_step, (snap->joints - start_joints).cwiseAbs().maxCoeff());
+      ++out.samples;
       if (st.blocked) ++out.blocked_samples;
-      if (st.arrived)
-        out.worst_arrived = std::max(out.worst_arrived, true_error), ++out.arrived_samples;
-      out.last = true_error;
+      if (st.arrived) ++out.arrived_samples;
       if (frame) {
         lie(*frame, frames++);
         calibration.observe(*frame);
@@ -135,25 +191,33 @@ class HostileObservations : public ::testing::Test {
     return out;
   }
 
-  // What the gate and the authority guarantee whatever the lie: no correction beyond
-  // max_correction, and the user keeps the robot.
-  static void expect_authority_held(const Outcome& out) {
+  // What the gate, the authority and the trust region guarantee whatever the lie, at every
+  // sample (in transit too): no correction beyond max_correction, no joint, commanded or
+  // measured, farther than the trust region from where the loop started, the world's true
+  // error within the open loop's plus the bound, and the user keeps the robot.
+  static void expect_bounds_held(const Outcome& out) {
     EXPECT_LE(out.snapshot->authority.largest, FeedbackOptions{}.max_correction + 1e-12);
+    const double radius = ControllerOptions{}.trust_region;
+    EXPECT_LE(out.commanded_step, radius + 1e-9);
+    EXPECT_LE(out.measured_step, radius + 1e-9);
+    EXPECT_GE(out.margin, 0) << "true error up to " << out.worst * 1e3 << " mm, open loop "
+                             << out.open_loop * 1e3 << " mm + bound " << out.bound * 1e3 << " mm";
+    EXPECT_GT(out.samples, 100);
+    EXPECT_LE(out.unsolved_samples, out.samples / 10) << "the world could not be judged";
     EXPECT_TRUE(out.link.armed) << out.link.reason;
   }
-  // No true-error bound is asserted: the feedback moves no target farther than max_correction,
-  // but while lies keep moving the corrected targets the optimizer jumps between optima up to
-  // 1 rad apart and the object on the way was seen 57-109 mm off (open loop 17 mm), the robot
-  // often never arriving; issue 32 stays open for it. The tests print it.
   static void print(const Outcome& out) {
-    std::printf("link held short of a graze in %d samples\n", out.blocked_samples);
+    std::printf("link held short of a graze in %d samples, world unsolved in %d\n",
+                out.blocked_samples, out.unsolved_samples);
     std::printf(
-        "open loop %.1f mm, worst %.1f mm where arrived (%d samples), %.1f mm in transit, last "
-        "%.1f mm; gate: %llu/%llu markers, "
+        "open loop %.1f mm + bound %.1f mm; worst %.1f mm (margin %.1f mm) over %d samples, %d "
+        "arrived, last %.1f mm; joints from the loop's start: %.4f rad commanded, %.4f "
+        "measured; gate: %llu/%llu markers, "
         "%llu/%llu frames rejected; largest correction %.1f mm; calibrations %llu run, "
         "%llu applied (%s)\n",
-        out.open_loop * 1e3, out.worst_arrived * 1e3, out.arrived_samples, out.worst * 1e3,
-        out.last * 1e3, (unsigned long long)out.snapshot->gate.markers_rejected,
+        out.open_loop * 1e3, out.bound * 1e3, out.worst * 1e3, out.margin * 1e3, out.samples,
+        out.arrived_samples, out.last * 1e3, out.commanded_step, out.measured_step,
+        (unsigned long long)out.snapshot->gate.markers_rejected,
         (unsigned long long)out.snapshot->gate.markers_checked,
         (unsigned long long)out.snapshot->gate.frames_rejected,
         (unsigned long long)out.snapshot->gate.frames_checked,
@@ -169,7 +233,7 @@ class HostileObservations : public ::testing::Test {
 
 TEST_F(HostileObservations, MarkersFiveToThreeHundredMillimetresOffAreGatedAndTheAuthorityHolds) {
   const Outcome out = run([&](ObservationFrame& f, int) { falsify(f, lie_size()); }, 5);
-  expect_authority_held(out), print(out);
+  expect_bounds_held(out), print(out);
   EXPECT_GT(out.snapshot->gate.frames_rejected, 0u);
   EXPECT_GT(out.snapshot->observations, 0u);  // the smaller lies pass the gate: the bound holds
 }
@@ -179,13 +243,13 @@ TEST_F(HostileObservations, MarkersFiveToThreeHundredMillimetresOffAreGatedAndTh
 // takes it, and the authority bound is what stops it.
 TEST_F(HostileObservations, ALieInsideTheGateMovesNoCorrectionBeyondTheBound) {
   const Outcome out = run([&](ObservationFrame& f, int) { falsify(f, 0.025); }, 5);
-  expect_authority_held(out), print(out);
+  expect_bounds_held(out), print(out);
   EXPECT_GT(out.snapshot->authority.largest, 0.015) << "the lie was taken";
 }
 
 TEST_F(HostileObservations, MarkersOneMetreOffAreAllRejectedAndMoveNothing) {
   const Outcome out = run([&](ObservationFrame& f, int) { falsify(f, 1.0); }, 4);
-  expect_authority_held(out), print(out);
+  expect_bounds_held(out), print(out);
   EXPECT_GT(out.snapshot->gate.frames_rejected, 20u);
   EXPECT_EQ(out.snapshot->gate.frames_rejected, out.snapshot->gate.frames_checked);
   EXPECT_EQ(out.snapshot->observations, 0u);
@@ -199,7 +263,7 @@ TEST_F(HostileObservations, AlternatingGoodAndLyingFramesAreGatedAndTheAuthority
         if (count % 2) falsify(f, lie_size());
       },
       5);
-  expect_authority_held(out), print(out);
+  expect_bounds_held(out), print(out);
   EXPECT_GT(out.snapshot->gate.frames_rejected, 0u);
   EXPECT_GT(out.snapshot->observations, 0u);  // the good frames are taken
 }

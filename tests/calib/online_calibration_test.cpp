@@ -37,9 +37,12 @@ class OnlineCalibrationTest : public ::testing::Test {
     camera.marker_nodes = targets.nodes;
   }
 
-  // The world at `joints` (from its last shape) and a frame of it.
+  // The world at `joints` (from its last shape, the gripped nodes carried along as the real
+  // object's are) and a frame of it.
   ObservationFrame look(const Eigen::VectorXd& joints) {
-    truth = world.solve_from(joints, truth.positions());
+    Positions x = truth.positions();
+    world.carry_gripped_nodes(truth.joints(), joints, truth.positions(), x);
+    truth = world.solve_from(joints, x);
     EXPECT_TRUE(truth.statics().converged()) << truth.statics().reason;
     return camera.observe(world.mesh(), truth.positions(), joints, rng);
   }

@@ -91,6 +91,9 @@ TEST_F(ClosedLoopCli, FeedbackBringsTheWorldToTargetsTheOpenLoopMisses) {
   EXPECT_GT(closed["gate"]["frames_checked"].get<int>(), 0) << closed.dump();
   EXPECT_EQ(closed["authority"]["max_correction"].get<double>(), 0.03);
   EXPECT_LE(closed["authority"]["largest"].get<double>(), 0.03);
+  // ...and the trust region: no joint farther than it from where the loop started.
+  EXPECT_EQ(closed["authority"]["trust_region"].get<double>(), 0.02);
+  EXPECT_LE(closed["authority"]["joint_offset"].get<double>(), 0.02 + 1e-9);
 
   // The world's true error is logged as it goes (how long it takes is a measurement, in
   // docs/benchmarks.md, not an assertion: the sim robot runs on the wall clock).
@@ -137,6 +140,9 @@ TEST_F(ClosedLoopCli, BadClosedLoopOptionsNameTheOption) {
       {{"--fit", "stiffness"}, "--fit"},
       {{"--camera-outliers", "1.5"}, "--camera-outliers"},
       {{"--camera-points", "-3"}, "--camera-points"},
+      {{"--trust-region", "0"}, "--trust-region"},
+      {{"--trust-region", "4"}, "--trust-region"},
+      {{"--trust-region", "nan"}, "--trust-region"},
       {{"--observations-udp", "70000"}, "--observations-udp"},
       {{"--observations-udp", "0", "--observations-address", "nowhere"}, "--observations-udp"},
   };

@@ -248,6 +248,73 @@ TEST(Controller, StatusSaysReachedOnlyWithinTheTolerance) {
   controller.stop();
 }
 
+// The trust region (issue 32): whatever the observations say, what the feedback re-aims at
+// moves no joint farther than options.trust_region from where the optimizer stopped for the
+// user's targets; the user's next targets move it as far as they need.
+TEST(Controller, FeedbackMovesNoJointBeyondTheTrustRegionButTheUserCan) {
+  const Scene scene = test::two_arm_scene({24, 2, 2});
+  GrippedObject probe(scene);
+  ReducedObjective probe_objective(probe);
+  const auto targets_at = [&](const Eigen::VectorXd& joints) {
+    const Evaluation e = probe_objective.evaluate(joints, probe.reference_positions());
+    ShapeTargets t;
+    for (int i = 0; i < probe.node_count(); i += 7)
+      t.nodes.push_back(i), t.positions.push_back(e.positions().segment<3>(3 * i));
+    return t;
+  };
+  const auto stopped = [](Controller& c) {  // steps until the request is applied and walked
+    c.step_once();
+    for (int k = 0; k < 300 && c.snapshot()->status == ControllerStatus::Optimizing; ++k)
+      c.step_once();
+    return c.snapshot();
+  };
+  Eigen::VectorXd goal = probe.reference_joints();
+  goal << 0.1, -0.4, 1.0, -0.1, -0.2, 0.8;
+  // Without the region (10 rad) the same lies move the joints far: that is what it is for.
+  for (const double radius : {0.02, 10.0}) {
+    ControllerOptions options;
+    options.trust_region = radius;
+    // Only the region bounds it: a correction up to 1 m, at any rate, through a 4 m gate.
+    options.feedback.max_correction = 1;
+    options.feedback.max_correction_rate = INFINITY;
+    options.feedback.gate.prior = 1;
+    Controller controller(scene, options);
+    controller.set_targets(targets_at(goal));
+    controller.set_feedback(true);
+    const Eigen::VectorXd start = stopped(controller)->joints;
+    // Every frame says the object is 0.2 m off in x: the corrected targets move 0.2 m away.
+    double farthest = 0;
+    for (int frame = 0; frame < 20; ++frame) {
+      const auto s = controller.snapshot();
+      ShapeObservation lie{.joints = s->joints, .markers = {}, .time = double(frame)};
+      for (int node : s->targets.nodes)
+        lie.markers.emplace_back(node, s->positions.segment<3>(3 * node) + Vec3(0.2, 0, 0));
+      controller.observe(lie);
+      for (int k = 0; k < 10; ++k) {
+        controller.step_once();
+        farthest =
+            std::max(farthest, (controller.snapshot()->joints - start).cwiseAbs().maxCoeff());
+      }
+    }
+    const auto s = controller.snapshot();
+    EXPECT_GT(s->authority.largest, 0.1) << "the lies were taken";
+    EXPECT_TRUE(s->safe);
+    if (radius < 1) {
+      EXPECT_LE(farthest, radius + 1e-12);
+      EXPECT_GT(farthest, radius - 1e-9) << "the lies pulled it to the region's face";
+    } else {
+      EXPECT_GT(farthest, 0.05);
+      continue;
+    }
+    // The user's own request: a free walk, then the region is around where that stops.
+    Eigen::VectorXd elsewhere = goal;
+    elsewhere[0] += 0.2, elsewhere[3] -= 0.2;
+    controller.set_feedback(false);
+    controller.set_targets(targets_at(elsewhere));
+    EXPECT_GT((stopped(controller)->joints - start).cwiseAbs().maxCoeff(), 0.1);
+  }
+}
+
 TEST(Centerline, StraightSketchAlongTheBarTargetsItsCentreNodes) {
   const Scene scene = test::two_arm_scene({24, 2, 2});
   GrippedObject object(scene);

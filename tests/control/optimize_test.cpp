@@ -76,6 +76,32 @@ TEST_P(OptimizeTest, ReachableTargetsAreReachedOverSeveralSeeds) {
   }
 }
 
+// A trust region (Optimizer::box) holds every trial: targets the optimizer would walk 0.25 rad
+// for are approached only as far as the box lets it, and the answer is still better than the
+// start.
+TEST_P(OptimizeTest, NoStepLeavesTheBox) {
+  const Scene scene = with_solver(test::two_arm_scene({24, 2, 2}));
+  GrippedObject object(scene);
+  ReducedObjective objective(object);
+  std::mt19937 rng(7);
+  const Eigen::VectorXd goal = object.reference_joints().array() + 0.25;
+  const Evaluation at_goal = objective.evaluate(goal, object.reference_positions());
+  ASSERT_TRUE(at_goal.statics().converged());
+  objective = objective.with_targets(targets_from_shape(at_goal.positions(), 15, rng));
+  const Evaluation start =
+      objective.evaluate(object.reference_joints(), object.reference_positions());
+  for (const double radius : {0.02, 10.0}) {
+    auto optimizer = make_optimizer(kind(), GradientMethod::Sensitivity);
+    optimizer->box =
+        Optimizer::JointBox{start.joints().array() - radius, start.joints().array() + radius};
+    const OptimizeResult result = optimize(objective, *optimizer, start, {.max_iterations = 60});
+    const double farthest = (result.best.joints() - start.joints()).cwiseAbs().maxCoeff();
+    EXPECT_LT(result.best.objective, start.objective);
+    if (radius < 1) EXPECT_NEAR(farthest, radius, 1e-12) << "held at the box's face";
+    else EXPECT_GT(farthest, 0.1) << "without a box in the way it walks far";  // the test's point
+  }
+}
+
 TEST_P(OptimizeTest, TargetsThroughEachOtherEndSafe) {
   // Pull the left end to the right of the right end and vice versa: the arms would cross.
   const Scene scene = with_solver(test::two_arm_scene());

@@ -27,8 +27,11 @@ std::optional<ObservationFrame> SimulatedWorld::step(double time,
   // A robot standing still leaves the world as it is: no solve (it shares the cores with the
   // controller it is testing).
   if (measured_joints != state_->joints()) {
-    ObjectState next =
-        object_.solve_from(measured_joints, state_->positions(), 0, nullptr, {}, workspaces_);
+    // From the last shape with the gripped nodes carried along, as the real object moves: from
+    // the last shape alone Newton first pulls the grips across, which can take it past its cap.
+    Positions x = state_->positions();
+    object_.carry_gripped_nodes(state_->joints(), measured_joints, state_->positions(), x);
+    ObjectState next = object_.solve_from(measured_joints, x, 0, nullptr, {}, workspaces_);
     if (!next.statics().converged())
       next = equilibrium_along_path(object_, measured_joints, 0.05, {}, workspaces_);
     state_.emplace(std::move(next));

@@ -119,6 +119,9 @@ struct Controller::State {
   std::uint64_t observations_ignored = 0;
   std::string observation_problem;
   std::uint64_t model_updates = 0;
+  // The centre of the feedback's trust region (ControllerOptions::trust_region): where the
+  // optimizer stopped after the user's last request; empty while it walks for that request.
+  std::optional<Eigen::VectorXd> loop_start;
 
   mutable std::mutex inbox_mutex;
   std::condition_variable inbox_changed;
@@ -153,11 +156,26 @@ struct Controller::State {
     objective = std::make_unique<ReducedObjective>(
         objective->with_targets(feedback_on ? feedback->corrected(user_targets) : user_targets));
   }
+  // The user's request: the optimizer walks free until it stops, and the loop starts there.
+  void free_walk() {
+    loop_start.reset();
+    optimizer->box.reset();
+  }
+  // The optimizer stopped: if it was the walk for the user's request, the loop starts here.
+  void start_loop() {
+    if (loop_start) return;
+    loop_start = current.joints();
+    optimizer->box = Optimizer::JointBox{current.joints().array() - options.trust_region,
+                                         current.joints().array() + options.trust_region};
+  }
   // Swaps in a new model at the current θ; false (last_error set) when it has no stable
   // equilibrium there.
   bool replace_model(const Scene& model);
   // Takes an observation into the feedback; true when the optimizer was re-aimed.
   bool take(const ShapeObservation& observation);
+  // Re-aims at the corrected targets if they moved enough (moved_enough) and the loop has
+  // started; true if it did.
+  bool reaim(double sigma);
   // Whether the corrected targets moved (RMS over the targets) past the threshold, or past
   // what the estimate's noise explains for observations of noise `sigma`, from those aimed at.
   bool moved_enough(const ShapeTargets& corrected, double sigma) const;
@@ -205,6 +223,8 @@ std::string Controller::State::jog_collision(const Eigen::VectorXd& from, const 
 }
 
 void Controller::State::apply(Inbox in) {
+  if (in.reset || in.clear || in.targets || in.centerline || (in.feedback && !*in.feedback))
+    free_walk();
   if (in.reset) {
     current = objective->evaluate(object->reference_joints(), object->reference_positions());
     retarget({});
@@ -246,6 +266,7 @@ void Controller::State::apply(Inbox in) {
     if (objective->confirm_stable(e)) {
       current = std::move(e);
       last_error.clear();
+      free_walk();
     } else {
       last_error = "jog refused: statics " + e.statics().reason;
       std::lock_guard lock(inbox_mutex);
@@ -327,7 +348,13 @@ bool Controller::State::take(const ShapeObservation& observation) {
     for (int k = 0; k < user_targets.size(); ++k)
       if (user_targets.nodes[k] == node) sum += (y - user_targets.positions[k]).norm(), ++count;
   observed_error = count ? sum / count : NAN;
-  if (!feedback_on || !moved_enough(feedback->corrected(user_targets), observation.sigma))
+  return reaim(observation.sigma);
+}
+
+bool Controller::State::reaim(double sigma) {
+  // Not while the optimizer walks for the user's request: re-aims would keep resetting it, and
+  // the loop (and its trust region) would never start. The walk's end catches up.
+  if (!feedback_on || !loop_start || !moved_enough(feedback->corrected(user_targets), sigma))
     return false;
   aim();
   return true;
@@ -373,8 +400,17 @@ void Controller::State::iterate() {
     last_iteration = now;
     if (dt > 0) rate = rate == 0 ? 1 / dt : 0.8 * rate + 0.2 / dt;
     if (last_outcome != StepOutcome::Improved) {
-      idle = true;  // wait for the next request
-      judge_stop();
+      // The walk for the user's request ended: the loop starts here, with what the feedback
+      // learnt on the way.
+      const bool walked = !loop_start;
+      start_loop();
+      if (walked && last_observation && reaim(last_observation->sigma)) {
+        objective->rescore(current);
+        optimizer->reset();
+      } else {
+        idle = true;  // wait for the next request
+        judge_stop();
+      }
     }
   } else if (objective->targets().empty() || paused) {
     idle = true;
@@ -389,6 +425,15 @@ void Controller::State::judge_stop() {
     shortfall = find_shortfalls(*objective, current);
   } catch (const std::exception& e) {  // the probes' statics: the reasons stay unknown
     shortfall.detail = std::string("reasons unknown: ") + e.what();
+  }
+  Eigen::Index j = 0;
+  if (loop_start &&
+      (current.joints() - *loop_start).cwiseAbs().maxCoeff(&j) >= options.trust_region - 1e-9) {
+    char held[160];
+    std::snprintf(held, sizeof held,
+                  "; the feedback's trust region holds %s at %.3g rad from where the loop started",
+                  object->robot().active_joint_names()[j].c_str(), options.trust_region);
+    shortfall.detail += held;
   }
 }
 
@@ -432,6 +477,9 @@ void Controller::State::publish() {
   s->observation_problem = observation_problem;
   s->gate = feedback->gate_counts();
   s->authority = feedback->authority();
+  s->authority.trust_region = options.trust_region;
+  if (loop_start)
+    s->authority.joint_offset = (current.joints() - *loop_start).cwiseAbs().maxCoeff();
   s->status = status();
   s->tolerance = options.tolerance;
   s->jog_refused_links = jog_refused_links;

@@ -52,6 +52,10 @@ struct FeedbackAuthority {
   double largest = 0;              // m, max |ê| over the observed nodes
   std::uint64_t rate_limited = 0;  // node updates held to the rate
   std::uint64_t clamped = 0;       // node updates held to max_correction
+  // The controller's trust region (ControllerOptions::trust_region), rad per joint, and how far
+  // the joints are now from where the loop started (0 while the optimizer walks for the user).
+  double trust_region = 0;
+  double joint_offset = 0;
 };
 
 class ModelErrorFeedback {

@@ -86,6 +86,15 @@ StepOutcome GaussNewton::step(const ReducedObjective& objective, Evaluation& cur
     if (!std::isfinite(largest)) return StepOutcome::Stuck;
     if (largest < 1e-12) return StepOutcome::Converged;
     if (largest > max_step) delta *= max_step / largest;
+    if (box) {
+      // Projected: at the box's face the step loses its outward part. A step that loses all
+      // of it is refused like a bad one: more damping turns it towards the projected gradient.
+      delta = held(current.joints() + delta) - current.joints();
+      if (delta.cwiseAbs().maxCoeff() < 1e-12) {
+        damping_ = std::min(damping_ * 4, 1e6);
+        continue;
+      }
+    }
     const Eigen::VectorXd theta = current.joints() + delta;
     // First-order prediction of the new equilibrium with its rotation made finite (a linear
     // one stretches the object), the gripped nodes carried exactly.
@@ -155,11 +164,14 @@ StepOutcome Lbfgs::step(const ReducedObjective& objective, Evaluation& current) 
   double t = 1.0;
   for (int k = 0; k < 16; ++k, t *= 0.5) {
     if (budget_spent()) return StepOutcome::OutOfTime;
-    const Eigen::VectorXd theta = current.joints() + t * d;
+    const Eigen::VectorXd theta = held(current.joints() + t * d);
+    // Armijo along the step taken: the projected one in a box.
+    const double decrease = box ? g.dot(theta - current.joints()) : t * slope;
+    if (!(decrease < 0)) continue;
     // Warm start from the current shape: carrying the gripped nodes alone (without dx̂/dθ·Δθ
     // for the rest) measured no faster for these short steps.
     Evaluation trial = objective.evaluate(theta, current.positions(), 25, &current, out_of_time);
-    if (!acceptable(trial, current, current.objective + 1e-4 * t * slope)) continue;
+    if (!acceptable(trial, current, current.objective + 1e-4 * decrease)) continue;
     if (!objective.confirm_stable(trial)) continue;
     const bool tiny = negligible(current.objective, trial.objective);
     const Eigen::VectorXd s = trial.joints() - current.joints();

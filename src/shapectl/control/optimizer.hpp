@@ -6,6 +6,7 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,12 +32,23 @@ class Optimizer {
   virtual StepOutcome step(const ReducedObjective& objective, Evaluation& current) = 0;
   // Forget accumulated curvature/damping, e.g. after the targets changed.
   virtual void reset() = 0;
+  // A trust region: the joints no trial may leave, per joint (rad). Empty: none (the paper's
+  // method). Trials are projected into it (the current joints must be inside); the controller
+  // holds what the feedback may do with it (control/controller.hpp).
+  struct JointBox {
+    Eigen::VectorXd lower, upper;
+  };
+  std::optional<JointBox> box;
   // Asked before every statics trial and every gradient; true ends the step there, so a budget
   // is overrun by at most one statics solve or gradient. Empty: no budget.
   std::function<bool()> out_of_time;
 
  protected:
   bool budget_spent() const { return out_of_time && out_of_time(); }
+  // `joints` projected into the box (unchanged without one).
+  Eigen::VectorXd held(const Eigen::VectorXd& joints) const {
+    return box ? Eigen::VectorXd(joints.cwiseMax(box->lower).cwiseMin(box->upper)) : joints;
+  }
 };
 
 enum class OptimizerKind { GaussNewton, Lbfgs };

@@ -249,7 +249,9 @@ nlohmann::json authority_json(const FeedbackAuthority& a) {
           {"max_correction_rate", a.max_correction_rate},
           {"largest", a.largest},
           {"rate_limited", a.rate_limited},
-          {"clamped", a.clamped}};
+          {"clamped", a.clamped},
+          {"trust_region", a.trust_region},
+          {"joint_offset", a.joint_offset}};
 }
 
 void log_gate(SessionLog& log, const ControllerSnapshot& s, GateCounts& logged) {
