@@ -16,6 +16,7 @@
 #include <shapectl/robot/robot_model.hpp>
 
 #include "commands.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 
@@ -113,7 +114,8 @@ void add_kinematics_command(CLI::App& app) {
                       "JSON {\"joints\": {\"name\": radians}}; missing joints are 0");
   command->add_option("--spheres", options->spheres, "Collision spheres JSON (see docs/robot.md)");
   command->add_option("--out", options->out, "Output JSON: link poses in the URDF root frame")
-      ->required();
+      ->required()
+      ->check(writable_output());
   add_package_path_option(*command, options->package_paths);
   command->callback([options] { run(*options); });
 }

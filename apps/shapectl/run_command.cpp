@@ -37,6 +37,7 @@
 #include "commands.hpp"
 #include "linear_solver_option.hpp"
 #include "link_options.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 #include "session_log_options.hpp"
@@ -433,7 +434,8 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::IsMember(link_kind_names()))
       ->capture_default_str();
   cmd->add_flag("--arm", args->arm, "arm the link: let the robot move (otherwise it holds)");
-  cmd->add_option("--log", args->log, "session log to write (JSON lines)");
+  cmd->add_option("--log", args->log, "session log to write (JSON lines)")
+      ->check(writable_output());
   add_session_log_options(*cmd, args->log_limits);
   cmd->add_flag("--until-settled", args->until_settled,
                 "exit 0 once the targets are reached and the robot arrived; exit 2 with the "

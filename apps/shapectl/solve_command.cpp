@@ -21,6 +21,7 @@
 
 #include "commands.hpp"
 #include "linear_solver_option.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 #include "surface_option.hpp"
@@ -165,9 +166,10 @@ void add_solve_command(CLI::App& app) {
       app.add_subcommand("solve", "Find joint angles that give the object the target shape");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
   cmd->add_option("--targets", args->targets, "TARGETS.json")->required();
-  cmd->add_option("--out", args->out, "RESULT.json to write")->required();
+  cmd->add_option("--out", args->out, "RESULT.json to write")->required()->check(writable_output());
   cmd->add_option("--vtu", args->vtu,
-                  "also write the deformed mesh at the best joints as VTU (ParaView)");
+                  "also write the deformed mesh at the best joints as VTU (ParaView)")
+      ->check(writable_output());
   add_surface_option(*cmd, args->surface);
   add_linear_solver_option(*cmd, args->linear_solver);
   cmd->add_option("--optimizer", args->optimizer, "gauss-newton (default) or lbfgs")

@@ -152,7 +152,7 @@ std::shared_ptr<const TetMesh> read_mesh_file(const std::filesystem::path& file,
 std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j, MeshOrigin& origin) {
   origin.field = j.path();
   if (j.is_string()) {
-    const auto path = j.directory() / j.string();
+    const auto path = j.file_path();
     origin.kind =
         is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
     return read_mesh_file(path, 1, {.origin_file = j.source(), .origin_path = j.path()}, origin);
@@ -171,7 +171,7 @@ std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j, MeshOrigin& origin)
   if (j.has("max_tet_volume")) options.max_tet_volume = j.at("max_tet_volume").non_negative();
   if (j.has("keep_surface")) options.keep_surface = j.at("keep_surface").boolean();
   const double scale = read_mesh_scale(j);
-  const auto path = j.directory() / j.at("file").string();
+  const auto path = j.at("file").file_path();
   origin.kind =
       is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
   origin.units_given = j.has("units") || j.has("scale");
@@ -239,7 +239,7 @@ RobotSetup read_robot(const JsonInput& j) {
   j.expect_only({"urdf", "reference_joints", "active_joints", "fixed_joints", "end_effectors",
                  "collision_spheres", "joint_limit_margin", "joint_limit_stiffness"});
   RobotSetup r;
-  const auto urdf = j.directory() / j.at("urdf").string();
+  const auto urdf = j.at("urdf").file_path();
   r.model = std::make_shared<RobotModel>(RobotModel::load_urdf_file(urdf));
   auto read_map = [](const JsonInput& m) {
     std::map<std::string, double> values;
@@ -279,8 +279,7 @@ RobotSetup read_robot(const JsonInput& j) {
   }
   if (j.has("collision_spheres"))
     r.collisions = std::make_shared<const CollisionModel>(
-        CollisionModel::load_json_file(*r.model,
-                                       j.directory() / j.at("collision_spheres").string()));
+        CollisionModel::load_json_file(*r.model, j.at("collision_spheres").file_path()));
   if (j.has("joint_limit_margin")) {
     j.at("joint_limit_margin").non_negative();
     r.joint_limit_margin = j.at("joint_limit_margin").number_in(0, 10, "rad or m");
