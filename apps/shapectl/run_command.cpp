@@ -356,15 +356,20 @@ LinkStatus stop_run(RobotLink& link, Controller& controller, const std::string& 
 
 // What `run` prints on stdout.
 nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status,
-                          RobotLink& link, const Observers& observers) {
+                          RobotLink& link, const Observers& observers, const RobotModel& robot) {
   const ControllerSnapshot& snap = *outcome.snapshot;
-  nlohmann::json result = {
-      {"settled", outcome.settled},          {"status", to_string(snap.status)},
-      {"status_reason", snap.status_reason}, {"unreachable", shortfall_names(snap.shortfalls)},
-      {"tolerance", snap.tolerance},         {"error_mean", snap.error.mean},
-      {"error_max", snap.error.max},         {"iterations", snap.iterations},
-      {"joint_names", snap.joint_names},     {"joints", vector_json(snap.joints)},
-      {"link", link_json(final_status)}};
+  nlohmann::json result = {{"settled", outcome.settled},
+                           {"status", to_string(snap.status)},
+                           {"status_reason", snap.status_reason},
+                           {"unreachable", shortfall_names(snap.shortfalls)},
+                           {"tolerance", snap.tolerance},
+                           {"error_mean", snap.error.mean},
+                           {"error_max", snap.error.max},
+                           {"iterations", snap.iterations},
+                           {"joint_names", snap.joint_names},
+                           {"joints", vector_json(snap.joints)},
+                           {"fixed_joints", fixed_joints_json(robot)},
+                           {"link", link_json(final_status)}};
   if (auto* egm = dynamic_cast<EgmLink*>(&link)) {
     const LatencyStats l = egm->latency();
     result["latency_us"] = {{"samples", l.samples},
@@ -417,7 +422,8 @@ void run(RunArgs args) {
   const RunOutcome outcome = follow_optimizer(args, controller, *link, log.get(), clock, observers);
   calibration.cancel();  // a fit still running would hold both cores while the rest stops
   const LinkStatus final_status = stop_run(*link, controller, outcome.failure);
-  const nlohmann::json result = run_result(outcome, final_status, *link, observers);
+  const nlohmann::json result =
+      run_result(outcome, final_status, *link, observers, *inputs.scene.robot->model);
   if (log) log->write("end", {{"settled", outcome.settled}, {"reason", outcome.failure}});
   std::cout << result.dump(2) << "\n";
   if (!outcome.failure.empty()) throw SolverFailure(outcome.failure);

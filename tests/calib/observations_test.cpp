@@ -139,7 +139,7 @@ TEST(Observations, JointsMustNameEveryActiveJointAndNoOther) {
       error_of(with_joints(R"({"a1": 0.1})"), context),
       "obs.json: frames[0].joints: missing active joint 'a2' (every active joint needs a value)");
   EXPECT_EQ(error_of(with_joints(R"({"a1": 0.1, "a2": 0, "a3": 0})"), context),
-            "obs.json: frames[0].joints.a3: not an active joint of the robot");
+            "obs.json: frames[0].joints.a3: unknown joint in arm.urdf");
   EXPECT_EQ(error_of(with_joints(R"({"a1": 0.1, "a2": 0, "finger": 0.01})"), context),
             "obs.json: frames[0].joints.finger: not an active joint of the robot");
   EXPECT_EQ(error_of(with_joints(R"({"a1": 0.1, "a2": "x"})"), context),

@@ -246,9 +246,17 @@ TEST(StaticsCli, UnknownJointInJointsFileIsNamed) {
   const auto run = run_cli(
       {"statics", kBar, "--joints", file.string(), "--out", (dir.path() / "r.json").string()});
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.err.find("j.json: joints.yumi_joint_9_l: not an active joint"), std::string::npos)
+  EXPECT_NE(run.err.find("j.json: joints.yumi_joint_9_l: unknown joint in "), std::string::npos)
       << run.err;
 }
 
 }  // namespace
 }  // namespace shapectl
+// A joint of the robot that the scene does not optimise (it fixes the fingers).
+const auto finger = dir.write("f.json", R"({"joints": {"gripper_l_joint": 0.01}})");
+const auto fixed = run_cli(
+    {"statics", kBar, "--joints", finger.string(), "--out", (dir.path() / "r.json").string()});
+EXPECT_EQ(fixed.exit_code, 1);
+EXPECT_NE(fixed.err.find("f.json: joints.gripper_l_joint: not an active joint of the robot"),
+          std::string::npos)
+    << fixed.err;
