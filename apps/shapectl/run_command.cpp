@@ -23,6 +23,7 @@
 #include <shapectl/calib/online_calibration.hpp>
 #include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/control/controller.hpp>
+#include <shapectl/control/reach_bound.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
@@ -142,6 +143,7 @@ RunInputs load_run_inputs(RunArgs& args) {
   print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(args.scene, "robot", "run needs a scene with a robot");
   TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
+  check_in_reach(GrippedObject(scene), targets, args.targets);  // before the link starts
   LinkKind kind = LinkKind::Sim;
   parse(args.robot, &kind);  // checked by the option
   args.link = link_config(args.link_options, kind, scene.robot->reference_joints);

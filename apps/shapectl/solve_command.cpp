@@ -11,6 +11,7 @@
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/control/controller.hpp>
 #include <shapectl/control/optimize.hpp>
+#include <shapectl/control/reach_bound.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/atomic_file.hpp>
 #include <shapectl/io/input_error.hpp>
@@ -80,6 +81,7 @@ void run_solve(const SolveArgs& args) {
   if (!scene.robot) throw InputError(args.scene, "robot", "a robot to optimize (missing key)");
   GrippedObject object(scene);
   const TargetsInput input = load_targets(args.targets, object.node_count());
+  check_in_reach(object, input, args.targets);  // a file in mm read as metres: refused now
   const ReducedObjective objective(object, resolve_targets(input, args.targets, object));
 
   OptimizerKind kind;

@@ -11,6 +11,7 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_input.hpp>
+#include <shapectl/io/length_units.hpp>
 #include <shapectl/linalg/cholesky_backend.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/mesh/load_mesh.hpp>
@@ -115,10 +116,7 @@ double read_mesh_scale(const JsonInput& j) {
     j.at("scale").fail_problem("give \"units\" or \"scale\", not both");
   if (j.has("scale")) return positive_in(j.at("scale"), 1e-9, 1e9, "");
   if (!j.has("units")) return 1;
-  const std::string units = j.at("units").string();
-  if (units == "m") return 1;
-  if (units == "cm") return 1e-2;
-  if (units == "mm") return 1e-3;
+  if (const auto scale = metres_per_unit(j.at("units").string())) return *scale;
   j.at("units").fail("\"m\", \"cm\" or \"mm\" (or give \"scale\": factor to metres)");
 }
 
