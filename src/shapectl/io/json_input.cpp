@@ -128,11 +128,10 @@ std::filesystem::path JsonInput::file_path() const {
   std::error_code error;
   // Only a file known to be absent; any other trouble (permissions) its reader reports.
   if (std::filesystem::exists(file, error) || error) return file;
-  if (std::filesystem::path(name).is_absolute())
-    fail_problem("no file '" + bounded_preview(name) + "'");
-  fail_problem("no file '" + bounded_preview(name) + "' (relative to the folder of " + source_ +
-               ", " + resolved_path(directory()).string() + ": " + resolved_path(file).string() +
-               ")");
+  const std::string shown = bounded_preview(name, 1000);  // a path, not the usual 80 bytes
+  if (std::filesystem::path(name).is_absolute()) fail_problem("no file '" + shown + "'");
+  fail_problem("no file '" + shown + "' (relative to the folder of " + source_ + ", " +
+               resolved_path(directory()).string() + ": " + resolved_path(file).string() + ")");
 }
 
 std::string JsonInput::child_path(std::string_view key) const {
