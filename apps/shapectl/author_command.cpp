@@ -32,6 +32,7 @@
 #include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
+#include "output_option.hpp"
 #include "robot_mesh_options.hpp"
 
 namespace shapectl::cli {
@@ -636,11 +637,13 @@ void add_author_command(CLI::App& app) {
       ->capture_default_str();
   c->add_option("--seed", o->seed, "Seed of the random poses (ignore pairs, IK restarts)")
       ->capture_default_str();
-  c->add_option("--out", o->out, "Scene JSON to write")->required();
+  c->add_option("--out", o->out, "Scene JSON to write")->required()->check(writable_output());
   c->add_option("--spheres-out", o->spheres_out,
-                "Sphere JSON to write (default: beside the scene, <name>_spheres.json)");
+                "Sphere JSON to write (default: beside the scene, <name>_spheres.json)")
+      ->check(writable_output());
   c->add_option("--report", o->report,
-                "Report JSON: grips, IK, clearance, limits, spheres, warnings");
+                "Report JSON: grips, IK, clearance, limits, spheres, warnings")
+      ->check(writable_output());
   c->callback([o] { run(*o); });
 }
 

@@ -25,6 +25,7 @@
 #include "bench_targets.hpp"
 #include "commands.hpp"
 #include "linear_solver_option.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 
@@ -303,7 +304,8 @@ void add_bench_command(CLI::App& app) {
                 "with --sizes: chord and Krylov steps solve in double precision, not single (to "
                 "measure what single saves)");
   cmd->add_option("--json", args->json,
-                  "also write the figures to this JSON file (for scripts/bench_table.py)");
+                  "also write the figures to this JSON file (for scripts/bench_table.py)")
+      ->check(writable_output());
   cmd->add_flag_callback(
       "--scaling", [args] { args->sizes = kDefaultSizes; },
       std::string("the scaling table at ") + kDefaultSizes + " tets (--sizes " + kDefaultSizes +

@@ -15,6 +15,7 @@
 
 #include "commands.hpp"
 #include "linear_solver_option.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 
@@ -156,14 +157,16 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option("--observations", args->observations, "OBSERVATIONS.json (docs/calibration.md)")
       ->required();
   cmd->add_option("--out", args->out, "CALIBRATED.json: the scene with the fitted values")
-      ->required();
+      ->required()
+      ->check(writable_output());
   cmd->add_option(
       "--fit", args->fit,
       "parameters to fit, comma-separated: youngs_modulus, poisson_ratio, density, grip_offsets, "
       "object_pose (default youngs_modulus,grip_offsets with a robot, "
       "youngs_modulus,object_pose for an object held by fixed nodes alone)");
   cmd->add_option("--report", args->report,
-                  "REPORT.json: values, standard deviations, residuals, identifiability");
+                  "REPORT.json: values, standard deviations, residuals, identifiability")
+      ->check(writable_output());
   cmd->add_option("--max-iterations", args->max_iterations, "iteration limit")
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--max-seconds", args->max_seconds,

@@ -1,5 +1,6 @@
-// shapectl kinematics ROBOT.urdf [--joints JOINTS.json] [--spheres SPHERES.json] --out OUT.json
-// Link poses at one configuration, and optionally self-collision clearances and limit checks.
+// shapectl kinematics ROBOT.urdf [--joints JOINTS.json|RESULT.json] [--spheres SPHERES.json] --out
+// OUT.json Link poses at one configuration, and optionally self-collision clearances and limit
+// checks.
 #include <iostream>
 #include <limits>
 #include <map>
@@ -8,14 +9,15 @@
 
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
-#include <shapectl/io/json_input.hpp>
 #include <shapectl/io/json_output.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/joint_limits.hpp>
+#include <shapectl/robot/joints_file.hpp>
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/robot/robot_model.hpp>
 
 #include "commands.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 
@@ -30,17 +32,6 @@ struct KinematicsOptions {
   std::string spheres;
   std::string out;
 };
-
-// {"joints": {"name": radians, ...}}; the model checks the names.
-std::map<std::string, double> read_joint_values(const std::string& file) {
-  const JsonInput json = JsonInput::load(file);
-  json.expect_only({"joints"});
-  std::map<std::string, double> values;
-  if (!json.has("joints")) return values;
-  const JsonInput joints = json.at("joints");
-  for (const auto& name : joints.keys()) values[name] = joints.at(name).number();
-  return values;
-}
 
 nlohmann::ordered_json collision_json(const RobotModel& robot, const CollisionModel& collision,
                                       const KinematicsState& state) {
@@ -73,10 +64,9 @@ nlohmann::ordered_json collision_json(const RobotModel& robot, const CollisionMo
 void run(const KinematicsOptions& options) {
   RobotModel robot = RobotModel::load_urdf_file(options.urdf);
   print_robot_notes(robot, options.package_paths);
-  const Eigen::VectorXd active =
-      options.joints.empty()
-          ? Eigen::VectorXd::Zero(robot.active_count()).eval()
-          : robot.active_joints_from_map(read_joint_values(options.joints), options.joints);
+  // A joints file or a result of statics, solve or run (its fixed joints too); missing joints 0.
+  Eigen::VectorXd active = Eigen::VectorXd::Zero(robot.active_count());
+  if (!options.joints.empty()) active = load_joints_file(options.joints, robot, active);
   const KinematicsState state = forward_kinematics(robot, active);
 
   nlohmann::ordered_json out;
@@ -110,10 +100,12 @@ void add_kinematics_command(CLI::App& app) {
       "kinematics", "Link poses of a URDF robot at given joint values; clearances with --spheres");
   command->add_option("robot", options->urdf, "Robot description (URDF)")->required();
   command->add_option("--joints", options->joints,
-                      "JSON {\"joints\": {\"name\": radians}}; missing joints are 0");
+                      "JOINTS.json {\"joints\": {\"name\": radians}}, or a result of statics, "
+                      "solve or run; missing joints are 0");
   command->add_option("--spheres", options->spheres, "Collision spheres JSON (see docs/robot.md)");
   command->add_option("--out", options->out, "Output JSON: link poses in the URDF root frame")
-      ->required();
+      ->required()
+      ->check(writable_output());
   add_package_path_option(*command, options->package_paths);
   command->callback([options] { run(*options); });
 }

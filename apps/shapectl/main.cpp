@@ -5,6 +5,7 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/runtime/runtime_policy.hpp>
 
+#include "command_suggestion.hpp"
 #include "commands.hpp"
 #include "shapectl_version.hpp"
 
@@ -23,6 +24,10 @@ int main(int argc, char** argv) {
   shapectl::cli::add_bench_command(app);
   shapectl::cli::add_serve_command(app);
   shapectl::cli::add_link_commands(app);
+  if (const auto unknown = shapectl::cli::unknown_command_message(app, argc, argv)) {
+    std::cerr << "error: " << *unknown << "\n";
+    return 1;  // as CLI11's own parse errors
+  }
   try {
     // Threads, OpenBLAS's idle threads, the heap (docs/runtime.md): before any command runs.
     shapectl::runtime::apply_runtime_policy(shapectl::runtime::settings_from_environment());

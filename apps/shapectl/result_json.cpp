@@ -16,10 +16,21 @@ nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints) {
   nlohmann::json out;
   const auto names = robot.active_joint_names();
   for (int j = 0; j < joints.size(); ++j) out["joints"][names[j]] = joints[j];
+  out["fixed_joints"] = fixed_joints_json(robot);
   const KinematicsState state = forward_kinematics(robot, joints);
   for (const auto& ee : scene.robot->end_effectors) {
     const Eigen::Isometry3d& T = state.T_world_link[ee.link];
     out["tools"][ee.name] = result_pose_json(T * ee.tcp_link, T.linear());
+  }
+  return out;
+}
+
+nlohmann::json fixed_joints_json(const RobotModel& robot) {
+  nlohmann::json out = nlohmann::json::object();
+  for (int j = 0; j < robot.joint_count(); ++j) {
+    const Joint& joint = robot.joints()[static_cast<std::size_t>(j)];
+    if (joint.movable() && joint.mimic_master < 0 && robot.active_index(j) < 0)
+      out[joint.name] = robot.fixed_value(j);
   }
   return out;
 }

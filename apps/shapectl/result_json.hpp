@@ -10,8 +10,12 @@
 
 namespace shapectl::cli {
 
-// {"joints": {name: rad}, "tools": {ee name: {"position": [..], "rotation": [[..]..]}}}
+// {"joints": {name: rad}, "fixed_joints": {name: value}, "tools": {ee name: {"position": [..],
+// "rotation": [[..]..]}}}
 nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints);
+// {name: value} of the robot's inactive movable joints (not mimics: gripper fingers): a result
+// carries them, so that `--joints RESULT` gives its pose on the bare URDF too (kinematics).
+nlohmann::json fixed_joints_json(const RobotModel& robot);
 // --tolerance M: the target error (m) under which a result counts as reached (default 1 mm).
 void add_tolerance_option(CLI::App& command, double& tolerance);
 // Throws SolverFailure ("<what>: <field> is not finite (<context>)") if any number in `result` is

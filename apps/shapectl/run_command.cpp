@@ -23,6 +23,7 @@
 #include <shapectl/calib/online_calibration.hpp>
 #include <shapectl/calib/simulated_world.hpp>
 #include <shapectl/control/controller.hpp>
+#include <shapectl/control/reach_bound.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
@@ -37,6 +38,7 @@
 #include "commands.hpp"
 #include "linear_solver_option.hpp"
 #include "link_options.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 #include "session_log_options.hpp"
@@ -141,6 +143,7 @@ RunInputs load_run_inputs(RunArgs& args) {
   print_scene_notes(scene, args.package_paths);
   if (!scene.robot) throw InputError(args.scene, "robot", "run needs a scene with a robot");
   TargetsInput targets = load_targets(args.targets, scene.object_mesh->node_count());
+  check_in_reach(GrippedObject(scene), targets, args.targets);  // before the link starts
   LinkKind kind = LinkKind::Sim;
   parse(args.robot, &kind);  // checked by the option
   args.link = link_config(args.link_options, kind, scene.robot->reference_joints);
@@ -355,15 +358,20 @@ LinkStatus stop_run(RobotLink& link, Controller& controller, const std::string& 
 
 // What `run` prints on stdout.
 nlohmann::json run_result(const RunOutcome& outcome, const LinkStatus& final_status,
-                          RobotLink& link, const Observers& observers) {
+                          RobotLink& link, const Observers& observers, const RobotModel& robot) {
   const ControllerSnapshot& snap = *outcome.snapshot;
-  nlohmann::json result = {
-      {"settled", outcome.settled},          {"status", to_string(snap.status)},
-      {"status_reason", snap.status_reason}, {"unreachable", shortfall_names(snap.shortfalls)},
-      {"tolerance", snap.tolerance},         {"error_mean", snap.error.mean},
-      {"error_max", snap.error.max},         {"iterations", snap.iterations},
-      {"joint_names", snap.joint_names},     {"joints", vector_json(snap.joints)},
-      {"link", link_json(final_status)}};
+  nlohmann::json result = {{"settled", outcome.settled},
+                           {"status", to_string(snap.status)},
+                           {"status_reason", snap.status_reason},
+                           {"unreachable", shortfall_names(snap.shortfalls)},
+                           {"tolerance", snap.tolerance},
+                           {"error_mean", snap.error.mean},
+                           {"error_max", snap.error.max},
+                           {"iterations", snap.iterations},
+                           {"joint_names", snap.joint_names},
+                           {"joints", vector_json(snap.joints)},
+                           {"fixed_joints", fixed_joints_json(robot)},
+                           {"link", link_json(final_status)}};
   if (auto* egm = dynamic_cast<EgmLink*>(&link)) {
     const LatencyStats l = egm->latency();
     result["latency_us"] = {{"samples", l.samples},
@@ -418,7 +426,8 @@ void run(RunArgs args) {
   const RunOutcome outcome = follow_optimizer(args, controller, *link, log.get(), clock, observers);
   calibration.cancel();  // a fit still running would hold both cores while the rest stops
   const LinkStatus final_status = stop_run(*link, controller, outcome.failure);
-  const nlohmann::json result = run_result(outcome, final_status, *link, observers);
+  const nlohmann::json result =
+      run_result(outcome, final_status, *link, observers, *inputs.scene.robot->model);
   if (log) log->write("end", {{"settled", outcome.settled}, {"reason", outcome.failure}});
   std::cout << result.dump(2) << "\n";
   if (!outcome.failure.empty()) throw SolverFailure(outcome.failure);
@@ -435,7 +444,8 @@ void add_run_command(CLI::App& app) {
       ->check(CLI::IsMember(link_kind_names()))
       ->capture_default_str();
   cmd->add_flag("--arm", args->arm, "arm the link: let the robot move (otherwise it holds)");
-  cmd->add_option("--log", args->log, "session log to write (JSON lines)");
+  cmd->add_option("--log", args->log, "session log to write (JSON lines)")
+      ->check(writable_output());
   add_session_log_options(*cmd, args->log_limits);
   cmd->add_flag("--until-settled", args->until_settled,
                 "exit 0 once the targets are reached and the robot arrived; exit 2 with the "

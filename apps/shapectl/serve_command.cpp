@@ -16,6 +16,7 @@
 #include "commands.hpp"
 #include "linear_solver_option.hpp"
 #include "link_options.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 #include "session_log_options.hpp"
@@ -139,7 +140,8 @@ void add_serve_command(CLI::App& app) {
       ->capture_default_str();
   add_link_options(*cmd, args->link);
   cmd->add_option("--log", args->log,
-                  "session log to write (JSON lines, as `run --log`; `shapectl replay` reads it)");
+                  "session log to write (JSON lines, as `run --log`; `shapectl replay` reads it)")
+      ->check(writable_output());
   add_session_log_options(*cmd, args->log_limits);
   cmd->add_option("--web-root", args->web_root,
                   "Directory with index.html (default: the repository's web/)");

@@ -11,6 +11,7 @@
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/control/controller.hpp>
 #include <shapectl/control/optimize.hpp>
+#include <shapectl/control/reach_bound.hpp>
 #include <shapectl/control/targets_file.hpp>
 #include <shapectl/io/atomic_file.hpp>
 #include <shapectl/io/input_error.hpp>
@@ -21,6 +22,7 @@
 
 #include "commands.hpp"
 #include "linear_solver_option.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 #include "surface_option.hpp"
@@ -79,6 +81,7 @@ void run_solve(const SolveArgs& args) {
   if (!scene.robot) throw InputError(args.scene, "robot", "a robot to optimize (missing key)");
   GrippedObject object(scene);
   const TargetsInput input = load_targets(args.targets, object.node_count());
+  check_in_reach(object, input, args.targets);  // a file in mm read as metres: refused now
   const ReducedObjective objective(object, resolve_targets(input, args.targets, object));
 
   OptimizerKind kind;
@@ -165,9 +168,10 @@ void add_solve_command(CLI::App& app) {
       app.add_subcommand("solve", "Find joint angles that give the object the target shape");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
   cmd->add_option("--targets", args->targets, "TARGETS.json")->required();
-  cmd->add_option("--out", args->out, "RESULT.json to write")->required();
+  cmd->add_option("--out", args->out, "RESULT.json to write")->required()->check(writable_output());
   cmd->add_option("--vtu", args->vtu,
-                  "also write the deformed mesh at the best joints as VTU (ParaView)");
+                  "also write the deformed mesh at the best joints as VTU (ParaView)")
+      ->check(writable_output());
   add_surface_option(*cmd, args->surface);
   add_linear_solver_option(*cmd, args->linear_solver);
   cmd->add_option("--optimizer", args->optimizer, "gauss-newton (default) or lbfgs")

@@ -16,6 +16,7 @@
 
 #include "commands.hpp"
 #include "linear_solver_option.hpp"
+#include "output_option.hpp"
 #include "result_json.hpp"
 #include "robot_mesh_options.hpp"
 #include "surface_option.hpp"
@@ -97,9 +98,11 @@ void add_statics_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("statics", "Solve the object's static equilibrium");
   cmd->add_option("scene", args->scene, "SCENE.json")->required();
   cmd->add_option("--joints", args->joints,
-                  "JOINTS.json {\"joints\": {name: rad}} (default: the reference joints)");
-  cmd->add_option("--out", args->out, "RESULT.json to write")->required();
-  cmd->add_option("--vtu", args->vtu, "also write the deformed mesh as VTU (ParaView)");
+                  "JOINTS.json {\"joints\": {name: rad}}, or a result of statics, solve or run "
+                  "(default: the reference joints)");
+  cmd->add_option("--out", args->out, "RESULT.json to write")->required()->check(writable_output());
+  cmd->add_option("--vtu", args->vtu, "also write the deformed mesh as VTU (ParaView)")
+      ->check(writable_output());
   add_surface_option(*cmd, args->surface);
   add_linear_solver_option(*cmd, args->linear_solver);
   add_package_path_option(*cmd, args->package_paths);

@@ -3,11 +3,14 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/surface_writer.hpp>
 
+#include "output_option.hpp"
+
 namespace shapectl::cli {
 
 void add_surface_option(CLI::App& cmd, std::string& file) {
   cmd.add_option("--surface", file,
-                 "also write the deformed surface triangles as PLY or OBJ (by the extension)");
+                 "also write the deformed surface triangles as PLY or OBJ (by the extension)")
+      ->check(writable_output());
 }
 
 void check_surface_option(const std::string& command, const std::string& file) {

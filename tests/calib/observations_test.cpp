@@ -72,8 +72,16 @@ TEST(Observations, SceneWithoutRobotHasNoJoints) {
       parse(R"({"frames": [{"markers": [{"node": 1, "position": [0, 0, 0]}]}]})",
             {.node_count = 2});
   EXPECT_EQ(obs.frames.at(0).joints.size(), 0);
-  EXPECT_EQ(error_of(R"({"frames": [{"joints": {}, "points": [[0, 0, 0]]}]})", {.node_count = 2}),
-            "obs.json: frames[0].joints: the scene has no robot: expected no joints");
+  // Issue 35: "joints": {} says the same as no key.
+  EXPECT_EQ(parse(R"({"frames": [{"joints": {}, "points": [[0, 0, 0]]}]})", {.node_count = 2})
+                .frames.at(0)
+                .joints.size(),
+            0);
+  EXPECT_EQ(error_of(R"({"frames": [{"joints": {"a1": 0}, "points": [[0, 0, 0]]}]})",
+                     {.node_count = 2}),
+            "obs.json: frames[0].joints: the scene has no robot: expected no joints (or {})");
+  EXPECT_EQ(error_of(R"({"frames": [{"joints": [], "points": [[0, 0, 0]]}]})", {.node_count = 2}),
+            "obs.json: frames[0].joints: the scene has no robot: expected no joints (or {})");
 }
 
 TEST(Observations, BadFramesAreErrorsNamingTheField) {
@@ -131,7 +139,7 @@ TEST(Observations, JointsMustNameEveryActiveJointAndNoOther) {
       error_of(with_joints(R"({"a1": 0.1})"), context),
       "obs.json: frames[0].joints: missing active joint 'a2' (every active joint needs a value)");
   EXPECT_EQ(error_of(with_joints(R"({"a1": 0.1, "a2": 0, "a3": 0})"), context),
-            "obs.json: frames[0].joints.a3: not an active joint of the robot");
+            "obs.json: frames[0].joints.a3: unknown joint in arm.urdf");
   EXPECT_EQ(error_of(with_joints(R"({"a1": 0.1, "a2": 0, "finger": 0.01})"), context),
             "obs.json: frames[0].joints.finger: not an active joint of the robot");
   EXPECT_EQ(error_of(with_joints(R"({"a1": 0.1, "a2": "x"})"), context),

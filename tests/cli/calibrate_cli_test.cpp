@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <random>
+#include <sstream>
 
 #include <shapectl/calib/joint_path.hpp>
 #include <shapectl/calib/model_parameters.hpp>
@@ -229,6 +230,59 @@ TEST_F(CalibrateFixedCli, FitsStiffnessAndClampPoseIntoASceneEveryCommandAccepts
   EXPECT_TRUE(nlohmann::json::parse(test::read_text(out))["object"].contains("pose"));
   const auto statics = run_cli({"statics", out, "--out", (dir.path() / "statics.json").string()});
   EXPECT_EQ(statics.exit_code, 0) << statics.err;
+}
+
+// Issue 35: every form of a path (a bare name, ./, absolute, ..) for the scene, the observations
+// and the outputs, run from where the form makes sense; the scene's mesh file named relative to
+// it, and "joints": {} in the frames of this scene without a robot. Each calibrated scene loads
+// from anywhere (its mesh path rebased), and nothing exits 3.
+TEST_F(CalibrateFixedCli, EveryFormOfAPathIsAccepted) {
+  namespace fs = std::filesystem;
+  const TetMesh& mesh = *model.object_mesh;
+  std::ostringstream node, ele;  // the scene's box as a TetGen pair, node order kept
+  node.precision(17);
+  node << mesh.node_count() << " 3 0 0\n";
+  for (int i = 0; i < mesh.node_count(); ++i) {
+    const Vec3& p = mesh.rest_positions()[i];
+    node << i << " " << p.x() << " " << p.y() << " " << p.z() << "\n";
+  }
+  ele << mesh.tet_count() << " 4 0\n";
+  for (int t = 0; t < mesh.tet_count(); ++t) {
+    const auto& n = mesh.tets()[t].nodes;
+    ele << t << " " << n[0] << " " << n[1] << " " << n[2] << " " << n[3] << "\n";
+  }
+  dir.write("meshes/bar.node", node.str());
+  dir.write("meshes/bar.ele", ele.str());
+  nlohmann::json scene = nlohmann::json::parse(test::read_text(kClamped));
+  scene["object"]["mesh"] = "../meshes/bar.ele";
+  dir.write("work/scene.json", scene.dump());
+  nlohmann::json obs = nlohmann::json::parse(test::read_text(observations));
+  for (auto& frame : obs["frames"]) frame["joints"] = nlohmann::json::object();
+  dir.write("work/obs.json", obs.dump());
+  dir.write("work/sub/.keep", "");
+  const fs::path work = dir.path() / "work";
+  struct Form {
+    const char* name;
+    fs::path cwd;
+    std::string scene, observations, out, report;
+  };
+  const std::vector<Form> forms = {
+      {"bare names", work, "scene.json", "obs.json", "bare.json", "bare_report.json"},
+      {"./", work, "./scene.json", "./obs.json", "./dot.json", "./dot_report.json"},
+      {"absolute", dir.path(), (work / "scene.json").string(), (work / "obs.json").string(),
+       (dir.path() / "absolute.json").string(), (dir.path() / "absolute_report.json").string()},
+      {"..", work / "sub", "../scene.json", "../obs.json", "../../up.json", "../up_report.json"}};
+  for (const Form& f : forms) {
+    const auto run = run_cli({"calibrate", f.scene, "--observations", f.observations, "--out",
+                              f.out, "--report", f.report},
+                             f.cwd);
+    EXPECT_EQ(run.exit_code, 0) << f.name << ": " << run.err;
+    const fs::path written = fs::path(f.out).is_absolute() ? fs::path(f.out) : f.cwd / f.out;
+    EXPECT_NO_THROW(load_scene(written)) << f.name;
+    EXPECT_TRUE(
+        fs::exists(fs::path(f.report).is_absolute() ? fs::path(f.report) : f.cwd / f.report))
+        << f.name;
+  }
 }
 
 TEST_F(CalibrateFixedCli, AFrameWithJointsExitsOneNamingTheField) {

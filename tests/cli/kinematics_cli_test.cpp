@@ -150,13 +150,58 @@ TEST(KinematicsCli, JointFileErrorsNameTheFileAndTheJoint) {
   const std::string out = (dir.path() / "out.json").string();
   const auto unknown = dir.write("unknown.json", R"({"joints": {"elbow": 0.1}})");
   expect_error({"kinematics", urdf.string(), "--joints", unknown.string(), "--out", out},
-               unknown.string() + ": joint 'elbow': unknown joint in " + urdf.string());
+               unknown.string() + ": joints.elbow: unknown joint in " + urdf.string());
   const auto huge = dir.write("huge.json", R"({"joints": {"shoulder": 1e999}})");
   expect_error({"kinematics", urdf.string(), "--joints", huge.string(), "--out", out},
                huge.string() + ": invalid JSON");  // nlohmann rejects 1e999 (number overflow)
   const auto typo = dir.write("typo.json", R"({"joint": {"shoulder": 0.1}})");
   expect_error({"kinematics", urdf.string(), "--joints", typo.string(), "--out", out},
                typo.string() + ": joint: unknown key; known: joints");
+}
+
+// Issue 36: a result of statics (or solve, or run) is a joints file, its fixed joints (the
+// gripper's fingers) included, so kinematics on the bare URDF gives the pose it was computed at.
+TEST(KinematicsCli, AResultGivesItsPoseFingersIncluded) {
+  const TempDir dir;
+  const std::string bar = source_path("scenes/yumi_bar.json").string();
+  const auto joints =
+      dir.write("joints.json", R"({"joints": {"yumi_joint_1_l": 0.1, "yumi_joint_6_r": -0.2}})");
+  const auto result_file = dir.path() / "result.json";
+  const test::CliRun statics =
+      run_cli({"statics", bar, "--joints", joints.string(), "--out", result_file.string()});
+  ASSERT_EQ(statics.exit_code, 0) << statics.err;
+  nlohmann::json result = nlohmann::json::parse(test::read_text(result_file));
+  EXPECT_EQ(result["fixed_joints"],
+            nlohmann::json({{"gripper_l_joint", 0.015}, {"gripper_r_joint", 0.015}}));
+  auto links_at = [&](const std::filesystem::path& file) {
+    const auto out = dir.path() / "links.json";
+    const test::CliRun run =
+        run_cli({"kinematics", kYumi, "--joints", file.string(), "--out", out.string()});
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return nlohmann::json::parse(test::read_text(out))["links"];
+  };
+  const nlohmann::json from_result = links_at(result_file);
+  // The same as every joint written out by hand, the fingers at the scene's 15 mm.
+  nlohmann::json all = result["joints"];
+  all.update(result["fixed_joints"]);
+  EXPECT_EQ(from_result, links_at(dir.write("all.json", nlohmann::json{{"joints", all}}.dump())));
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(from_result["gripper_l_tcp"]["position"][k].get<double>(),
+                result["tools"]["left"]["position"][k].get<double>(), 1e-12);
+    EXPECT_NEAR(from_result["gripper_r_tcp"]["position"][k].get<double>(),
+                result["tools"]["right"]["position"][k].get<double>(), 1e-12);
+  }
+  // Without them the fingers would be closed: the result's fixed joints are what reproduces it.
+  result.erase("fixed_joints");
+  EXPECT_NE(links_at(dir.write("closed.json", result.dump()))["gripper_l_finger_r"]["position"],
+            from_result["gripper_l_finger_r"]["position"]);
+  // A scene holding the fingers elsewhere cannot reproduce the result: refused, not ignored.
+  result["fixed_joints"] = {{"gripper_l_joint", 0.02}};
+  const auto other = dir.write("other.json", result.dump());
+  expect_error({"statics", bar, "--joints", other.string(), "--out", result_file.string()},
+               other.string() +
+                   ": fixed_joints.gripper_l_joint: expected 0.015, the value this robot holds "
+                   "the joint at (the result was computed with another), got 0.02");
 }
 
 TEST(KinematicsCli, SphereFileErrorsNameTheFileAndTheLink) {

@@ -96,6 +96,19 @@ TEST(RunCli, SimRobotSettlesAndTheLogReplaysWithinTheLimits) {
   EXPECT_TRUE(summary["violations"].empty());
   EXPECT_LE(summary["velocity_ratio"].get<double>(), 1 + 1e-9);
   EXPECT_EQ(summary["counts"]["arm"], 1);
+
+  // Issue 36: its stdout is a result --joints takes, fixed joints included.
+  const auto result_file = dir.write("run.json", run.out);
+  const auto statics_out = dir.path() / "statics.json";
+  const auto statics = run_cli({"statics", small_yumi_scene(dir).string(), "--joints",
+                                result_file.string(), "--out", statics_out.string()});
+  ASSERT_EQ(statics.exit_code, 0) << statics.err;
+  const auto again = nlohmann::json::parse(test::read_text(statics_out));
+  ASSERT_EQ(result["joint_names"].size(), result["joints"].size());
+  for (std::size_t k = 0; k < result["joints"].size(); ++k)
+    EXPECT_EQ(again["joints"][result["joint_names"][k].get<std::string>()], result["joints"][k]);
+  EXPECT_EQ(again["fixed_joints"], result["fixed_joints"]);
+  EXPECT_EQ(result["fixed_joints"].size(), 2u);
 }
 
 TEST(RunCli, EgmRobotThroughEgmSimSettlesWithinTheLimits) {

@@ -118,6 +118,49 @@ TEST(SolveCli, ASolveResultIsAcceptedAsJointsByStatics) {
   EXPECT_NE(bad.err.find("jionts"), std::string::npos) << bad.err;
 }
 
+// Issue 36 item 11: targets written in mm. Read as metres they lie hundreds of metres away, past
+// anything the robot reaches: refused at once (exit 1, nothing optimized or written). With
+// "units": "mm" the same file is the reachable shape it describes, and solve reaches it.
+TEST(SolveCli, TargetsInMillimetresNeedUnitsAndAreRefusedBeyondReachWithout) {
+  TempDir dir;
+  nlohmann::json joints = {{"yumi_joint_1_l", -0.02}, {"yumi_joint_1_r", 0.13}};
+  const auto joints_file = dir.write("joints.json", nlohmann::json{{"joints", joints}}.dump());
+  const auto goal = run_json({"statics", kBar, "--joints", joints_file.string(), "--out",
+                              (dir.path() / "goal.json").string()},
+                             dir.path() / "goal.json");
+  nlohmann::json targets = nlohmann::json::array();
+  for (int i = 0; i < 425; i += 53) {
+    nlohmann::json mm = nlohmann::json::array();
+    for (int d = 0; d < 3; ++d) mm.push_back(1e3 * goal["positions"][i][d].get<double>());
+    targets.push_back({{"node", i}, {"position", mm}});
+  }
+  const auto out = dir.path() / "solve.json";
+  const auto in_metres = dir.write("metres.json", nlohmann::json{{"targets", targets}}.dump());
+  const auto refused =
+      run_cli({"solve", kBar, "--targets", in_metres.string(), "--out", out.string()});
+  EXPECT_EQ(refused.exit_code, 1) << refused.err;
+  EXPECT_NE(refused.err.find(in_metres.string() + ": targets[0]: target "), std::string::npos)
+      << refused.err;
+  EXPECT_NE(refused.err.find("; the robot reaches at most "), std::string::npos) << refused.err;
+  EXPECT_EQ(refused.err.find("solve: "), std::string::npos) << refused.err;  // no optimizing
+  EXPECT_FALSE(std::filesystem::exists(out));
+
+  const auto in_mm =
+      dir.write("mm.json", nlohmann::json{{"units", "mm"}, {"targets", targets}}.dump());
+  const auto result =
+      run_json({"solve", kBar, "--targets", in_mm.string(), "--out", out.string()}, out);
+  EXPECT_LT(result["error_mean"].get<double>(), 1e-3);
+  EXPECT_NEAR(result["targets"][1]["position"][2].get<double>(),
+              goal["positions"][53][2].get<double>(), 1e-12);  // read back in metres
+  const auto bad_units = dir.write("cubits.json", R"({"units": "cubit", "targets": []})");
+  const auto wrong =
+      run_cli({"solve", kBar, "--targets", bad_units.string(), "--out", out.string()});
+  EXPECT_EQ(wrong.exit_code, 1);
+  EXPECT_NE(wrong.err.find(bad_units.string() + ": units: expected \"m\", \"cm\" or \"mm\", got "),
+            std::string::npos)
+      << wrong.err;
+}
+
 TEST(SolveCli, CentreLineIsFollowedOnTheBar) {
   TempDir dir;
   // A gentle arc through the bar's current ends (y = ±0.16), bulging up by 3 cm.
@@ -246,8 +289,16 @@ TEST(StaticsCli, UnknownJointInJointsFileIsNamed) {
   const auto run = run_cli(
       {"statics", kBar, "--joints", file.string(), "--out", (dir.path() / "r.json").string()});
   EXPECT_EQ(run.exit_code, 1);
-  EXPECT_NE(run.err.find("j.json: joints.yumi_joint_9_l: not an active joint"), std::string::npos)
+  EXPECT_NE(run.err.find("j.json: joints.yumi_joint_9_l: unknown joint in "), std::string::npos)
       << run.err;
+  // A joint of the robot that the scene does not optimise (it fixes the fingers).
+  const auto finger = dir.write("f.json", R"({"joints": {"gripper_l_joint": 0.01}})");
+  const auto fixed = run_cli(
+      {"statics", kBar, "--joints", finger.string(), "--out", (dir.path() / "r.json").string()});
+  EXPECT_EQ(fixed.exit_code, 1);
+  EXPECT_NE(fixed.err.find("f.json: joints.gripper_l_joint: not an active joint of the robot"),
+            std::string::npos)
+      << fixed.err;
 }
 
 }  // namespace

@@ -185,10 +185,12 @@ TEST(StaticsCli, UnknownLinearSolverIsRefusedWithTheChoices) {
 // Every command with --linear-solver checks it before reading any file.
 TEST(StaticsCli, EveryCommandWithTheLinearSolverOptionRefusesAnUnknownName) {
   const std::string none = "/nonexistent/x.json";
+  const TempDir dir;  // outputs are checked first (a writable one here)
+  const std::string out = (dir.path() / "x.json").string();
   const std::vector<std::vector<std::string>> commands = {{"solve", none, "--targets", none,
-                                                           "--out", none},
+                                                           "--out", out},
                                                           {"calibrate", none, "--observations",
-                                                           none, "--out", none},
+                                                           none, "--out", out},
                                                           {"bench", none},
                                                           {"run", none, "--targets", none},
                                                           {"serve", none}};

@@ -84,12 +84,17 @@ int wait_for_exit(pid_t pid) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-CliRun run_cli(const std::vector<std::string>& args) {
+CliRun run_cli(const std::vector<std::string>& args,
+               const std::filesystem::path& working_directory) {
   TempDir dir;
   const auto out_file = dir.path() / "stdout";
   const auto err_file = dir.path() / "stderr";
+  const std::string cwd = working_directory.string();  // made before fork
+  auto enter = [&cwd] {
+    if (!cwd.empty() && chdir(cwd.c_str()) != 0) _exit(126);
+  };
   CliRun run;
-  run.exit_code = wait_for_exit(start_process(cli_command(args), out_file, err_file));
+  run.exit_code = wait_for_exit(start_process(cli_command(args), out_file, err_file, enter));
   run.out = read_text(out_file);
   run.err = read_text(err_file);
   return run;

@@ -34,8 +34,10 @@ struct CliRun {
   std::string out;  // stdout
   std::string err;  // stderr
 };
-// Runs the built `shapectl` binary with `args` (each passed as one argument, no shell).
-CliRun run_cli(const std::vector<std::string>& args);
+// Runs the built `shapectl` binary with `args` (each passed as one argument, no shell), in
+// `working_directory` if given (else the test's), for relative paths.
+CliRun run_cli(const std::vector<std::string>& args,
+               const std::filesystem::path& working_directory = {});
 
 // The built `shapectl` followed by `args`: a command line for start_process.
 std::vector<std::string> cli_command(const std::vector<std::string>& args);

@@ -23,6 +23,16 @@ describe('target files', () => {
     assert.deepEqual(readTargetsOrJoints('j.json', JSON.stringify({ joints: { b: 2, a: 1 } }), robot), { joints: [1, 2] });
     const result = { converged: true, joints: { a: 1, b: 2 }, targets: [t(1, 0.2)], positions: [] };
     assert.deepEqual(readTargetsOrJoints('r.json', JSON.stringify(result), robot), { targets: [t(1, 0.2)], joints: [1, 2] });
+    const run = { settled: true, joint_names: ['b', 'a'], joints: [2, 1], fixed_joints: {} };
+    assert.deepEqual(readTargetsOrJoints('run.json', JSON.stringify(run), robot), { joints: [1, 2] });
+  });
+
+  it('reads coordinates in the file\'s "units" as metres', () => {
+    const mm = { units: 'mm', targets: [{ node: 3, position: [400, 0, 300] }] };
+    assert.deepEqual(readTargetsOrJoints('t.json', JSON.stringify(mm), robot), { targets: [t(3, 0.3)] });
+    const line = { units: 'cm', centerline: [[0, 0, 0], [10, 0, 0]] };
+    assert.deepEqual(readTargetsOrJoints('c.json', JSON.stringify(line), robot), { centerline: [[0, 0, 0], [0.1, 0, 0]] });
+    assert.throws(() => readTargetsOrJoints('x.json', '{"units": "ft", "targets": []}', robot), /x\.json: units: expected "m", "cm" or "mm", got "ft"/);
   });
 
   it('names the file and the field of what it cannot read', () => {

@@ -15,8 +15,10 @@ namespace {
 // θ with every active joint named; size 0 for a scene without a robot.
 Eigen::VectorXd read_frame_joints(const JsonInput& frame, const RobotModel* robot) {
   if (!robot) {
-    if (frame.has("joints"))
-      frame.at("joints").fail_problem("the scene has no robot: expected no joints");
+    // {} says "no joints" as well as leaving the key out (a program writing frames generically).
+    if (frame.has("joints") &&
+        !(frame.at("joints").is_object() && frame.at("joints").keys().empty()))
+      frame.at("joints").fail_problem("the scene has no robot: expected no joints (or {})");
     return {};
   }
   const JsonInput joints = frame.at("joints");

@@ -1,6 +1,7 @@
 #pragma once
 // TARGETS.json: {"targets": [{"node": i, "position": [x, y, z]}, …]} or
-// {"centerline": [[x, y, z], …]} (world frame, metres).
+// {"centerline": [[x, y, z], …]} (world frame), with "units": "m" (default), "cm" or "mm" for
+// the coordinates; read in metres.
 #include <filesystem>
 #include <vector>
 

@@ -102,4 +102,10 @@ void write_file_atomically(const fs::path& file, const std::string& text) {
   write_files_atomically({{file, text}});
 }
 
+void check_writable(const fs::path& file) {
+  check_target(file);
+  std::error_code ec;
+  fs::remove(write_temporary(file, ""), ec);  // permissions, a read-only file system, quotas
+}
+
 }  // namespace shapectl

@@ -23,4 +23,9 @@ struct FileContent {
 void write_files_atomically(const std::vector<FileContent>& files);
 void write_file_atomically(const std::filesystem::path& file, const std::string& text);
 
+// Whether `file` could be written now, checked before a long computation rather than after:
+// its directory exists, it is not a directory, and a temporary can be created beside it (then
+// removed; an existing file is not touched). Throws InputError naming the file, as above.
+void check_writable(const std::filesystem::path& file);
+
 }  // namespace shapectl

@@ -32,14 +32,30 @@ struct Descriptor {
 
 }  // namespace
 
+std::filesystem::path resolved_path(const std::filesystem::path& path) {
+  std::error_code error;
+  const std::filesystem::path cwd = std::filesystem::current_path(error);
+  const std::filesystem::path normal = (cwd / path).lexically_normal();
+  // "/a/b/" (from "." or "") shown as "/a/b".
+  return normal.has_filename() || normal == normal.root_path() ? normal : normal.parent_path();
+}
+
 std::string read_input_file(const std::filesystem::path& file, std::uintmax_t max_bytes,
                             std::string_view what) {
   const std::string name = file.string();
   // O_NONBLOCK: opening a FIFO must not wait for a writer; the type is checked on the open
   // descriptor, so the file cannot be swapped between the check and the read.
   const Descriptor in{open(file.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC)};
-  if (in.fd < 0)
-    throw InputError(name, "", "cannot open file (" + std::string(std::strerror(errno)) + ")");
+  if (in.fd < 0) {
+    const int error = errno;
+    const std::string resolved = error == ENOENT && file.is_relative()
+                                     ? "; relative to the current directory " +
+                                           resolved_path("").string() + ": " +
+                                           resolved_path(file).string()
+                                     : "";
+    throw InputError(name, "",
+                     "cannot open file (" + std::string(std::strerror(error)) + resolved + ")");
+  }
   struct stat info {};
   if (fstat(in.fd, &info) != 0)
     throw InputError(name, "", "cannot open file (" + std::string(std::strerror(errno)) + ")");

@@ -122,6 +122,18 @@ std::filesystem::path JsonInput::directory() const {
   return std::filesystem::path(source_).parent_path();
 }
 
+std::filesystem::path JsonInput::file_path() const {
+  const std::string name = string();
+  const std::filesystem::path file = directory() / name;  // an absolute name stays as it is
+  std::error_code error;
+  // Only a file known to be absent; any other trouble (permissions) its reader reports.
+  if (std::filesystem::exists(file, error) || error) return file;
+  const std::string shown = bounded_preview(name, 1000);  // a path, not the usual 80 bytes
+  if (std::filesystem::path(name).is_absolute()) fail_problem("no file '" + shown + "'");
+  fail_problem("no file '" + shown + "' (relative to the folder of " + source_ + ", " +
+               resolved_path(directory()).string() + ": " + resolved_path(file).string() + ")");
+}
+
 std::string JsonInput::child_path(std::string_view key) const {
   // Keys come from the input: a path shows at most 80 bytes of each.
   const std::string shown_key = bounded_preview(key);

@@ -43,6 +43,11 @@ class JsonInput {
   const std::string& path() const { return path_; }
   // The directory of the file this came from, for resolving relative paths.
   std::filesystem::path directory() const;
+  // The file this string names: relative to directory() unless absolute. A file that does not
+  // exist is an InputError naming the field, the name as written and how it was resolved:
+  // "scene.json: robot.urdf: no file 'arm.urdf' (relative to the folder of scene.json, /a/b:
+  // /a/b/arm.urdf)".
+  std::filesystem::path file_path() const;
 
   bool is_object() const { return value_.is_object(); }
   bool is_array() const { return value_.is_array(); }

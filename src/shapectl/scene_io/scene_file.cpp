@@ -11,6 +11,7 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_input.hpp>
+#include <shapectl/io/length_units.hpp>
 #include <shapectl/linalg/cholesky_backend.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/mesh/load_mesh.hpp>
@@ -115,10 +116,7 @@ double read_mesh_scale(const JsonInput& j) {
     j.at("scale").fail_problem("give \"units\" or \"scale\", not both");
   if (j.has("scale")) return positive_in(j.at("scale"), 1e-9, 1e9, "");
   if (!j.has("units")) return 1;
-  const std::string units = j.at("units").string();
-  if (units == "m") return 1;
-  if (units == "cm") return 1e-2;
-  if (units == "mm") return 1e-3;
+  if (const auto scale = metres_per_unit(j.at("units").string())) return *scale;
   j.at("units").fail("\"m\", \"cm\" or \"mm\" (or give \"scale\": factor to metres)");
 }
 
@@ -152,7 +150,7 @@ std::shared_ptr<const TetMesh> read_mesh_file(const std::filesystem::path& file,
 std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j, MeshOrigin& origin) {
   origin.field = j.path();
   if (j.is_string()) {
-    const auto path = j.directory() / j.string();
+    const auto path = j.file_path();
     origin.kind =
         is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
     return read_mesh_file(path, 1, {.origin_file = j.source(), .origin_path = j.path()}, origin);
@@ -171,7 +169,7 @@ std::shared_ptr<const TetMesh> read_mesh(const JsonInput& j, MeshOrigin& origin)
   if (j.has("max_tet_volume")) options.max_tet_volume = j.at("max_tet_volume").non_negative();
   if (j.has("keep_surface")) options.keep_surface = j.at("keep_surface").boolean();
   const double scale = read_mesh_scale(j);
-  const auto path = j.directory() / j.at("file").string();
+  const auto path = j.at("file").file_path();
   origin.kind =
       is_surface_file(path) ? MeshOrigin::Kind::SurfaceFile : MeshOrigin::Kind::VolumeFile;
   origin.units_given = j.has("units") || j.has("scale");
@@ -239,7 +237,7 @@ RobotSetup read_robot(const JsonInput& j) {
   j.expect_only({"urdf", "reference_joints", "active_joints", "fixed_joints", "end_effectors",
                  "collision_spheres", "joint_limit_margin", "joint_limit_stiffness"});
   RobotSetup r;
-  const auto urdf = j.directory() / j.at("urdf").string();
+  const auto urdf = j.at("urdf").file_path();
   r.model = std::make_shared<RobotModel>(RobotModel::load_urdf_file(urdf));
   auto read_map = [](const JsonInput& m) {
     std::map<std::string, double> values;
@@ -279,8 +277,7 @@ RobotSetup read_robot(const JsonInput& j) {
   }
   if (j.has("collision_spheres"))
     r.collisions = std::make_shared<const CollisionModel>(
-        CollisionModel::load_json_file(*r.model,
-                                       j.directory() / j.at("collision_spheres").string()));
+        CollisionModel::load_json_file(*r.model, j.at("collision_spheres").file_path()));
   if (j.has("joint_limit_margin")) {
     j.at("joint_limit_margin").non_negative();
     r.joint_limit_margin = j.at("joint_limit_margin").number_in(0, 10, "rad or m");
