@@ -129,6 +129,7 @@ void run_solve(const SolveArgs& args) {
     violations.push_back(
         {{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
+  out["loads_total"] = vec3_json(scene.loads_total());
   out["positions"] = positions_json(best.positions());
   out["targets"] = targets_json(objective.targets());
   for (const auto& h : result.history)

@@ -71,6 +71,7 @@ class StaticsSolution:
     residual: float
     energy: float
     result: StaticsResult
+    loads_total: FloatArray  # (3,), N
     positions: FloatArray  # (n, 3)
     joints: Optional[FloatArray]  # (m,)
     joint_names: List[str]
@@ -144,6 +145,7 @@ class SolveResult:
     objective: float
     min_clearance: Optional[float]
     limit_violations: List[LimitViolation]
+    loads_total: FloatArray  # (3,), N
     positions: FloatArray  # (n, 3)
     target_nodes: IntArray  # (k,)
     target_positions: FloatArray  # (k, 3)

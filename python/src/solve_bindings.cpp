@@ -31,6 +31,7 @@ struct SolveResult {
   double error_mean = 0, error_max = 0, objective = 0;
   std::optional<double> min_clearance;
   std::vector<LimitViolation> limit_violations;
+  Vec3 loads_total = Vec3::Zero();
   Positions positions;
   ShapeTargets targets;
   std::vector<HistoryEntry> history;
@@ -108,6 +109,7 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
   if (best.min_clearance != std::numeric_limits<double>::infinity())
     out.min_clearance = best.min_clearance;
   out.limit_violations = violations_at(object.robot(), best.joints());
+  out.loads_total = s.scene->loads_total();
   out.positions = best.positions();
   out.targets = objective.targets();
   out.history = result.history;
@@ -173,6 +175,8 @@ void bind_solve(py::module_& m) {
                     "Smallest sphere clearance, m; None without spheres.")
       .def_readonly("limit_violations", &SolveResult::limit_violations,
                     "Joints outside their hard limits.")
+      .def_readonly("loads_total", &SolveResult::loads_total,
+                    "Sum of the scene's applied loads, N, world frame: array of shape (3,).")
       .def_property_readonly(
           "positions", [](const SolveResult& r) { return positions_array(r.positions); },
           "Equilibrium at the best θ: array of shape (n, 3).")

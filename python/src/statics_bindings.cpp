@@ -12,6 +12,7 @@ namespace {
 // and tool poses.
 struct StaticsSolution {
   StaticsResult result;
+  Vec3 loads_total = Vec3::Zero();
   Positions positions;
   std::optional<Eigen::VectorXd> joints;
   std::vector<std::string> joint_names;
@@ -20,6 +21,7 @@ struct StaticsSolution {
 
 StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in) {
   StaticsSolution out;
+  out.loads_total = s.scene->loads_total();
   if (!s.object) {
     if (!joints_in.is_none())
       throw InputError("joints", "", "joints given, but the scene has no robot");
@@ -116,6 +118,8 @@ void bind_statics(py::module_& m) {
       .def_property_readonly(
           "energy", [](const StaticsSolution& s) { return s.result.energy; }, "Energy, J.")
       .def_readonly("result", &StaticsSolution::result, "The full StaticsResult.")
+      .def_readonly("loads_total", &StaticsSolution::loads_total,
+                    "Sum of the scene's applied loads, N, world frame: array of shape (3,).")
       .def_property_readonly(
           "positions", [](const StaticsSolution& s) { return positions_array(s.positions); },
           "Equilibrium positions, world frame, metres: array of shape (n, 3), mesh node order.")

@@ -157,16 +157,18 @@ TEST(ParameterSpace, ObjectPoseMovesTheSceneAboutTheObjectsOrigin) {
   EXPECT_EQ(space.coordinates()[5].name, "object_pose.rz");
 }
 
+// Why ParameterSpace refuses `fit` for `scene`, or "accepted".
+std::string refusal(const Scene& scene, const FitSelection& fit) {
+  try {
+    ParameterSpace space(scene, fit);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "accepted";
+}
+
 // The grips tie a gripped object to the grippers, which are where the joints put them.
 TEST(ParameterSpace, ObjectPoseIsRefusedForAnObjectTheRobotHolds) {
-  const auto refusal = [](const Scene& scene, const FitSelection& fit) -> std::string {
-    try {
-      ParameterSpace space(scene, fit);
-    } catch (const std::invalid_argument& e) {
-      return e.what();
-    }
-    return "accepted";
-  };
   Scene gripped = offset_scene();
   EXPECT_NE(refusal(gripped, {.object_pose = true}).find("held by the robot's grips alone"),
             std::string::npos);
@@ -176,6 +178,24 @@ TEST(ParameterSpace, ObjectPoseIsRefusedForAnObjectTheRobotHolds) {
   EXPECT_EQ(refusal(clamped_scene(), {.grip_offsets = true}),
             "grip_offsets: the scene has no grips");
   EXPECT_EQ(refusal(clamped_scene(), {.object_pose = true}), "accepted");
+}
+
+// Calibration fits one material over the whole mesh and turns only the weight with the object.
+TEST(ParameterSpace, MaterialIsRefusedWithRegionsAndObjectPoseWithLoads) {
+  Scene two_materials = clamped_scene();
+  two_materials.regions.push_back({.box = AlignedBox{Vec3(-1, -1, -1), Vec3(0, 1, 1)},
+                                   .material = material_from_youngs(1e6, 0.3, 40)});
+  for (const FitSelection& fit :
+       {FitSelection{.youngs_modulus = true}, FitSelection{.poisson_ratio = true},
+        FitSelection{.density = true}})
+    EXPECT_NE(refusal(two_materials, fit).find("not fitted in a scene with \"regions\""),
+              std::string::npos);
+  EXPECT_EQ(refusal(two_materials, {.object_pose = true}), "accepted");
+  Scene loaded = clamped_scene();
+  loaded.loads.push_back({.nodes = {3}, .force = Vec3(0, 0, -0.1)});
+  EXPECT_EQ(refusal(loaded, {.object_pose = true}),
+            "object_pose: not fitted in a scene with \"loads\"");
+  EXPECT_EQ(refusal(loaded, {.youngs_modulus = true}), "accepted");
 }
 
 TEST(ParameterSpace, UnknownNamesAreRefused) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <random>
+#include <stdexcept>
+#include <vector>
 
 #include <shapectl/fem/material.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
@@ -17,6 +19,24 @@ TEST(Gravity, LumpedMassesSumToTheTotalMass) {
   const Eigen::VectorXd m = lumped_masses(mesh, 40.0);
   EXPECT_NEAR(m.sum(), 40.0 * 0.32 * 0.03 * 0.03, 1e-12);
   EXPECT_GT(m.minCoeff(), 0);
+}
+
+TEST(Gravity, PerElementDensitiesGiveEachElementItsMass) {
+  const TetMesh mesh = make_box_mesh({0.32, 0.03, 0.03}, {16, 4, 4});
+  std::vector<Material> materials;
+  double mass = 0;
+  for (const TetRest& t : mesh.tets()) {
+    materials.push_back({.density = t.nodes[0] % 2 ? 40.0 : 400.0});
+    mass += materials.back().density * t.volume;
+  }
+  const Eigen::VectorXd m = lumped_masses(mesh, materials);
+  EXPECT_NEAR(m.sum(), mass, 1e-12 * mass);
+  // One material for all is the scalar density's lumping, bit for bit.
+  EXPECT_TRUE(
+      (lumped_masses(mesh, {Material{.density = 40}}).array() == lumped_masses(mesh, 40.0).array())
+          .all());
+  EXPECT_NEAR(Gravity(mesh, materials, Vec3(0, 0, -9.81)).weight(), mass * 9.81, 1e-12);
+  EXPECT_THROW(lumped_masses(mesh, std::vector<Material>(2)), std::invalid_argument);
 }
 
 TEST(Gravity, EnergyIsMassTimesGTimesHeight) {

@@ -6,7 +6,9 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <stdexcept>
 #include <tbb/task_arena.h>
+#include <vector>
 
 #include <shapectl/mesh/box_mesh.hpp>
 
@@ -30,6 +32,63 @@ TEST(NeoHookean, DerivativesMatchCentralDifferences) {
   std::mt19937 rng(42);
   for (int trial = 0; trial < 5; ++trial)
     test::expect_derivatives_match(term, test::perturbed(mesh.rest_vector(), 0.003, rng), 1e-6);
+}
+
+// Seeded materials, one per element, moduli spread over two decades (a two-material casting and
+// more): a mix-up of elements and materials shows in the derivatives.
+std::vector<Material> random_materials(const TetMesh& mesh, std::mt19937& rng) {
+  std::uniform_real_distribution<double> log_modulus(3, 5);
+  std::vector<Material> materials;
+  for (std::size_t e = 0; e < mesh.tets().size(); ++e)
+    materials.push_back({.mu = std::pow(10, log_modulus(rng)),
+                         .kappa = std::pow(10, log_modulus(rng)),
+                         .density = 30});
+  return materials;
+}
+
+TEST(NeoHookean, PerElementMaterialsDerivativesMatchCentralDifferences) {
+  const TetMesh mesh = make_box_mesh({0.1, 0.02, 0.02}, {4, 1, 1});
+  std::mt19937 rng(17);
+  const NeoHookean term(mesh, random_materials(mesh, rng));
+  for (int trial = 0; trial < 5; ++trial)
+    test::expect_derivatives_match(term, test::perturbed(mesh.rest_vector(), 0.003, rng), 1e-6);
+}
+
+TEST(NeoHookean, PerElementMaterialsGiveEachElementItsOwnEnergyAndHessian) {
+  const TetMesh mesh = make_box_mesh({0.1, 0.02, 0.02}, {4, 1, 1});
+  std::mt19937 rng(23);
+  const std::vector<Material> materials = random_materials(mesh, rng);
+  const NeoHookean term(mesh, materials);
+  const Positions x = test::perturbed(mesh.rest_vector(), 0.003, rng);
+  double energy = 0;
+  Eigen::MatrixXd hessian = Eigen::MatrixXd::Zero(x.size(), x.size());
+  for (std::size_t e = 0; e < mesh.tets().size(); ++e) {
+    const TetRest& t = mesh.tets()[e];
+    Vec12 xe;
+    for (int a = 0; a < 4; ++a) xe.segment<3>(3 * a) = x.segment<3>(3 * t.nodes[a]);
+    Mat12 H;
+    energy += neo_hookean_tet(t, materials[e], xe, nullptr, &H);
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        hessian.block<3, 3>(3 * t.nodes[a], 3 * t.nodes[b]) += H.block<3, 3>(3 * a, 3 * b);
+  }
+  EXPECT_NEAR(term.value(x), energy, 1e-12 * std::abs(energy));
+  EXPECT_TRUE(test::derivative_matches(test::dense_hessian(term, x), hessian, 1e-12,
+                                       "per-element Hessian"));
+}
+
+TEST(NeoHookean, OneMaterialPerElementAllAlikeIsTheSingleMaterialBitForBit) {
+  const TetMesh mesh = make_box_mesh({0.1, 0.02, 0.02}, {4, 1, 1});
+  const NeoHookean single(mesh, kFoam);
+  const NeoHookean each(mesh, std::vector<Material>(mesh.tets().size(), kFoam));
+  std::mt19937 rng(29);
+  const Positions x = test::perturbed(mesh.rest_vector(), 0.003, rng);
+  EXPECT_EQ(single.value(x), each.value(x));
+  EXPECT_TRUE(
+      (test::energy_gradient(single, x).array() == test::energy_gradient(each, x).array()).all());
+  EXPECT_TRUE(
+      (test::dense_hessian(single, x).array() == test::dense_hessian(each, x).array()).all());
+  EXPECT_THROW(NeoHookean(mesh, std::vector<Material>(2, kFoam)), std::invalid_argument);
 }
 
 TEST(NeoHookean, RestStateHasZeroEnergyAndForce) {

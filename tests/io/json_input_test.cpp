@@ -7,6 +7,8 @@
 
 #include <functional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include <shapectl/io/input_file.hpp>
 
@@ -54,6 +56,21 @@ TEST(JsonInput, DuplicateKeysAreErrorsNamingPathAndKey) {
   // The same key in different objects is fine.
   EXPECT_NO_THROW(
       parse_json_text(R"({"a": {"x": 1}, "b": {"x": 1}, "c": [{"x": 1}, {"x": 2}]})", "s.json"));
+}
+
+TEST(JsonInput, NumbersBeyondADoubleAreErrorsNamingTheirPath) {
+  // Read as a double they would be infinite: refused while parsing, named where they stand.
+  for (const auto& [text, where] : std::vector<std::pair<std::string, std::string>>{
+           {R"({"loads": [{"force": [0, 0, -1e999]}]})", "loads[0].force[2]"},
+           {R"({"loads": [{"nodes": [1]}, {"force": [1e400, 0, 0]}]})", "loads[1].force[0]"},
+           {R"({"gravity": 1e999})", "gravity"},
+           {R"([{"a": 1}, 2, -1e999])", "[2]"}}) {
+    const std::string message = error_of([&] { parse_json_text(text, "s.json"); });
+    EXPECT_EQ(message.rfind("s.json: " + where + ": expected a finite number, got one out of range",
+                            0),
+              0u)
+        << message;
+  }
 }
 
 TEST(JsonInput, HugeUnknownKeyIsEchoedBounded) {

@@ -62,6 +62,8 @@ std::string object_pose_refusal(const Scene& scene) {
     return "object_pose: the object is held by the robot's grips alone, which tie it to the "
            "grippers: its pose follows the joints (fit grip_offsets for where they hold it)";
   if (!scene.fixed) return "object_pose: the scene has no fixed nodes to place";
+  // Its force derivatives turn the weight with the object, not the loads.
+  if (!scene.loads.empty()) return "object_pose: not fitted in a scene with \"loads\"";
   return "";
 }
 
@@ -114,6 +116,12 @@ Scene PhysicalParameters::applied_to(const Scene& scene) const {
 }
 
 ParameterSpace::ParameterSpace(const Scene& scene, const FitSelection& selection) {
+  // One material is fitted, its derivatives taken over the whole mesh.
+  if ((selection.youngs_modulus || selection.poisson_ratio || selection.density) &&
+      !scene.regions.empty())
+    throw std::invalid_argument(
+        "youngs_modulus, poisson_ratio, density: not fitted in a scene with \"regions\" "
+        "(calibration fits one material for the whole object)");
   if (selection.youngs_modulus)
     coordinates_.push_back({Kind::LogYoungsModulus, -1, -1, "youngs_modulus", 1});
   if (selection.poisson_ratio)

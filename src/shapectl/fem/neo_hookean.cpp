@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <stdexcept>
+#include <string>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
@@ -159,7 +161,18 @@ double neo_hookean_tet(const TetRest& rest, const Material& m, const Vec12& x, V
 }
 
 NeoHookean::NeoHookean(const TetMesh& mesh, const Material& material)
-    : mesh_(mesh), material_(material), gather_(tet_nodes(mesh), mesh.node_count()) {}
+    : NeoHookean(mesh, std::vector<Material>{material}) {}
+
+NeoHookean::NeoHookean(const TetMesh& mesh, std::vector<Material> materials)
+    : mesh_(mesh),
+      materials_(std::move(materials)),
+      stride_(materials_.size() == 1 ? 0 : 1),
+      gather_(tet_nodes(mesh), mesh.node_count()) {
+  if (materials_.size() != 1 && materials_.size() != mesh.tets().size())
+    throw std::invalid_argument("NeoHookean: " + std::to_string(materials_.size()) +
+                                " materials for " + std::to_string(mesh.tets().size()) +
+                                " elements (expected one, or one per element)");
+}
 
 double NeoHookean::value(const Positions& x) const {
   const auto& tets = mesh_.tets();
@@ -168,7 +181,7 @@ double NeoHookean::value(const Positions& x) const {
       tbb::blocked_range<std::size_t>(0, tets.size(), kGrain), 0.0,
       hand_off([&](const tbb::blocked_range<std::size_t>& r, double sum) {
         for (std::size_t e = r.begin(); e != r.end(); ++e)
-          sum += tet_energy(tets[e], material_, gather(x, tets[e]));
+          sum += tet_energy(tets[e], material(e), gather(x, tets[e]));
         return sum;
       }),
       hand_off(std::plus<>()));
@@ -182,7 +195,7 @@ double NeoHookean::tet_energy_and_gradient(const Positions& x, std::size_t e,
                                            double* corners) const {
   // Written in place: a local copy, read back as wide loads, stalled on store forwarding.
   const TetRest& tet = mesh_.tets()[e];
-  const double energy = tet_energy_gradient(tet, material_, gather(x, tet), corners);
+  const double energy = tet_energy_gradient(tet, material(e), gather(x, tet), corners);
   if (!std::isfinite(energy))
     Eigen::Map<Vec12>{corners}.setConstant(std::numeric_limits<double>::quiet_NaN());
   return energy;
@@ -228,7 +241,7 @@ void NeoHookean::add_hessian(const Positions& x, ElementHessianSink& sink, bool 
     Mat12 H;
     // An inverted tet leaves its block NaN, so the factorization fails.
     if (std::isfinite(
-            neo_hookean_tet(tets[e], material_, gather(x, tets[e]), nullptr, &H, project_psd)))
+            neo_hookean_tet(tets[e], material(e), gather(x, tets[e]), nullptr, &H, project_psd)))
       Eigen::Map<Mat12>{block} = H;
   });
 }

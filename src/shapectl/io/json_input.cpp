@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <set>
 #include <sstream>
 
@@ -18,10 +19,15 @@ long line_at(std::string_view text, std::size_t at) {
 }
 
 // Tracks where the parser is ("object.mesh.box", "grips[1]") and refuses a key an object
-// already has: with nlohmann's default the last one would silently win.
+// already has: with nlohmann's default the last one would silently win. Copies share the
+// position (nlohmann keeps a copy), so a failed parse can say where it stopped.
 class DuplicateKeyCheck {
  public:
   explicit DuplicateKeyCheck(const std::string& source) : source_(source) {}
+
+  // The path of the value being read when parsing stopped ("loads[0].force[2]"): in an array,
+  // the element after the last one counted (it never parsed).
+  std::string failed_value_path() const { return path(1); }
 
   bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
     using Event = nlohmann::json::parse_event_t;
@@ -29,14 +35,14 @@ class DuplicateKeyCheck {
       case Event::object_start:
       case Event::array_start:
         count_element();
-        frames_.push_back({event == Event::object_start, {}, {}, -1});
+        frames_->push_back({event == Event::object_start, {}, {}, -1});
         break;
       case Event::object_end:
       case Event::array_end:
-        if (!frames_.empty()) frames_.pop_back();
+        if (!frames_->empty()) frames_->pop_back();
         break;
       case Event::key: {
-        Frame& top = frames_.back();
+        Frame& top = frames_->back();
         top.key = parsed.get<std::string>();
         if (!top.keys.insert(top.key).second)
           throw InputError(source_, path(), "duplicate key (each key may appear once)");
@@ -55,17 +61,21 @@ class DuplicateKeyCheck {
     long index;       // the element being read
   };
   void count_element() {
-    if (!frames_.empty() && !frames_.back().object) ++frames_.back().index;
+    if (!frames_->empty() && !frames_->back().object) ++frames_->back().index;
   }
-  std::string path() const {
+  // `pending`: added to the innermost array's index.
+  std::string path(long pending = 0) const {
     std::string out;
-    for (const Frame& f : frames_)
+    for (std::size_t k = 0; k < frames_->size(); ++k) {
+      const Frame& f = (*frames_)[k];
+      const long index = f.index + (k + 1 == frames_->size() ? pending : 0);
       out += f.object ? (out.empty() ? "" : ".") + bounded_preview(f.key)
-                      : "[" + std::to_string(f.index) + "]";
+                      : "[" + std::to_string(index) + "]";
+    }
     return out;
   }
   const std::string& source_;
-  std::vector<Frame> frames_;
+  std::shared_ptr<std::vector<Frame>> frames_ = std::make_shared<std::vector<Frame>>();
 };
 
 }  // namespace
@@ -98,13 +108,19 @@ nlohmann::json parse_json_text(std::string_view text, const std::string& source,
   if (const std::size_t at = json_too_deep_at(text, limits.max_depth); at != std::string_view::npos)
     throw InputError(source + ":" + std::to_string(line_at(text, at)), "",
                      "JSON nested deeper than " + std::to_string(limits.max_depth) + " levels");
+  const DuplicateKeyCheck check(source);
   try {
-    return nlohmann::json::parse(text.begin(), text.end(), DuplicateKeyCheck(source));
+    return nlohmann::json::parse(text.begin(), text.end(), check);
   } catch (const nlohmann::json::parse_error& e) {
     // nlohmann reports a byte offset; turn it into a line number. Its "last read" token can
     // be the whole rest of the file: the message is cut.
     throw InputError(source + ":" + std::to_string(line_at(text, e.byte)), "",
                      "invalid JSON (" + bounded_preview(e.what(), 200) + ")");
+  } catch (const nlohmann::json::out_of_range& e) {
+    // A number beyond a double's range (1e999) would be infinite: named where it stands.
+    throw InputError(source, check.failed_value_path(),
+                     "expected a finite number, got one out of range (" +
+                         bounded_preview(e.what(), 200) + ")");
   } catch (const nlohmann::json::exception& e) {
     throw InputError(source, "", "invalid JSON (" + bounded_preview(e.what(), 200) + ")");
   }

@@ -1,5 +1,6 @@
 #include <shapectl/scene_io/scene_file.hpp>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -31,6 +32,7 @@ constexpr double max_distance = max_scene_distance;  // m, positions and sizes
 constexpr double max_gravity = 1e3;                  // m/s^2 (100 g)
 constexpr double max_stiffness = 1e12;               // N/m, and the barrier stiffnesses
 constexpr double max_weight = 1e12;                  // objective weights
+constexpr double max_force = 1e9;                    // N, an applied load
 
 // A positive number from lo to hi; "a positive number" for zero or negative values.
 double positive_in(const JsonInput& j, double lo, double hi, const std::string& unit) {
@@ -48,8 +50,9 @@ AlignedBox read_box(const JsonInput& j) {
   return box;
 }
 
-NodeSelection read_node_selection(const JsonInput& j, int node_count) {
-  j.expect_only({"box", "nodes"});
+namespace {
+// The "box" and/or "nodes" keys of `j`, which may have others.
+NodeSelection read_selection_keys(const JsonInput& j, int node_count) {
   if (!j.has("box") && !j.has("nodes")) j.fail("an object with \"box\" or \"nodes\"");
   NodeSelection s;
   if (j.has("box")) s.box = read_box(j.at("box"));
@@ -59,6 +62,12 @@ NodeSelection read_node_selection(const JsonInput& j, int node_count) {
       s.nodes.push_back(static_cast<int>(list.at(k).integer_in(0, node_count - 1)));
   }
   return s;
+}
+}  // namespace
+
+NodeSelection read_node_selection(const JsonInput& j, int node_count) {
+  j.expect_only({"box", "nodes"});
+  return read_selection_keys(j, node_count);
 }
 
 Eigen::Isometry3d read_pose(const JsonInput& j) {
@@ -200,8 +209,7 @@ std::string significant(double value, int digits) {
 // A material whose load doubles resolve on the scene's mesh under its gravity
 // (sim/object_statics.hpp, roundoff_load_ratio): otherwise the rest shape would pass as the
 // equilibrium. Names the field and its largest valid value.
-void check_resolvable_material(const JsonInput& j, const Scene& scene) {
-  const Material& m = scene.material;
+void check_resolvable_material(const JsonInput& j, const Scene& scene, const Material& m) {
   const double ratio = roundoff_load_ratio(scene, m);
   if (ratio <= 1) return;
   const std::string why =
@@ -231,6 +239,53 @@ void check_resolvable_material(const JsonInput& j, const Scene& scene) {
     j.at("kappa").fail("at most " + significant(kappa, 3) + " Pa" + why);
   }
   j.fail_problem("a material too stiff for its weight" + why);
+}
+
+// "regions": [{"box", "material"}]: each material checked as the object's is.
+std::vector<MaterialRegion> read_regions(const JsonInput& list, const Scene& scene) {
+  std::vector<MaterialRegion> regions;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const JsonInput r = list.at(k);
+    r.expect_only({"box", "material"});
+    regions.push_back({.box = read_box(r.at("box")), .material = read_material(r.at("material"))});
+    check_resolvable_material(r.at("material"), scene, regions.back().material);
+  }
+  return regions;
+}
+
+// "loads": [{"nodes" and/or "box", "force"}]: a force (N, world frame) shared equally by its
+// nodes (rest positions, object coordinates, as "fixed").
+std::vector<NodeLoad> read_loads(const JsonInput& list, const TetMesh& mesh) {
+  std::vector<NodeLoad> loads;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const JsonInput l = list.at(k);
+    l.expect_only({"nodes", "box", "force"});
+    loads.push_back({.nodes = read_selection_keys(l, mesh.node_count()).resolve(mesh),
+                     .force = l.at("force").vec3_within(max_force, "a force", "N")});
+  }
+  return loads;
+}
+
+// A load on no node or a region of no element would silently change nothing. Checked after
+// check_scene, as the grips' regions are: a mesh drawn in mm misses every box, and the object's
+// size says why.
+void refuse_empty_selections(const JsonInput& root, const Scene& scene) {
+  for (std::size_t k = 0; k < scene.loads.size(); ++k) {
+    if (!scene.loads[k].nodes.empty()) continue;
+    const JsonInput l = root.at("loads").at(k);
+    if (l.has("box"))
+      l.at("box").fail("a box around at least one node (rest positions, object coordinates)");
+    l.at("nodes").fail("at least one node index");
+  }
+  const TetMesh& mesh = *scene.object_mesh;
+  for (std::size_t k = 0; k < scene.regions.size(); ++k) {
+    const MaterialRegion& region = scene.regions[k];
+    if (std::none_of(mesh.tets().begin(), mesh.tets().end(),
+                     [&](const TetRest& t) { return region.contains(mesh, t); }))
+      root.at("regions").at(k).at("box").fail(
+          "a box around the centroid of at least one element (rest positions, object "
+          "coordinates)");
+  }
 }
 
 RobotSetup read_robot(const JsonInput& j) {
@@ -364,16 +419,18 @@ ObjectiveWeights read_objective(const JsonInput& o) {
 
 Scene load_scene(const std::filesystem::path& file) {
   const JsonInput root = JsonInput::load(file);
-  root.expect_only(
-      {"object", "gravity", "fixed", "statics", "robot", "grips", "grip_stiffness", "objective"});
+  root.expect_only({"object", "gravity", "fixed", "loads", "regions", "statics", "robot", "grips",
+                    "grip_stiffness", "objective"});
   Scene scene;
   scene.source = file;
   read_object(root.at("object"), scene);
   if (root.has("gravity"))
     scene.gravity = root.at("gravity").vec3_within(max_gravity, "a gravity vector", "m/s^2");
-  check_resolvable_material(root.at("object").at("material"), scene);
+  check_resolvable_material(root.at("object").at("material"), scene, scene.material);
+  if (root.has("regions")) scene.regions = read_regions(root.at("regions"), scene);
   if (root.has("fixed"))
     scene.fixed = read_node_selection(root.at("fixed"), scene.object_mesh->node_count());
+  if (root.has("loads")) scene.loads = read_loads(root.at("loads"), *scene.object_mesh);
   if (root.has("statics")) scene.statics = read_statics(root.at("statics"));
   if (root.has("robot")) scene.robot = read_robot(root.at("robot"));
   if (root.has("grips")) {
@@ -384,6 +441,7 @@ Scene load_scene(const std::filesystem::path& file) {
     scene.grip_stiffness = positive_in(root.at("grip_stiffness"), 1e-12, max_stiffness, "N/m");
   if (root.has("objective")) scene.weights = read_objective(root.at("objective"));
   scene.warnings = check_scene(scene);
+  refuse_empty_selections(root, scene);
   return scene;
 }
 

@@ -76,6 +76,27 @@ std::shared_ptr<const TetMesh> placed_mesh(const Scene& scene) {
 }  // namespace
 
 namespace {
+// Weight plus the applied loads' magnitudes, N: what the force tolerance and the energy's
+// round-off scale with (a tip load on a weightless bar is resolved relative to the load).
+double applied_load(const Scene& scene, double weight) {
+  double load = weight;
+  for (const NodeLoad& l : scene.loads) load += l.force.norm();
+  return load;
+}
+
+// The material of largest moduli, which sets the force round-off (roundoff_scale).
+Material stiffest_material(const Scene& scene) {
+  Material m = scene.material;
+  for (const MaterialRegion& r : scene.regions)
+    if (r.material.mu + r.material.kappa > m.mu + m.kappa) m = r.material;
+  return m;
+}
+
+std::optional<ConstantForce> load_term(const Scene& scene) {
+  if (scene.loads.empty()) return std::nullopt;
+  return ConstantForce("loads", scene.load_forces());
+}
+
 std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
   std::vector<char> fixed(placed.node_count(), 0);
   if (scene.fixed)
@@ -92,6 +113,7 @@ std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
 // (A cold solve's own, exact Krylov steps pay at every size: StaticsOptions::cold_krylov_steps.)
 constexpr int kKrylovFrom = 5000;  // unknowns
 
+// `weight`: applied_load's, the weight plus the loads.
 StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double weight) {
   // Converged when every nodal force is a tiny fraction of the weight (or, for a weightless
   // object, of the force that strains it by 0.1 %) — but never below what round-off leaves.
@@ -99,7 +121,7 @@ StaticsOptions statics_options(const Scene& scene, const TetMesh& placed, double
   // resolved (load_scene refuses such a material), and a scene built in code then ends not
   // converged instead of passing the rest shape as its equilibrium.
   const double load = object_load(placed, scene.material, weight);
-  const RoundoffScale roundoff = roundoff_scale(placed, scene.material, weight);
+  const RoundoffScale roundoff = roundoff_scale(placed, stiffest_material(scene), weight);
   return {.force_tolerance = scene.statics.relative_tolerance * load,
           .force_roundoff =
               std::min(roundoff.force, max_roundoff_share * load / placed.node_count()),
@@ -124,10 +146,12 @@ double roundoff_load_ratio(const Scene& scene, const Material& material) {
 
 ObjectStatics::ObjectStatics(const Scene& scene, const std::vector<int>& held_nodes)
     : mesh_(placed_mesh(scene)),
-      elasticity_(*mesh_, scene.material),
-      gravity_(*mesh_, scene.material.density, scene.gravity),
+      elasticity_(*mesh_, scene.element_materials()),
+      gravity_(*mesh_, elasticity_.materials(), scene.gravity),
+      loads_(load_term(scene)),
       fixed_node_(fixed_nodes(scene, *mesh_)),
-      solver_(mesh_->node_count(), fixed_node_, statics_options(scene, *mesh_, gravity_.weight())) {
+      solver_(mesh_->node_count(), fixed_node_,
+              statics_options(scene, *mesh_, applied_load(scene, gravity_.weight()))) {
   std::vector<char> held = fixed_node_;
   for (int i : held_nodes) held[i] = 1;
   unheld_reason_ = find_unheld_part(*mesh_, held);
@@ -135,8 +159,13 @@ ObjectStatics::ObjectStatics(const Scene& scene, const std::vector<int>& held_no
 
 EnergyTerms ObjectStatics::terms(const EnergyTerm* extra) const {
   EnergyTerms t = {&elasticity_, &gravity_};
+  if (loads_) t.push_back(&*loads_);
   if (extra) t.push_back(extra);
   return t;
+}
+
+Eigen::VectorXd ObjectStatics::load_forces() const {
+  return loads_ ? loads_->forces() : Eigen::VectorXd::Zero(3 * mesh_->node_count());
 }
 
 StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra,

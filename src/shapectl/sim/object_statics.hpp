@@ -1,7 +1,9 @@
 #pragma once
-// A scene's object as an energy and a statics solver: neo-Hookean elasticity, gravity, fixed
-// nodes, plus extra terms the caller owns (the robot's grip springs).
+// A scene's object as an energy and a statics solver: neo-Hookean elasticity (each element of
+// its region's material), gravity, applied loads, fixed nodes, plus extra terms the caller owns
+// (the robot's grip springs).
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <shapectl/fem/gravity.hpp>
@@ -19,7 +21,7 @@ class ObjectStatics {
   // to detect parts of the object that nothing holds.
   explicit ObjectStatics(const Scene& scene, const std::vector<int>& held_nodes = {});
 
-  // The object's energy terms (elasticity, gravity), plus `extra` if given.
+  // The object's energy terms (elasticity, gravity, the loads if any), plus `extra` if given.
   EnergyTerms terms(const EnergyTerm* extra = nullptr) const;
   StaticsWorkspace make_workspace() const { return solver_.make_workspace(); }
   // Equilibrium from the warm start x (fixed nodes must be at their prescribed positions) with
@@ -37,6 +39,8 @@ class ObjectStatics {
   const TetMesh& mesh() const { return *mesh_; }
   const std::vector<char>& fixed_node() const { return fixed_node_; }
   double weight() const { return gravity_.weight(); }
+  // The applied loads' nodal forces (3n, N); zero without loads.
+  Eigen::VectorXd load_forces() const;
   // The force Newton stops at: the scene's tolerance, or the round-off floor if larger.
   double force_tolerance() const { return solver_.effective_tolerance(); }
 
@@ -44,6 +48,7 @@ class ObjectStatics {
   std::shared_ptr<const TetMesh> mesh_;
   NeoHookean elasticity_;
   Gravity gravity_;
+  std::optional<ConstantForce> loads_;  // none without loads: the default terms stay two
   std::vector<char> fixed_node_;
   std::string unheld_reason_;
   StaticsSolver solver_;
@@ -63,8 +68,8 @@ RoundoffScale roundoff_scale(const TetMesh& mesh, const Material& material, doub
 // Poisson's ratio near 0.5; stiff and light; far from the origin) the rest shape would pass as
 // converged under the object's own weight.
 inline constexpr double max_roundoff_share = 0.01;
-// The load the force tolerance is relative to, N: the weight; for a weightless object the force
-// that strains it by 0.1 %.
+// The load the force tolerance is relative to, N: the weight (with applied loads: the weight plus
+// their magnitudes); for an object with neither, the force that strains it by 0.1 %.
 double object_load(const TetMesh& mesh, const Material& material, double weight);
 // RoundoffScale::force over max_roundoff_share × the mean nodal load, for `material` on the
 // scene's mesh placed in the world under its gravity: above 1 its load cannot be resolved.

@@ -21,4 +21,33 @@ Positions Scene::world_rest_positions() const {
   return x;
 }
 
+bool MaterialRegion::contains(const TetMesh& mesh, const TetRest& tet) const {
+  Vec3 centroid = Vec3::Zero();
+  for (int a : tet.nodes) centroid += mesh.rest_positions()[a];
+  return box.contains(centroid / 4);
+}
+
+std::vector<Material> Scene::element_materials() const {
+  if (regions.empty()) return {material};
+  const auto& tets = object_mesh->tets();
+  std::vector<Material> out(tets.size(), material);
+  for (std::size_t e = 0; e < tets.size(); ++e)
+    for (const MaterialRegion& r : regions)
+      if (r.contains(*object_mesh, tets[e])) out[e] = r.material;
+  return out;
+}
+
+Eigen::VectorXd Scene::load_forces() const {
+  Eigen::VectorXd f = Eigen::VectorXd::Zero(3 * object_mesh->node_count());
+  for (const NodeLoad& load : loads)
+    for (int i : load.nodes) f.segment<3>(3 * i) += load.force / double(load.nodes.size());
+  return f;
+}
+
+Vec3 Scene::loads_total() const {
+  Vec3 total = Vec3::Zero();
+  for (const NodeLoad& load : loads) total += load.force;
+  return total;
+}
+
 }  // namespace shapectl

@@ -33,6 +33,21 @@ struct NodeSelection {
   std::vector<int> resolve(const TetMesh& mesh) const;
 };
 
+// A constant force shared equally by some nodes of the object: a hanging weight, a tip force.
+struct NodeLoad {
+  std::vector<int> nodes;     // at least one, each once
+  Vec3 force = Vec3::Zero();  // the total, N, world frame
+};
+
+// Part of the object of its own material: the elements whose rest centroid (object
+// coordinates) lies in `box`.
+struct MaterialRegion {
+  AlignedBox box;
+  Material material;
+  // Whether `tet` of `mesh` (rest positions) is in the region.
+  bool contains(const TetMesh& mesh, const TetRest& tet) const;
+};
+
 struct StaticsSettings {
   int max_iterations = 100;
   double relative_tolerance = 1e-6;        // force tolerance as a fraction of the object's weight
@@ -89,9 +104,12 @@ struct Scene {
   std::filesystem::path source;                // the scene file
   std::shared_ptr<const TetMesh> object_mesh;  // rest mesh in object coordinates
   Material material;
+  // Later regions override earlier ones; elements in none are of `material`.
+  std::vector<MaterialRegion> regions;
   Eigen::Isometry3d T_world_object = Eigen::Isometry3d::Identity();
   Vec3 gravity{0, 0, -9.81};
   std::optional<NodeSelection> fixed;
+  std::vector<NodeLoad> loads;
   StaticsSettings statics;
   std::optional<RobotSetup> robot;
   std::vector<Grip> grips;
@@ -104,6 +122,12 @@ struct Scene {
 
   // Rest positions placed in the world, stacked (3n).
   Positions world_rest_positions() const;
+  // Each element's material (mesh.tets() order), or {material} alone when there are no regions.
+  std::vector<Material> element_materials() const;
+  // The loads' nodal forces, stacked (3n), N, world frame.
+  Eigen::VectorXd load_forces() const;
+  // The sum of the loads' forces, N, world frame.
+  Vec3 loads_total() const;
 };
 
 }  // namespace shapectl
