@@ -15,7 +15,7 @@ if ! configure_log=$(cmake -S . -B build-tsan -DSHAPECTL_TSAN=ON -DSHAPECTL_BUIL
 fi
 grep -v -e '^-- ' -e '^$' <<<"$configure_log" >&2 || true
 cmake --build build-tsan -j "$(nproc)" --target tsan_tests
-ctest --test-dir build-tsan -L tsan --output-on-failure -j "$(nproc)" --timeout 900
+(cd build-tsan && ctest -L tsan --output-on-failure -j "$(nproc)" --timeout 900)
 
 cd build
 ctest --output-on-failure -j "$(nproc)" --timeout 900
