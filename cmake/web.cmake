@@ -19,7 +19,8 @@ if(NOT EXISTS /usr/bin/chromium)
   message(FATAL_ERROR "/usr/bin/chromium is missing: apt-get install chromium "
                       "or configure with -DSHAPECTL_WEB_TESTS=OFF")
 endif()
-foreach(script gui_e2e ws_fuzz robot_link real_object units robot_visuals targets targets_files panel robot_meshes status_jog)
+foreach(script gui_e2e ws_fuzz robot_link real_object units robot_visuals targets targets_files panel robot_meshes status_jog
+               panel_controls)
   add_test(NAME web_${script}
     COMMAND ${NODE_EXECUTABLE} --test --test-reporter=spec ${PROJECT_SOURCE_DIR}/tests/web/${script}.test.mjs)
   set_tests_properties(web_${script} PROPERTIES TIMEOUT 300

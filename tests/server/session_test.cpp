@@ -46,6 +46,18 @@ TEST_F(SessionTest, SceneMessageDescribesRobotObjectAndScenes) {
       << "scenes without a robot are not offered";
 }
 
+TEST_F(SessionTest, SceneMessageNamesTheArmEachJointMoves) {
+  const auto robot = nlohmann::json::parse(session.scene_message())["robot"];
+  const auto& names = robot["joint_names"];
+  const auto& arms = robot["joint_arms"];
+  ASSERT_EQ(arms.size(), names.size());
+  // The YuMi's joints end in _l (left arm) or _r (right arm); its end effectors are named so.
+  for (std::size_t k = 0; k < names.size(); ++k) {
+    const std::string name = names[k];
+    EXPECT_EQ(arms[k], name.ends_with("_l") ? "left" : "right") << name;
+  }
+}
+
 TEST_F(SessionTest, SetTargetReachesTheControllerAndTheStateMessage) {
   const auto r =
       session.handle(R"({"type":"set_target","id":1,"node":5,"position":[0.4,0.0,0.3]})");

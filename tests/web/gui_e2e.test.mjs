@@ -143,12 +143,17 @@ describe('browser GUI', () => {
     await waitFor(() => slider.isEnabled(), 'the slider to be enabled');
     const grip = (await hooks(page, () => window.shapectl.scene)).grips[0].nodes[0];
     const gripBefore = await hooks(page, (n) => window.shapectl.nodePosition(n), grip);
-    // Drag the slider's thumb a few pixels to the right (the panel scrolls: bring it into view).
+    // Drag the slider's thumb (10 px wide) two pixels to the right and hold it until the joint
+    // walks after it (the panel scrolls: bring it into view).
     await slider.scrollIntoViewIfNeeded();
     const box = await slider.boundingBox();
     const [lo, hi] = [Number(await slider.getAttribute('min')), Number(await slider.getAttribute('max'))];
-    const x = box.x + 8 + (box.width - 16) * (paused.joints[0] - lo) / (hi - lo), y = box.y + box.height / 2;
-    await mouseStroke(page, [{ x, y }, { x: x + 1, y }, { x: x + 2, y }]);
+    const x = box.x + 5 + (box.width - 10) * (paused.joints[0] - lo) / (hi - lo), y = box.y + box.height / 2;
+    await page.mouse.move(x, y);
+    await page.mouse.down();
+    await page.mouse.move(x + 2, y, { steps: 2 });
+    await waitFor(async () => (await state(page)).joints[0] - paused.joints[0] > 0.01, 'joint 1 to walk while the thumb is held');
+    await page.mouse.up();
     const asked = Number(await slider.inputValue());
     assert.ok(asked - paused.joints[0] > 0.01 && asked - paused.joints[0] < 0.2, `slider moved from ${paused.joints[0]} to ${asked}`);
     const jogged = await waitFor(async () => {

@@ -1,5 +1,5 @@
 // The side panel and the view's tools, as a user at 1280×800 sees them: a panel that fits,
-// scrolls and does not jump; Delete only when there is something to remove; the
+// scrolls and does not jump as numbers change; Delete only when there is something to remove; the
 // convergence plot's axis, range, editing band, log scale and hover read-out; frames, scale
 // bar, hover read-out, view presets, screenshot and `?` help in the 3D view; a notice when
 // another client changes the shared session. Real mouse and keyboard events; the page's
@@ -96,19 +96,17 @@ describe('side panel and view tools', () => {
     await drag(page, start2d, end2d);
     const seen = await sampling;
     for (const tops of seen) assert.deepEqual(tops, start, 'nothing moved while the session changed');
-    // The widest texts the page writes there.
-    const extreme = await hooks(page, async (f) => {
+    // Numbers up to their boxes' widths move nothing after them on the line (longer texts wrap
+    // whole instead of being cut: panel_controls.test.mjs).
+    const lefts = await hooks(page, () => {
       const set = (id, text) => { document.getElementById(id).textContent = text; };
-      set('status', 'best effort · unreachable: joint limit of yumi_joint_7_l and collision with the other arm');
-      set('error-mean', '12345.67'); set('error-max', '123456.78'); set('rate', '1234');
-      set('status-detail', '12 targets · 123456 iterations · 3 page(s) · clearance 123 mm · UNSAFE · jog refused: link_7_l would collide with link_6_r (clearance −3 mm)');
-      const tops = new Function(`return (${f})()`)();
-      // Before the next state message rewrites it: the tooltip updates in a microtask.
-      await new Promise((done) => queueMicrotask(done));
-      return { tops, title: document.getElementById('status').title };
-    }, probe.toString());
-    assert.deepEqual(extreme.tops, start, 'long texts do not re-wrap the panel');
-    assert.match(extreme.title, /^best effort · unreachable: joint limit/, 'what is cut off is whole in the tooltip');
+      const measure = () => [...document.querySelectorAll('#numbers-line > span')].map((e) => e.getBoundingClientRect().left);
+      set('error-mean', '–'); set('error-max', '0.01'); set('rate', '–');
+      const narrow = measure();
+      set('error-mean', '123.45'); set('error-max', '999.99'); set('rate', '9999');
+      return { narrow, wide: measure() };
+    });
+    assert.deepEqual(lefts.wide, lefts.narrow, 'the numbers do not push each other');
   });
 
   it('draws the convergence plot in mm with a robust range, merged editing spans and a log option', async () => {

@@ -10,6 +10,7 @@ import { fileURLToPath } from 'node:url';
 
 export const sourceDir = process.env.SHAPECTL_SOURCE_DIR ?? path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const cli = process.env.SHAPECTL_CLI ?? path.join(sourceDir, 'build/shapectl');
+export const buildDir = path.dirname(cli);  // where tests may write (screenshots), not the sources
 
 export async function loadPlaywright() {
   return import(path.join(sourceDir, 'web/node_modules/playwright-core/index.mjs'));

@@ -12,6 +12,7 @@ export const KEYS = Object.freeze([
   ['Ctrl+Shift+Z, Ctrl+Y', 'redo'],
   ['1 / 3 / 7 / 0', 'view from the front / side / top / iso'],
   ['t', 'see-through robot'],
+  ['Shift+← / →', 'on a joint slider: jog by 0.1°'],
   ['?', 'this help'],
 ]);
 
@@ -19,6 +20,7 @@ export const MOUSE = Object.freeze([
   ['click the object', 'add a target at the nearest node'],
   ['drag a handle', 'move that target in the view plane'],
   ["drag the gizmo's arrows", 'move the selected target along that axis'],
+  ['drag a joint slider (paused)', 'the joint follows while held; Shift: a tenth as fast'],
   ['left drag', 'orbit'],
   ['right / middle drag', 'pan'],
   ['wheel', 'zoom'],

@@ -6,19 +6,18 @@ import { ConvergencePlot } from './plot.js';
 import { CalibrationPanel } from './calibration_panel.js';
 import { TargetEditor } from './target_editing.js';
 import { ViewTools } from './view_tools.js';
-import { Command } from './protocol.js';
+import { Command, ControllerStatus } from './protocol.js';
 import { statusBadge } from './status_badge.js';
-import { boundedJog, chainOrder, limitText } from './joint_jog.js';
+import { typingIn } from './keys.js';
+import { JointPanel } from './joint_panel.js';
 
 const $ = (id) => document.getElementById(id);
-const DEG = 180 / Math.PI;
 // Metres as mm for the panel; '–' for none.
 const mm = (v) => (v === null || v === undefined ? '–' : (1000 * v).toFixed(2));
 
 const page = {
   scene: null,       // the last "scene" message
   state: null,       // the last "state" message
-  sliders: [],       // per joint: {slider, row, value, mark, lo, hi}
   robotWarnings: [], // robot meshes not drawn, as shown in the panel
   stats: { states: 0, positions: 0, errors: [], editingStates: 0, stateTimes: [] },
 };
@@ -37,7 +36,7 @@ const editor = new TargetEditor({
 const plot = new ConvergencePlot($('plot'), $('plot-legend'), { readout: $('plot-readout'), logScale: $('plot-log') });
 const tools = new ViewTools(view, {
   frames: $('show-frames'), screenshot: $('screenshot'), helpButton: $('help-button'), help: $('help'), scaleBar: $('scale-bar'),
-  hover: $('hover-readout'), notice: $('notice'), deleteButton: $('delete'), clipped: [$('status'), $('status-detail'), $('status-reason')],
+  hover: $('hover-readout'), notice: $('notice'), deleteButton: $('delete'),
 });
 const calibration = new CalibrationPanel({
   button: $('calibrate'), auto: $('auto-calibration'), status: $('calibration-status'), model: $('model'),
@@ -59,11 +58,17 @@ const connection = new Connection(`ws://${location.host}/ws`, {
   error: (message) => { page.stats.errors.push(message.message); toast(message.message); },
 });
 
-// Fire and forget: errors already show as a toast.
-function command(type, fields) {
+// Resolves with the reply, rejects with an error reply (which shows as a toast anyway).
+function send(type, fields) {
   tools.sent(type);
-  return connection.send(type, fields).catch(() => {});
+  return connection.send(type, fields);
 }
+
+// Fire and forget.
+function command(type, fields) {
+  return send(type, fields).catch(() => {});
+}
+const jointPanel = new JointPanel($('joints'), (joint, value) => send(Command.SetJoint, { joint, value }));
 
 function toast(text) {
   const t = $('toast');
@@ -94,7 +99,7 @@ function onScene(scene) {
   $('face-bar').disabled = !scene.bar;
   $('sketch').title = scene.bar ? 'Sketch a centre-line with the mouse (C)' : 'Only for bar-like objects';
   $('link-section').hidden = !scene.link;
-  buildJointSliders(scene.robot);
+  jointPanel.setRobot(scene.robot);
   showRobotWarnings(scene.warnings ?? []);
 }
 
@@ -110,39 +115,6 @@ function showRobotWarnings(lines) {
 view.robotView.group.addEventListener('meshloaded', () => view.requestRender());
 view.ghostView.group.addEventListener('meshloaded', () => view.requestRender());
 view.robotView.group.addEventListener('mesherror', (e) => showRobotWarnings([...page.robotWarnings, e.message]));
-
-function buildJointSliders(robot) {
-  const box = $('joints');
-  box.replaceChildren();
-  page.sliders = [];
-  if (!robot) return;
-  // In chain order (shoulder to wrist, arm by arm), each with its limits.
-  chainOrder(robot).forEach((k) => {
-    const name = robot.joint_names[k];
-    const lo = robot.lower_limits[k] ?? -Math.PI, hi = robot.upper_limits[k] ?? Math.PI;
-    const row = document.createElement('div');
-    row.className = 'joint';
-    const limits = limitText(robot.lower_limits[k], robot.upper_limits[k]);
-    const position = robot.chain_positions?.[k] ? `${robot.chain_positions[k]}. ` : '';
-    row.innerHTML = `<span class="name" title="${name}: joint ${position}in its chain, ${limits}">${position}${name}</span>
-      <input type="range" min="${lo}" max="${hi}" step="any" aria-label="${name}" data-joint="${k}">
-      <span class="value"></span><div class="limit"><i></i></div><span class="limits">${limits}</span>`;
-    const slider = row.querySelector('input');
-    slider.addEventListener('pointerdown', () => { slider.dragging = true; });
-    slider.addEventListener('pointerup', () => { slider.dragging = false; });
-    slider.addEventListener('blur', () => { slider.dragging = false; });
-    slider.addEventListener('input', () => {
-      slider.editedAt = performance.now();
-      // At most one jog step from the last value sent (or the state's), whatever was clicked.
-      const value = boundedJog(Number(slider.value), slider.jogFrom ?? page.state.joints[k]);
-      slider.value = value;
-      slider.jogFrom = value;
-      command(Command.SetJoint, { joint: k, value });
-    });
-    box.appendChild(row);
-    page.sliders[k] = { slider, row, value: row.querySelector('.value'), mark: row.querySelector('.limit i'), lo, hi };
-  });
-}
 
 // ---- state ----
 function onState(state) {
@@ -164,25 +136,20 @@ function onState(state) {
   $('status-reason').textContent = badge.title;
   $('error-mean').textContent = state.targets.length ? mm(state.error.mean) : '–';
   $('error-max').textContent = state.targets.length ? mm(state.error.max) : '–';
-  $('rate').textContent = (state.iterations_per_second ?? 0).toFixed(0);
-  const clearance = state.min_clearance === null ? '' : ` · clearance ${(1000 * state.min_clearance).toFixed(0)} mm`;
-  $('status-detail').textContent = `${state.targets.length} targets · ${state.iterations} iterations · ${state.clients} page(s)` +
-    `${clearance}${state.safe ? '' : ' · UNSAFE'}${state.last_error ? ' · ' + state.last_error : ''}`;
+  // Only while it iterates: a paused or stopped optimizer has no rate, not the last one.
+  const running = state.status === ControllerStatus.Optimizing && state.iterations_per_second !== null;
+  $('rate').textContent = running ? state.iterations_per_second.toFixed(0) : '–';
+  // Wrapped between its parts, never inside one ("53" and "mm" on separate lines).
+  const whole = (part) => part.replaceAll(' ', '\u00a0');
+  const parts = [`${state.targets.length} targets`, `${state.iterations} iterations`, `${state.clients} page(s)`];
+  if (state.min_clearance !== null) parts.push(`clearance ${(1000 * state.min_clearance).toFixed(0)} mm`);
+  if (!state.safe) parts.push('UNSAFE');
+  $('status-detail').textContent = parts.map(whole).join(' · ') + (state.last_error ? ` · ${state.last_error}` : '');
   $('pause').textContent = state.paused ? 'Resume' : 'Pause';
   $('pause').classList.toggle('active', state.paused);
   $('jog-hint').textContent = state.paused ? '(drag to jog)' : '(pause to jog)';
 
-  page.sliders.forEach((s, k) => {
-    const v = state.joints[k];
-    s.slider.disabled = !state.paused;
-    // Don't fight the user's hand: a slider being moved keeps its own value.
-    const recentlyEdited = performance.now() - (s.slider.editedAt ?? -1e9) < 500;
-    if (!s.slider.dragging && !recentlyEdited) { s.slider.value = v; s.slider.jogFrom = undefined; }
-    s.value.textContent = `${(v * DEG).toFixed(1)}°`;
-    s.mark.style.left = `calc(${(100 * (v - s.lo) / (s.hi - s.lo)).toFixed(2)}% - 1px)`;
-    const margin = 0.05 * (s.hi - s.lo);
-    s.row.classList.toggle('near-limit', v < s.lo + margin || v > s.hi - margin);
-  });
+  jointPanel.update(state);
 
   $('feedback').checked = !!state.feedback;
   $('observed').textContent = observedLine(state);
@@ -254,14 +221,15 @@ $('feedback').onchange = (e) => command(Command.SetFeedback, { on: e.target.chec
 $('arm').onclick = () => command(Command.Arm);
 $('disarm').onclick = () => command(Command.Disarm);
 window.addEventListener('keydown', (e) => {
-  if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
-  if (e.ctrlKey || e.metaKey || e.altKey) return;  // Ctrl+Z and the like: target_editing.js
+  if (typingIn(e.target) || e.ctrlKey || e.metaKey || e.altKey) return;  // Ctrl+Z and the like: target_editing.js
   if (e.key === 'Delete' || e.key === 'Backspace') deleteSelected();
   else if (e.key === 'c') setSketchMode(!view.sketchMode);
   else if (e.key === 'Escape') setSketchMode(false);
   else if (e.key === 'f') view.fitView();
   else if (e.key === 't') view.setRobotSeeThrough(!view.robotSeeThrough);
-  else if (e.key === ' ') { e.preventDefault(); $('pause').click(); }
+  else if (e.key === ' ') $('pause').click();
+  else return;
+  e.preventDefault();  // not also the focused control's own use of the key
 });
 
 // ---- hooks for tests and scripts (read-only views plus screen projections) ----

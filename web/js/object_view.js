@@ -59,6 +59,7 @@ export class ObjectView {
     this.showHandles = true;       // no handles while a centre-line is the handle
     this.localTargets = new Map(); // node → Vector3 of targets being dragged
     this.selected = null;          // node whose handle is highlighted
+    this.hovered = null;           // node whose handle is under the pointer
   }
 
   // Rebuilds the surface from a scene message; targets and positions start empty.
@@ -97,6 +98,7 @@ export class ObjectView {
     this.targets = [];
     this.localTargets.clear();
     this.selected = null;
+    this.hovered = null;
     this.drawTargets();
   }
 
@@ -154,6 +156,14 @@ export class ObjectView {
   setSelected(node) {
     this.selected = node;
     this.drawTargets();
+  }
+
+  // False when it already was.
+  setHovered(node) {
+    if (node === this.hovered) return false;
+    this.hovered = node;
+    this.drawTargets();
+    return true;
   }
 
   // [[node, x, y, z], ...] from the state's "observed_markers".
@@ -247,6 +257,6 @@ export class ObjectView {
   drawTarget(node, target) {
     this.nodePosition(node, _from);
     if (_from.distanceTo(target) > MIN_ARROW_LENGTH) this.glyphs.addArrow(_from, target);
-    if (this.showHandles) this.glyphs.addHandle(node, target, node === this.selected);
+    if (this.showHandles) this.glyphs.addHandle(node, target, node === this.selected, node === this.hovered);
   }
 }

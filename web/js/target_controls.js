@@ -9,6 +9,7 @@
 //   sketchstart, sketch {points}, sketchend {points}  (sketchend: evenly resampled, at most 64)
 // The owner disables its camera controls from dragstart/sketchstart to the matching end event.
 import { Controls, Plane, Raycaster, Vector2, Vector3 } from 'three';
+import { typingIn } from './keys.js';
 
 const SKETCH_SPACING = 0.002;  // m; closer pointer samples are dropped
 const SKETCH_POINTS = 64;      // points in a finished sketch
@@ -71,8 +72,9 @@ export class TargetControls extends Controls {
     const key = event.key.toLowerCase();
     if (!(key in AXES) || event.ctrlKey || event.metaKey || event.altKey) return;
     if (event.type === 'keyup') { if (this.axis === key) this.axis = null; return; }
-    const typing = event.target instanceof HTMLInputElement || event.target instanceof HTMLTextAreaElement || event.target instanceof HTMLSelectElement;
-    if (!typing) this.axis = key;
+    if (typingIn(event.target)) return;
+    this.axis = key;
+    event.preventDefault();  // a focused list does not pick an item by the letter
   }
 
   dispose() {

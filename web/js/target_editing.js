@@ -4,6 +4,7 @@
 import { Command } from './protocol.js';
 import { TargetHistory, targetsSnapshot } from './target_history.js';
 import { jointsFileBody, readTargetsOrJoints, targetsFileBody } from './targets_file.js';
+import { typingIn } from './keys.js';
 
 const MM = 1000;
 const TYPED_HOLD_MS = 1000;  // an edit not in a state by then: trust the state's again
@@ -88,8 +89,7 @@ export class TargetEditor {
   }
 
   onKey(e) {
-    if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
-    if (!(e.ctrlKey || e.metaKey)) return;
+    if (typingIn(e.target) || !(e.ctrlKey || e.metaKey)) return;  // a field keeps its own undo
     const key = e.key.toLowerCase();
     if (key === 'z' && !e.shiftKey) this.undo();
     else if ((key === 'z' && e.shiftKey) || key === 'y') this.redo();

@@ -59,11 +59,16 @@ export class TargetGizmo extends EventDispatcher {
 
   // Whether a press at `event` would grab the gizmo (an axis arrow or plane square under it).
   hits(event) {
-    if (this.node === null) return false;
     const rect = this.domElement.getBoundingClientRect();
     this._pointer.set(((event.clientX - rect.left) / rect.width) * 2 - 1, -((event.clientY - rect.top) / rect.height) * 2 + 1);
+    return this.hitsAt(this._pointer, event.button);
+  }
+
+  // The same at `pointer` (normalized device coordinates); it also highlights that arrow.
+  hitsAt(pointer, button = 0) {
+    if (this.node === null) return false;
     this.controls.getHelper().updateMatrixWorld(true);
-    this.controls.pointerHover({ x: this._pointer.x, y: this._pointer.y, button: event.button });
+    this.controls.pointerHover({ x: pointer.x, y: pointer.y, button });
     return this.controls.axis !== null;
   }
 

@@ -7,6 +7,7 @@ import * as THREE from 'three';
 export const TARGET_ORANGE = 0xff8c1a;
 const HANDLE_PIXELS = 7;           // handle radius on screen
 const SELECTED_HANDLE_PIXELS = 10; // the selected one is bigger, same orange (and carries the gizmo)
+const HOVERED_GROWTH_PIXELS = 2;   // the one under the pointer grows by this: it can be grabbed
 const SHAFT_PIXELS = 1.5;          // arrow shaft radius
 const HEAD_PIXELS = 5;             // arrow head radius
 const HEAD_FRACTION = 0.3;         // head length / arrow length: the head grows with the error
@@ -51,7 +52,7 @@ export class TargetGlyphs {
     this.arrows.forEach((a, k) => { a.visible = k < this.arrowCount; });
   }
 
-  addHandle(node, position, selected) {
+  addHandle(node, position, selected, hovered) {
     if (this.handleCount === this.handles.length) {
       const mesh = new THREE.Mesh(SPHERE, HANDLE_MATERIAL);
       mesh.renderOrder = RENDER_ORDER + 1;
@@ -61,7 +62,7 @@ export class TargetGlyphs {
     const handle = this.handles[this.handleCount++];
     handle.position.copy(position);
     handle.userData.node = node;
-    handle.userData.pixels = selected ? SELECTED_HANDLE_PIXELS : HANDLE_PIXELS;
+    handle.userData.pixels = (selected ? SELECTED_HANDLE_PIXELS : HANDLE_PIXELS) + (hovered ? HOVERED_GROWTH_PIXELS : 0);
   }
 
   addArrow(from, to) {

@@ -68,6 +68,7 @@ export class View3D {
 
     this.robotSeeThrough = false;  // the t key
     this.fitPending = false;       // a new scene waits for its shape and pose to be framed
+    this.framed = false;           // the camera is as fit-view left it: a resize frames anew
     this.state = null;             // the last state message shown
     this.frames = 0;               // frames rendered (tests wait for a few)
     this.renderPending = false;
@@ -78,6 +79,7 @@ export class View3D {
     this.wireTargetControls();
     // Render on demand only: software WebGL (headless, remote desktops) can't afford 60 fps.
     this.orbit.addEventListener('change', () => this.requestRender());
+    this.orbit.addEventListener('start', () => { this.framed = false; });  // the user's view now
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
   }
@@ -153,6 +155,7 @@ export class View3D {
     this.renderer.setSize(w, h, false);
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
+    if (this.framed) this.fitView(this.scratch.subVectors(this.camera.position, this.orbit.target));
     this.requestRender();
   }
 
@@ -213,14 +216,15 @@ export class View3D {
     this.gizmo.attach(at ? node : null, at);
   }
 
-  // Frames the robot and the object from the front (+x, where the robot faces), a little from
-  // the side and above, all of both in view (on load, on a scene switch, and the f key).
-  fitView() {
+  // Frames the robot and the object from `direction` (towards the camera; by default the front,
+  // +x where the robot faces, a little from the side and above), all of both in view (on load,
+  // on a scene switch, the f key, and on a resize from where the camera looks).
+  fitView(direction = FRONT_VIEW) {
     if (!this.objectView.positions) return;
     const robot = this.robotView.group, object = this.objectView.positionAttribute, point = new THREE.Vector3();
     robot.updateMatrixWorld(true);  // link poses set since the last render
     const box = new THREE.Box3().setFromBufferAttribute(object).union(new THREE.Box3().setFromObject(robot));
-    fitCamera(this.camera, this.orbit, box.getCenter(new THREE.Vector3()), FRONT_VIEW, (visit) => {
+    fitCamera(this.camera, this.orbit, box.getCenter(new THREE.Vector3()), direction, (visit) => {
       for (let i = 0; i < object.count; i++) visit(point.fromBufferAttribute(object, i));
       // Primitive visuals, and loaded mesh visuals inside their holders.
       for (const visual of this.robotView.visualMeshes) visual.traverse((mesh) => {
@@ -228,9 +232,9 @@ export class View3D {
         for (let i = 0; i < (vertices?.count ?? 0); i++) visit(point.fromBufferAttribute(vertices, i).applyMatrix4(mesh.matrixWorld));
       });
     });
+    this.framed = true;
     this.requestRender();
   }
-
 
   // Looks at a bar square on from the robot's front, so the sketch plane contains its axis.
   faceBar(direction) {
@@ -239,6 +243,7 @@ export class View3D {
     this.objectView.centroid(this.orbit.target);
     this.camera.position.copy(this.orbit.target).addScaledVector(side, 0.8);
     this.camera.position.z += 0.2;
+    this.framed = false;
     this.orbit.update();
     this.camera.updateMatrixWorld();
   }
@@ -264,6 +269,7 @@ export class View3D {
   setSketchMode(on) {
     this.targetControls.sketchMode = on;
     this.container.classList.toggle('sketching', on);
+    this.renderer.domElement.style.cursor = '';  // the sketch's crosshair (style.css), or the hover's again
   }
 
   setWireframe(on) { this.objectView.setWireframe(on); this.requestRender(); }

@@ -9,12 +9,12 @@ import { HelpOverlay } from './help_overlay.js';
 import { SessionNotices } from './session_notices.js';
 import { applyPreset } from './view_presets.js';
 import { saveScreenshot } from './screenshot.js';
+import { typingIn } from './keys.js';
 
 const NOTICE_MS = 6000;
 
 export class ViewTools {
-  // `elements`: {frames, screenshot, helpButton, help, scaleBar, hover, notice, deleteButton, clipped}
-  // (`clipped`: panel texts cut to a fixed size so the panel does not jump).
+  // `elements`: {frames, screenshot, helpButton, help, scaleBar, hover, notice, deleteButton}
   constructor(view, elements) {
     this.view = view;
     this.elements = elements;
@@ -29,17 +29,14 @@ export class ViewTools {
     elements.frames.addEventListener('change', () => { this.frames.setVisible(elements.frames.checked); view.requestRender(); });
     elements.screenshot.addEventListener('click', () => saveScreenshot(view, this.scene?.scene));
     window.addEventListener('keydown', (e) => this.onKey(e));
-    // A cut-off text is whole in its tooltip.
-    for (const e of elements.clipped)
-      new MutationObserver(() => { e.title = e.textContent; }).observe(e, { childList: true, characterData: true, subtree: true });
   }
 
   onKey(e) {
-    if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement || e.target instanceof HTMLTextAreaElement) return;
-    if (e.ctrlKey || e.metaKey || e.altKey) return;
+    if (typingIn(e.target) || e.ctrlKey || e.metaKey || e.altKey) return;
     if (e.key === '?') this.help.toggle();
     else if (e.key === 'Escape') this.help.toggle(false);
-    else applyPreset(this.view, e.key);
+    else if (!applyPreset(this.view, e.key)) return;
+    e.preventDefault();
   }
 
   setScene(scene) {

@@ -150,6 +150,28 @@ ChainOrder chain_order(const RobotModel& model) {
   return out;
 }
 
+// Per θ index: the name of the end effector the joint moves (the page groups the joints by arm),
+// null for a joint that moves none or several of them.
+nlohmann::json joint_arms(const RobotSetup& setup) {
+  const RobotModel& model = *setup.model;
+  constexpr int kNone = -1, kSeveral = -2;
+  std::vector<int> arm(static_cast<std::size_t>(model.active_count()), kNone);
+  for (std::size_t e = 0; e < setup.end_effectors.size(); ++e) {
+    // Up from the end effector's link to the root.
+    for (int joint =
+             model.links()[static_cast<std::size_t>(setup.end_effectors[e].link)].parent_joint;
+         joint >= 0; joint = model.links()[model.joints()[joint].parent_link].parent_joint) {
+      const int k = model.active_index(joint);
+      if (k >= 0) arm[k] = arm[k] == kNone ? static_cast<int>(e) : kSeveral;
+    }
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (const int e : arm)
+    out.push_back(e >= 0 ? nlohmann::json(setup.end_effectors[static_cast<std::size_t>(e)].name)
+                         : nlohmann::json());
+  return out;
+}
+
 nlohmann::json robot_json(const RobotSetup& setup, const std::vector<VisualMesh>& meshes) {
   const RobotModel& model = *setup.model;
   const ChainOrder chain = chain_order(model);
@@ -181,6 +203,7 @@ nlohmann::json robot_json(const RobotSetup& setup, const std::vector<VisualMesh>
           {"upper_limits", vector_json(model.upper_limits())},
           {"chain_order", chain.joints},
           {"chain_positions", chain.positions},
+          {"joint_arms", joint_arms(setup)},
           {"reference_joints", vector_json(setup.reference_joints)},
           {"end_effectors", end_effectors},
           {"collision_spheres", spheres}};
