@@ -115,7 +115,8 @@ TEST_F(ClosedLoopCli, TheOnlineCalibrationLearnsTheWorldWhileTheLoopReachesTheTa
   const std::filesystem::path log = dir.path() / "calibrated.jsonl";
   const nlohmann::json r = run({"--log", log.string()});
   ASSERT_TRUE(r["settled"].get<bool>()) << r.dump();
-  EXPECT_LT(r["true_error"].get<double>(), 1e-3);
+  // The result says why when it misses (authority.joint_offset at the trust region: held there).
+  EXPECT_LT(r["true_error"].get<double>(), 1e-3) << r.dump();
   ASSERT_TRUE(r.contains("calibration")) << r.dump();
   EXPECT_GE(r["calibration"]["applied"].get<int>(), 1) << r.dump();
   const auto calibrations = log_events(log, "calibration");
