@@ -27,6 +27,12 @@ class EnergyTerm {
   // Hessian cannot be factorized).
   virtual void add_hessian(const Positions& x, ElementHessianSink& sink,
                            bool project_psd) const = 0;
+  // The largest step length α ∈ (0, 1] such that the whole way from x to x + α·dx stays
+  // admissible for this term (contact: continuous collision detection, so no surface passes
+  // through an obstacle between two iterates). Terms admissible everywhere: 1.
+  virtual double max_step(const Positions& /*x*/, const Eigen::VectorXd& /*dx*/) const {
+    return 1.0;
+  }
 
   // The same Hessian as triplets (every entry of every block, both triangles); for tests and
   // tools that want a plain sparse matrix.

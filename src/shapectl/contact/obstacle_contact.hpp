@@ -1,0 +1,85 @@
+#pragma once
+// The contact energy between the object's surface and the scene's obstacles (IPC, Li et al.
+// 2020): for every pair of an object primitive and an obstacle primitive closer than d̂,
+//   E = κ Σ b(d),  b(d) = −(d − d̂)² ln(d / d̂) for 0 < d < d̂, 0 beyond, +inf for d ≤ 0,
+// d the unsigned distance less the obstacle's radius. The pairs: object surface vertex –
+// obstacle triangle (point–triangle distance, its edges and corners included) / segment /
+// point / half-space; obstacle point – object surface triangle; obstacle segment – object
+// surface edge. b is C² at d̂, so Newton and the sensitivities stay exact; each pair's Hessian
+// block is exact and, with project_psd, projected on its own.
+//
+// Obstacles do not move with θ here, so the term adds nothing to ∂F/∂θ.
+//
+// Every pair couples nodes of one surface triangle (or one edge, one vertex): the Hessian's
+// elements are the surface's vertices, edges and triangles, fixed, so the assembler's pattern
+// and the symbolic factorization stay valid while contacts come and go.
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <shapectl/contact/obstacle.hpp>
+#include <shapectl/fem/energy_term.hpp>
+#include <shapectl/mesh/tet_mesh.hpp>
+
+namespace shapectl {
+
+// One pair in contact at x, for results and the GUI.
+struct ContactPoint {
+  int obstacle = -1;          // index into the obstacles
+  Vec3 point = Vec3::Zero();  // the closest point on the object, world, m
+  Vec3 force = Vec3::Zero();  // the force the obstacle exerts on the object there, N
+  double distance = 0;        // gap d, m
+};
+
+struct ContactSummary {
+  int count = 0;                    // pairs with d < d̂
+  double min_distance = 0;          // smallest d over all pairs (+inf if no pair is within d̂)
+  Vec3 force_total = Vec3::Zero();  // Σ forces of the obstacles on the object, N
+  struct PerObstacle {
+    int count = 0;
+    Vec3 force = Vec3::Zero();
+  };
+  std::vector<PerObstacle> by_obstacle;  // in obstacle order
+  std::vector<ContactPoint> points;      // every pair with d < d̂
+};
+
+class ObstacleContact : public EnergyTerm {
+ public:
+  // The object's surface from `mesh` (its surface_triangles()), `obstacles` in the world.
+  // stiffness κ in J/m² (see default_contact_stiffness).
+  ObstacleContact(const TetMesh& mesh, std::vector<Obstacle> obstacles, double distance,
+                  double stiffness);
+
+  std::string_view name() const override { return "contact"; }
+  double value(const Positions& x) const override;
+  void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
+  void hessian_elements(ElementNodes& elements) const override;
+  void add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const override;
+  // Continuous collision detection: the largest α ∈ (0, 1] such that on the way from x to
+  // x + α·dx no pair's gap falls below 10 % of where it started (so no surface passes through
+  // an obstacle, however thin); 1 if none comes that close.
+  double max_step(const Positions& x, const Eigen::VectorXd& dx) const override;
+
+  ContactSummary summary(const Positions& x) const;
+  // The first object surface triangle that intersects or touches (d ≤ 0) an obstacle at x, as
+  // {obstacle, triangle index into the mesh's surface_triangles()}; {-1, -1} if none.
+  std::array<int, 2> first_intersection(const Positions& x) const;
+
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  double distance() const { return distance_; }
+  double stiffness() const { return stiffness_; }
+
+ private:
+  struct Impl;
+  std::shared_ptr<const Impl> impl_;  // surface, candidate search structures
+  std::vector<Obstacle> obstacles_;
+  double distance_;
+  double stiffness_;
+};
+
+// κ such that a node carrying the mean nodal weight (weight / node count, N) against a flat
+// obstacle rests at a gap of d̂/2: κ = w̄ / |b′(d̂/2)|.
+double default_contact_stiffness(double weight, int node_count, double distance);
+
+}  // namespace shapectl
