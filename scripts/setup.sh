@@ -18,7 +18,7 @@ packages=(
   clang-format
   qemu-user  # portable_install runs the installed tree on an emulated CPU without AVX
   pybind11-dev python3-dev python3-numpy python3-pytest
-  python3-matplotlib python3-dask python3-distributed
+  python3-matplotlib python3-dask python3-distributed python3-tqdm
 )
 
 missing=()

@@ -118,29 +118,40 @@ def solve_task(task, targets, scene, options):
                 joints=result.joints.tolist())
 
 
-class _Progress:
-    """A counter on `stream`: rewritten in place on a terminal, a line per tenth otherwise."""
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during solve_many: `rows` are the tasks finished so far, in task order (each keeps
+    its "task" number); the others were cancelled."""
 
-    def __init__(self, total, stream):
-        self.total, self.stream, self.done, self.failed = total, stream, 0, 0
-        self.tty = stream is not None and stream.isatty()
-        self.every = 1 if self.tty else max(1, total // 10)
+    def __init__(self, rows):
+        super().__init__(f"interrupted after {len(rows)} finished tasks")
+        self.rows = rows
 
-    def count(self, row):
-        self.done += 1
-        self.failed += row["status"] == "failed"
-        if self.stream is None or (self.done % self.every and self.done != self.total):
-            return
-        end = "\r" if self.tty and self.done != self.total else "\n"
-        self.stream.write(f"batch: {self.done}/{self.total} solves, {self.failed} failed{end}")
-        self.stream.flush()
+
+def _progress_bar(total, stream):
+    """tqdm's bar with its rate and ETA on `stream` (None: none), the failures as its postfix."""
+    from tqdm import tqdm
+
+    return tqdm(total=total, file=stream, disable=stream is None, desc="batch", unit="solve",
+                mininterval=0.5, postfix={"failed": 0})
+
+
+def _finished_row(task, future):
+    if future.status == "finished":
+        return future.result()
+    # An exception the task did not expect, a worker lost, a cancelled task.
+    try:
+        reason = future.exception()
+    except Exception as e:  # cancelled: no exception to fetch
+        reason = e
+    return _row(task, error=f"{type(reason).__name__}: {reason}")
 
 
 def solve_many(client, scene, target_sets, progress=sys.stderr, **options):
     """shapectl.solve(scene, targets, **options) for every entry of `target_sets` (dicts of the
     TARGETS.json schema) on the cluster behind `client`; returns one row per entry, in order.
     scene: a Scene (sent as to_dict()) or a dict of the scene schema with absolute file names.
-    progress: where the counter goes (None: nowhere)."""
+    progress: where the progress bar goes (None: nowhere). Ctrl-C (KeyboardInterrupt) cancels
+    the tasks not finished and raises Interrupted with the rows that are."""
     scene_dict = scene.to_dict() if isinstance(scene, shapectl.Scene) else scene
     from distributed import as_completed
 
@@ -152,19 +163,19 @@ def solve_many(client, scene, target_sets, progress=sys.stderr, **options):
                          scene=scene_on_workers, options=options, pure=False)
     task_of = {future.key: task for task, future in enumerate(futures)}
     rows = [None] * len(futures)
-    counter = _Progress(len(futures), progress)
-    for future in as_completed(futures):
-        task = task_of[future.key]
-        if future.status == "finished":
-            rows[task] = future.result()
-        else:  # an exception the task did not expect, a worker lost, a cancelled task
-            try:
-                reason = future.exception()
-            except Exception as e:  # cancelled: no exception to fetch
-                reason = e
-            rows[task] = _row(task, error=f"{type(reason).__name__}: {reason}")
-        future.release()
-        counter.count(rows[task])
+    failed = 0
+    with _progress_bar(len(futures), progress) as bar:
+        try:
+            for future in as_completed(futures):
+                task = task_of[future.key]
+                rows[task] = _finished_row(task, future)
+                future.release()
+                failed += rows[task]["status"] == "failed"
+                bar.set_postfix(failed=failed, refresh=False)
+                bar.update()
+        except KeyboardInterrupt:
+            client.cancel([f for task, f in enumerate(futures) if rows[task] is None])
+            raise Interrupted([row for row in rows if row is not None]) from None
     return rows
 
 

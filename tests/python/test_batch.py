@@ -27,8 +27,9 @@ def test_every_task_has_its_row_even_when_it_raises_something_unexpected(bar_sce
     assert rows[1]["error"].startswith("TypeError: targets: not JSON serializable: set")
     assert rows[2]["error"].startswith("ValueError: targets: targets[0].node: expected")
     assert rows[0]["error_mean"] < 1e-3 and rows[0]["joints"] == rows[3]["joints"]
-    lines = progress.getvalue().split("\n")  # not a terminal: a line per count, no \r
-    assert len(lines) == 5 and lines[-2] == "batch: 4/4 solves, 2 failed" and "\r" not in lines[0]
+    # tqdm's bar: its last state counts every task, with the failures.
+    last = progress.getvalue().rstrip("\n").split("\r")[-1]
+    assert "4/4" in last and "failed=2" in last, progress.getvalue()
     # Workers inside this process share its threads: its tuning is left as it was.
     assert shapectl.runtime_settings()["threads"] == 0
 
