@@ -111,6 +111,21 @@ describe('the real object: plot and calibration (serve --world)', () => {
     // The observed error's line, on top of the others: its colour in the plot's pixels.
     await waitFor(async () => (await plotPixelsOf(page, observed.colour)) >= 20, 'the observed error\'s line in the plot');
     assert.match(await text(page, '#observed'), /observed error [\d.]+ mm/);
+    // The panel says what is happening: frames arriving at the camera's rate (10/s), the
+    // feedback's state, no calibration yet.
+    const activity = await waitFor(async () => {
+      const t = await text(page, '#activity');
+      return /observations: arriving at [\d.]+\/s/.test(t) && t;
+    }, 'the observation rate in the panel');
+    const perSecond = Number(activity.match(/arriving at ([\d.]+)\/s/)[1]);
+    assert.ok(perSecond > 3 && perSecond < 15, activity);
+    assert.match(activity, /feedback off: the robot follows the model alone/);
+    assert.match(activity, /calibrations \(on request\): 0 run, 0 applied to the model/);
+    await page.click('#feedback');
+    await waitFor(async () => /feedback on: targets corrected by up to [\d.]+ mm/.test(await text(page, '#activity')),
+      'the feedback\'s effect in the panel');
+    await page.click('#feedback');
+    await waitFor(async () => /feedback off/.test(await text(page, '#activity')), 'feedback off again');
   });
 
   it('calibrates from the observed frames and shows the fitted values', async () => {
@@ -149,6 +164,7 @@ describe('the real object: plot and calibration (serve --world)', () => {
     const shownE = Number(modelAfter.match(/E ([\d.]+) kPa/)[1]);
     assert.ok(Math.abs(shownE - fitted) <= 0.01 * fitted, `model line ${modelAfter} vs fitted ${fitted} kPa`);
     assert.equal(await page.locator('#calibration-error').isVisible(), false);
+    assert.match(await text(page, '#activity'), /calibrations \(on request\): 1 run, 1 applied to the model/);
     assert.deepEqual(page.problems, []);
   });
 

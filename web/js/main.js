@@ -4,6 +4,7 @@ import { Connection } from './connection.js';
 import { View3D } from './view3d.js';
 import { ConvergencePlot } from './plot.js';
 import { CalibrationPanel } from './calibration_panel.js';
+import { ObservationRate, activityLines } from './real_object_activity.js';
 import { TargetEditor } from './target_editing.js';
 import { ViewTools } from './view_tools.js';
 import { Command, ControllerStatus } from './protocol.js';
@@ -153,6 +154,8 @@ function onState(state) {
 
   $('feedback').checked = !!state.feedback;
   $('observed').textContent = observedLine(state);
+  const activity = activityLines(state, observationRate.update(state.observations ?? 0)).join('\n');
+  if ($('activity').textContent !== activity) $('activity').textContent = activity;
 
   calibration.update(state);
 
@@ -162,6 +165,8 @@ function onState(state) {
       (l.reason ? ` — ${l.reason}` : '');
   }
 }
+
+const observationRate = new ObservationRate();
 
 // The Real object panel's line: observations, the errors, what the gate refused and why the
 // newest was ignored or gated (docs/calibration.md, Safety).
