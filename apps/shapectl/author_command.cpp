@@ -5,12 +5,14 @@
 // file and a report; refuses (exit 1) what it cannot make plausible.
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <random>
 #include <set>
 #include <sstream>
@@ -19,7 +21,9 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/input_file.hpp>
 #include <shapectl/io/json_eigen.hpp>
+#include <shapectl/io/json_input.hpp>
 #include <shapectl/io/json_output.hpp>
+#include <shapectl/io/length_units.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/mesh/load_mesh.hpp>
 #include <shapectl/mesh/surface_mesher.hpp>
@@ -29,6 +33,7 @@
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/robot/sphere_cover.hpp>
 #include <shapectl/robot/urdf_collision.hpp>
+#include <shapectl/robot/visual_meshes.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
@@ -56,6 +61,10 @@ struct AuthorOptions {
   double poisson_ratio = 0.3;
   double density = 40;
   std::vector<std::string> package_paths;
+  bool allow_missing_meshes = false;
+  std::string units;                     // of --mesh: "m", "cm" or "mm"; empty: metres
+  std::string active_joints;             // NAME,...: exactly these; empty: those that move a tool
+  std::optional<double> finger_opening;  // value of the joints that move no tool
   double sphere_margin = 0.005;
   unsigned seed = 1;
   std::string out;
@@ -170,11 +179,17 @@ ObjectMesh read_object_mesh(const AuthorOptions& o, const fs::path& scene_dir) {
             Json{{"box", {{"size", vec3_json(size)}, {"cells", cells}}}}};
   }
   const fs::path file = fs::absolute(o.mesh);
-  auto mesh = std::make_shared<const TetMesh>(load_mesh(file));
   std::error_code error;
   fs::path relative = fs::relative(file, fs::absolute(scene_dir), error);
   if (error || relative.empty()) relative = file;
-  return {mesh, Json(relative.generic_string())};
+  if (o.units.empty() || o.units == "m")
+    return {std::make_shared<const TetMesh>(load_mesh(file)), Json(relative.generic_string())};
+  // Read as the scene will read it (scaled before TetGen meshes a surface), so the grips'
+  // node numbers are the scene's.
+  if (!metres_per_unit(o.units))
+    throw InputError("command line", "--units", "m, cm or mm", bounded_preview(o.units));
+  const JsonInput read({{"file", file.string()}, {"units", o.units}}, "command line", "--mesh");
+  return {load_object_mesh(read), Json{{"file", relative.generic_string()}, {"units", o.units}}};
 }
 
 struct Spheres {
@@ -206,6 +221,75 @@ std::vector<CollisionSphere> cover_meshes(const AuthorOptions& o, const RobotMod
     add_cover(spheres, m.link, cover_triangle_mesh(surface.vertices, surface.triangles));
   }
   return spheres;
+}
+
+// The mesh files the URDF names (collision meshes, covered with spheres; visual ones, drawn)
+// that cannot be found, as written: a scene authored without them would have a robot with
+// holes in its collision model.
+std::vector<std::string> missing_meshes(const AuthorOptions& o, const RobotModel& model) {
+  const std::vector<fs::path> paths = package_paths(o.package_paths);
+  std::set<std::string> missing;
+  for (const auto& m : read_mesh_collisions(model, o.urdf))
+    if (!resolve_mesh_file(m.filename, fs::path(o.urdf).parent_path(), paths))
+      missing.insert(bounded_preview(m.filename));
+  for (const auto& m : find_visual_meshes(model, paths))
+    if (!m.file && m.problem.rfind("not found", 0) == 0)
+      missing.insert(bounded_preview(model.links()[static_cast<std::size_t>(m.link)]
+                                         .visual_shapes[static_cast<std::size_t>(m.shape)]
+                                         .mesh_filename));
+  return {missing.begin(), missing.end()};
+}
+
+void check_meshes_found(const AuthorOptions& o, const RobotModel& model) {
+  if (o.allow_missing_meshes) return;
+  const std::vector<std::string> missing = missing_meshes(o, model);
+  if (missing.empty()) return;
+  std::string list;
+  for (std::size_t k = 0; k < missing.size() && k < 5; ++k)
+    list += (k ? ", '" : "'") + missing[k] + "'";
+  if (missing.size() > 5) list += " and " + std::to_string(missing.size() - 5) + " more";
+  throw InputError(o.urdf + ": " + std::to_string(missing.size()) + " mesh file" +
+                   (missing.size() == 1 ? "" : "s") + " not found: " + list +
+                   "; give --package-path DIR (the folder holding the ROS package) or set "
+                   "ROS_PACKAGE_PATH, or --allow-missing-meshes to author without them");
+}
+
+// The joints θ of the scene: --active-joints if given, else every joint that moves an end
+// effector. The others that could move (gripper fingers, a head) are fixed: at
+// --finger-opening, else at the value nearest 0 within their limits. Returns the fixed values.
+std::map<std::string, double> choose_active_joints(const AuthorOptions& o,
+                                                   const std::vector<EndEffector>& ees,
+                                                   RobotModel& model) {
+  std::vector<std::string> active;
+  if (!o.active_joints.empty()) {
+    std::stringstream list(o.active_joints);
+    for (std::string name; std::getline(list, name, ',');) active.push_back(name);
+  } else {
+    std::set<int> moving;
+    for (const auto& ee : ees)
+      for (const auto& entry : model.jacobian_entries(ee.link)) moving.insert(entry.joint);
+    for (int j : model.active_joints())
+      if (moving.count(j)) active.push_back(model.joints()[static_cast<std::size_t>(j)].name);
+  }
+  try {
+    model.set_active_joints(active);
+  } catch (const InputError& e) {
+    throw InputError("command line", "--active-joints", e.what());
+  }
+  std::map<std::string, double> fixed;
+  for (int j = 0; j < model.joint_count(); ++j) {
+    const Joint& joint = model.joints()[static_cast<std::size_t>(j)];
+    if (!joint.movable() || joint.mimic_master >= 0 || model.active_index(j) >= 0) continue;
+    const double value = o.finger_opening.value_or(0);
+    if (o.finger_opening && !(value >= joint.lower && value <= joint.upper))
+      throw InputError("command line", "--finger-opening",
+                       "a value within the limits of joint '" + joint.name + "' (" +
+                           std::to_string(joint.lower) + " to " + std::to_string(joint.upper) + ")",
+                       value);
+    fixed[joint.name] = std::clamp(value, joint.lower, joint.upper);
+  }
+  model.set_fixed_joint_values(fixed, "command line");
+  return fixed;
 }
 
 // Link pairs whose spheres overlap: from the centres at one pose.
@@ -427,7 +511,9 @@ void run(const AuthorOptions& o) {
   std::vector<std::string> warnings;
   for (const auto& w : robot_notes(model, o.package_paths))
     if (w.find("collision meshes ignored") == std::string::npos) warnings.push_back(w);
+  check_meshes_found(o, model);
   const std::vector<EndEffector> ees = read_end_effectors(o, model);
+  const std::map<std::string, double> fixed_joints = choose_active_joints(o, ees, model);
   const ObjectMesh object = read_object_mesh(o, scene_dir);
   const Spheres spheres = generate_spheres(o, model, warnings);
   for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
@@ -522,6 +608,8 @@ void run(const AuthorOptions& o) {
                          {{"urdf", relative_to(o.urdf, scene_dir).generic_string()},
                           {"collision_spheres",
                            relative_to(spheres_file, scene_dir).generic_string()},
+                          {"active_joints", names},
+                          {"fixed_joints", fixed_joints},
                           {"reference_joints", reference_joints},
                           {"end_effectors", end_effectors},
                           {"joint_limit_margin", joint_limit_margin}}},
@@ -632,6 +720,14 @@ void add_author_command(CLI::App& app) {
   c->add_option("--poisson-ratio", o->poisson_ratio, "")->capture_default_str();
   c->add_option("--density", o->density, "kg/m^3")->capture_default_str();
   add_package_path_option(*c, o->package_paths);
+  c->add_flag("--allow-missing-meshes", o->allow_missing_meshes,
+              "Author even when mesh files the URDF names are not found (links lose them)");
+  c->add_option("--units", o->units, "Units of --mesh's coordinates: m (default), cm or mm");
+  c->add_option("--active-joints", o->active_joints,
+                "NAME,...: the joints to optimise (default: every joint that moves a tool)");
+  c->add_option("--finger-opening", o->finger_opening,
+                "Value (m or rad) of the joints that move no tool, e.g. gripper fingers "
+                "(default: nearest 0 within their limits)");
   c->add_option("--sphere-margin", o->sphere_margin,
                 "Collision margin written to the sphere file (m)")
       ->capture_default_str();

@@ -67,8 +67,11 @@ std::string geometry(const Primitive& p) {
   return g.str();
 }
 
-// Two 3-joint arms on a base; the right hand's mesh is missing on purpose.
-std::string urdf() {
+// Two 3-joint arms on a base; the right hand's mesh is missing on purpose. With `finger`, the
+// left tool carries a part on a prismatic joint (±10 cm) that moves no tool, like a gripper's
+// finger or a camera slide. (A real 25 mm finger cannot be active at all: the joint-limit margin
+// of 0.05, m for prismatic joints, is wider than its stroke.)
+std::string urdf(bool finger = false) {
   std::map<std::string, std::string> links;
   for (const auto& p : primitives()) links[p.link] += geometry(p);
   links["r_link3"] +=
@@ -95,6 +98,11 @@ std::string urdf() {
            "_link3'/><child link='" + s + "_tool'/><origin xyz='0.2 0 0'/></joint>" +
            link(s + "_tool");
   }
+  if (finger)
+    xml +=
+        "<joint name='l_finger_joint' type='prismatic'><parent link='l_tool'/><child "
+        "link='l_finger'/><axis xyz='0 1 0'/><limit lower='-0.1' upper='0.1' velocity='0.1' "
+        "effort='1'/></joint><link name='l_finger'/>";
   return xml + "</robot>";
 }
 
@@ -136,12 +144,19 @@ struct Authored {
 };
 
 std::vector<std::string> author_args(const Authored& a) {
-  return {"author",          a.urdf.string(),
-          "--mesh",          a.mesh.string(),
-          "--end-effectors", "left=l_tool,right=r_tool",
-          "--package-path",  (a.dir.path() / "pkg").string(),
-          "--out",           a.scene.string(),
-          "--report",        a.report.string()};
+  return {"author",
+          a.urdf.string(),
+          "--mesh",
+          a.mesh.string(),
+          "--end-effectors",
+          "left=l_tool,right=r_tool",
+          "--package-path",
+          (a.dir.path() / "pkg").string(),
+          "--out",
+          a.scene.string(),
+          "--report",
+          a.report.string(),
+          "--allow-missing-meshes"};
 }
 
 void write_inputs(Authored& a) {
@@ -277,6 +292,95 @@ TEST(AuthorCli, AMissingCollisionMeshIsAWarningNamingIt) {
   EXPECT_NE(a.run.err.find("r_link3"), std::string::npos) << a.run.err;
   EXPECT_NE(a.run.err.find("missing.stl' not found"), std::string::npos) << a.run.err;
   EXPECT_EQ(read_json(a.report)["warnings"].size(), 1u);
+}
+
+// Without --allow-missing-meshes a mesh the URDF names and nobody finds stops the authoring,
+// naming it and how to point at it; nothing is written.
+TEST(AuthorCli, MissingMeshesAreExitOneNamingThemAndThePackagePath) {
+  Authored a;
+  write_inputs(a);
+  std::vector<std::string> args = author_args(a);
+  args.pop_back();  // --allow-missing-meshes
+  const auto run = run_cli(args);
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("arms.urdf: 1 mesh file not found: "
+                         "'package://two_arms/meshes/missing.stl'"),
+            std::string::npos)
+      << run.err;
+  EXPECT_NE(run.err.find("--package-path"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("--allow-missing-meshes"), std::string::npos) << run.err;
+  EXPECT_FALSE(std::filesystem::exists(a.scene));
+}
+
+// A joint that moves no tool (a finger) is no optimisation variable: fixed at the opening asked
+// for (or the value nearest 0), unless --active-joints names it.
+TEST(AuthorCli, JointsThatMoveNoToolAreFixedAtTheFingerOpening) {
+  Authored a;
+  write_inputs(a);
+  a.urdf = a.dir.write("arms.urdf", urdf(true));
+  const std::vector<std::string> arms = {"l1", "l2", "l3", "r1", "r2", "r3"};
+  a.run = run_cli(author_args(a));
+  ASSERT_EQ(a.run.exit_code, 0) << a.run.err;
+  Json robot = read_json(a.scene)["robot"];
+  EXPECT_EQ(robot["active_joints"].get<std::vector<std::string>>(), arms);
+  EXPECT_EQ(robot["fixed_joints"], Json({{"l_finger_joint", 0.0}}));
+  EXPECT_FALSE(robot["reference_joints"].contains("l_finger_joint"));
+
+  auto args = author_args(a);
+  args.insert(args.end(), {"--finger-opening", "0.01"});
+  const auto opened = run_cli(args);
+  ASSERT_EQ(opened.exit_code, 0) << opened.err;
+  robot = read_json(a.scene)["robot"];
+  EXPECT_EQ(robot["fixed_joints"]["l_finger_joint"].get<double>(), 0.01);
+  // The written scene is one every command takes.
+  EXPECT_EQ(
+      run_cli({"statics", a.scene.string(), "--out", (a.dir.path() / "s.json").string()}).exit_code,
+      0);
+
+  // Named explicitly, the same joints; a joint left out is fixed (at the opening asked for).
+  args = author_args(a);
+  args.insert(args.end(), {"--active-joints", "l1,l2,l3,r1,r2,r3"});
+  const auto named = run_cli(args);
+  ASSERT_EQ(named.exit_code, 0) << named.err;
+  robot = read_json(a.scene)["robot"];
+  EXPECT_EQ(robot["active_joints"].get<std::vector<std::string>>(), arms);
+  EXPECT_EQ(robot["fixed_joints"], Json({{"l_finger_joint", 0.0}}));
+
+  for (const auto& [option, value] :
+       {std::pair<std::string, std::string>{"--finger-opening", "0.5"},
+        {"--active-joints", "l1,l2,nothing"}}) {
+    args = author_args(a);
+    args.insert(args.end(), {option, value});
+    const auto run = run_cli(args);
+    EXPECT_EQ(run.exit_code, 1) << option << ": " << run.err;
+    EXPECT_NE(run.err.find(option), std::string::npos) << run.err;
+  }
+}
+
+// --units: a mesh in millimetres gives the scene the metres version's nodes, the file scaled
+// as the scene reads it.
+TEST(AuthorCli, UnitsScaleTheMeshAsTheSceneReadsIt) {
+  Authored a;
+  write_inputs(a);
+  ASSERT_EQ(run_cli(author_args(a)).exit_code, 0);
+  const Json in_metres = read_json(a.report);
+  a.mesh = a.dir.write("bar_mm.obj", box_obj({340, 30, 30}, {17, 2, 2}));
+  auto args = author_args(a);
+  args.insert(args.end(), {"--units", "mm"});
+  a.run = run_cli(args);
+  ASSERT_EQ(a.run.exit_code, 0) << a.run.err;
+  EXPECT_EQ(read_json(a.scene)["object"]["mesh"]["units"], "mm");
+  const Json in_millimetres = read_json(a.report);
+  EXPECT_EQ(in_millimetres["object"]["node_count"], in_metres["object"]["node_count"]);
+  for (int g = 0; g < 2; ++g)
+    EXPECT_EQ(in_millimetres["grips"][g]["node_count"], in_metres["grips"][g]["node_count"]);
+
+  args = author_args(a);
+  args.insert(args.end(), {"--units", "furlong"});
+  const auto run = run_cli(args);
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("--units: expected m, cm or mm, got furlong"), std::string::npos)
+      << run.err;
 }
 
 TEST(AuthorCli, BadInputIsExitOneNamingTheFieldAndLeavesAnExistingSceneAlone) {

@@ -417,6 +417,11 @@ ObjectiveWeights read_objective(const JsonInput& o) {
 
 }  // namespace
 
+std::shared_ptr<const TetMesh> load_object_mesh(const JsonInput& j) {
+  MeshOrigin origin;
+  return read_mesh(j, origin);
+}
+
 Scene load_scene(const std::filesystem::path& file) {
   const JsonInput root = JsonInput::load(file);
   root.expect_only({"object", "gravity", "fixed", "loads", "regions", "statics", "robot", "grips",

@@ -28,5 +28,8 @@ AlignedBox read_box(const JsonInput& j);
 NodeSelection read_node_selection(const JsonInput& j, int node_count);
 // {"position": [x, y, z], "rpy": [roll, pitch, yaw]} (io/json_eigen.hpp: scene_pose_json).
 Eigen::Isometry3d read_pose(const JsonInput& j);
+// An "object.mesh" value (a file name, {"file", "units", ...} or {"box"}) as load_scene reads
+// it: `shapectl author` numbers its grips' nodes as the scene will.
+std::shared_ptr<const TetMesh> load_object_mesh(const JsonInput& j);
 
 }  // namespace shapectl
