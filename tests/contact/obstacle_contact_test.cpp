@@ -99,6 +99,26 @@ TEST(ObstacleContact, EnergyIsTheBarrierSumOverVerticesAboveAPlane) {
   EXPECT_EQ(contact.value(x), std::numeric_limits<double>::infinity());
 }
 
+TEST(ObstacleContact, CountsEachContactOnceHoweverManyTrianglesFindIt) {
+  // The object over a closed plate meshed like its own bottom: each bottom vertex sits right
+  // above a plate vertex that six plate triangles, several plate edges and several object
+  // triangles all find. Counted once each, the energy is the plane's: 25 barriers.
+  const TetMesh mesh = object_mesh();
+  const double gap = 0.4 * kDhat;
+  std::vector<Vec3> plate = mesh.rest_positions();
+  for (Vec3& p : plate) p.z() -= 0.02 + gap;
+  const ObstacleContact on_mesh(mesh,
+                                {make_mesh_obstacle("plate", plate, mesh.surface_triangles())},
+                                kDhat, 2.0);
+  const ObstacleContact on_plane(mesh,
+                                 {make_plane("table", Vec3(0, 0, -0.01 - gap), Vec3::UnitZ())},
+                                 kDhat, 2.0);
+  const Positions x = mesh.rest_vector();
+  EXPECT_EQ(on_mesh.summary(x).count, 25);
+  EXPECT_NEAR(on_mesh.value(x), 25 * 2.0 * barrier(gap, kDhat).value, 1e-9 * on_plane.value(x));
+  EXPECT_NEAR(on_mesh.value(x), on_plane.value(x), 1e-9 * on_plane.value(x));
+}
+
 // Collects every block a term gives, in order.
 class BlockSink : public ElementHessianSink {
  public:

@@ -55,6 +55,7 @@ struct Triangle {
   int obstacle;
   Vec3 a, b, c;
   double radius;
+  Vec3 normal;                 // unit (zero if degenerate)
   std::array<int, 3> corners;  // into Impl::points
   std::array<int, 3> sides;    // into Impl::segments: side k joins corners k and k + 1
 };
@@ -399,7 +400,15 @@ struct ObstacleContact::Impl {
       }
       if (!vertex_searches) continue;
       const Aabb box = box_of({vertices[v]});
-      triangle_bvh.query(box, [&](int i) { visit(Pair{PairKind::VertexTriangle, v, i}); });
+      const Vec3 q = dx ? Vec3(p + dx->segment<3>(3 * vertices[v])) : p;
+      triangle_bvh.query(box, [&](int i) {
+        // Far from the triangle's plane all the way (its distance is at least that): no pair.
+        const Triangle& t = obstacle_triangles[i];
+        const double far = t.radius + inflate, dp = (p - t.a).dot(t.normal),
+                     dq = (q - t.a).dot(t.normal);
+        if ((dp >= far && dq >= far) || (dp <= -far && dq <= -far)) return;
+        visit(Pair{PairKind::VertexTriangle, v, i});
+      });
       vertex_segment_bvh.query(box, [&](int i) {
         visit(Pair{PairKind::VertexSegment, v, vertex_segments[i]});
       });
@@ -408,14 +417,25 @@ struct ObstacleContact::Impl {
       });
     }
     if (!segment_bvh.empty())
-      for (int e = 0; e < static_cast<int>(edges.size()); ++e)
-        segment_bvh.query(box_of({edges[e][0], edges[e][1]}), [&](int i) {
-          visit(Pair{PairKind::SegmentEdge, e, i});
+      for (int e = 0; e < static_cast<int>(edges.size()); ++e) {
+        const Aabb box = box_of({edges[e][0], edges[e][1]});
+        segment_bvh.query(box, [&](int i) {
+          // A long segment (a box's diagonal) has a big box: test the segment itself.
+          const Segment& s = segments[i];
+          if (segment_overlaps(s.a, s.b, box.inflated(s.radius)))
+            visit(Pair{PairKind::SegmentEdge, e, i});
         });
+      }
     if (!point_bvh.empty())
       for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
         const auto& tri = triangles[t];
+        const Vec3 a = node(x, tri[0]);
+        Vec3 n = (node(x, tri[1]) - a).cross(node(x, tri[2]) - a);
+        n /= n.norm();
         point_bvh.query(box_of({tri[0], tri[1], tri[2]}), [&](int i) {
+          // At x only (the plane turns along a step): far from the triangle's plane.
+          const Point& q = points[i];
+          if (!dx && std::abs((q.p - a).dot(n)) >= q.radius + inflate) return;
           visit(Pair{PairKind::PointTriangle, t, i});
         });
       }
@@ -518,8 +538,10 @@ ObstacleContact::ObstacleContact(const TetMesh& mesh, std::vector<Obstacle> obst
         corners[k] = first_point + i;
         sides[k] = side->second;
       }
-      m->obstacle_triangles.push_back(
-          {o, ob.points[t[0]], ob.points[t[1]], ob.points[t[2]], r, corners, sides});
+      const Vec3 n = (ob.points[t[1]] - ob.points[t[0]]).cross(ob.points[t[2]] - ob.points[t[0]]);
+      m->obstacle_triangles.push_back({o, ob.points[t[0]], ob.points[t[1]], ob.points[t[2]], r,
+                                       n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero(), corners,
+                                       sides});
       triangle_boxes.push_back(box_of({ob.points[t[0]], ob.points[t[1]], ob.points[t[2]]}, r));
     }
   }
