@@ -31,5 +31,8 @@ Eigen::Isometry3d read_pose(const JsonInput& j);
 // An "object.mesh" value (a file name, {"file", "units", ...} or {"box"}) as load_scene reads
 // it: `shapectl author` numbers its grips' nodes as the scene will.
 std::shared_ptr<const TetMesh> load_object_mesh(const JsonInput& j);
+// "units" ("m", "cm", "mm") or "scale" of a mesh file: the factor from its coordinates to
+// metres (1 without either).
+double read_mesh_scale(const JsonInput& j);
 
 }  // namespace shapectl
