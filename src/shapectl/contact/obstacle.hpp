@@ -6,6 +6,7 @@
 //     segment with radius r; a box or a mesh is its corners, edges and triangles with r = 0.
 // Geometry is in the world frame. Obstacles attached to robot links ("link" in the scene) are
 // not supported yet: load_scene refuses them.
+#include <Eigen/Geometry>
 #include <array>
 #include <optional>
 #include <string>

@@ -1,0 +1,19 @@
+#include <shapectl/contact/barrier.hpp>
+
+#include <cmath>
+#include <limits>
+
+namespace shapectl {
+
+BarrierValue barrier(double d, double dhat) {
+  if (!(d > 0)) {
+    const double inf = std::numeric_limits<double>::infinity();
+    return {inf, -inf, inf};
+  }
+  if (d >= dhat) return {};
+  const double e = d - dhat, log_ratio = std::log(d / dhat);
+  return {-e * e * log_ratio, -2 * e * log_ratio - e * e / d,
+          -2 * log_ratio - 4 * e / d + e * e / (d * d)};
+}
+
+}  // namespace shapectl
