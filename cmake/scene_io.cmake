@@ -2,7 +2,8 @@
 # URDF a scene names and runs sim/'s scene checks; sim/scene.hpp itself sees no JSON.
 shapectl_area(scene_io)
 target_link_libraries(shapectl_scene_io PUBLIC shapectl_sim
-                      PRIVATE shapectl_fem shapectl_io shapectl_linalg shapectl_mesh shapectl_robot)
+                      PRIVATE shapectl_contact shapectl_fem shapectl_io shapectl_linalg shapectl_mesh
+                              shapectl_robot)
 
 shapectl_tests(scene_io shapectl_scene_io)
 if(TARGET scene_io_tests)

@@ -1,5 +1,6 @@
 #include "result_json.hpp"
 
+#include <cmath>
 #include <iostream>
 
 #include <shapectl/io/json_eigen.hpp>
@@ -32,6 +33,19 @@ nlohmann::json fixed_joints_json(const RobotModel& robot) {
     if (joint.movable() && joint.mimic_master < 0 && robot.active_index(j) < 0)
       out[joint.name] = robot.fixed_value(j);
   }
+  return out;
+}
+
+nlohmann::json contacts_json(const ObstacleContact& contact, const Positions& x) {
+  const ContactSummary summary = contact.summary(x);
+  nlohmann::json out = {{"count", summary.count}, {"force_total", vec3_json(summary.force_total)}};
+  // +inf when no pair is that close: JSON has no infinity, so the key is left out.
+  if (std::isfinite(summary.min_distance)) out["min_distance"] = summary.min_distance;
+  nlohmann::json by_obstacle = nlohmann::json::object();
+  for (std::size_t k = 0; k < summary.by_obstacle.size(); ++k)
+    by_obstacle[contact.obstacles()[k].name] = {{"count", summary.by_obstacle[k].count},
+                                                {"force", vec3_json(summary.by_obstacle[k].force)}};
+  out["by_obstacle"] = by_obstacle;
   return out;
 }
 

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include <shapectl/contact/obstacle_contact.hpp>
 #include <shapectl/sim/scene.hpp>
 
 #include "commands.hpp"
@@ -16,6 +17,10 @@ nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints);
 // {name: value} of the robot's inactive movable joints (not mimics: gripper fingers): a result
 // carries them, so that `--joints RESULT` gives its pose on the bare URDF too (kinematics).
 nlohmann::json fixed_joints_json(const RobotModel& robot);
+// The contacts at positions x: {"count", "min_distance" (m; left out when no pair is within
+// the contact distance), "force_total": [..] (N, the obstacles' force on the object),
+// "by_obstacle": {name: {"count", "force"}}}.
+nlohmann::json contacts_json(const ObstacleContact& contact, const Positions& x);
 // --tolerance M: the target error (m) under which a result counts as reached (default 1 mm).
 void add_tolerance_option(CLI::App& command, double& tolerance);
 // Throws SolverFailure ("<what>: <field> is not finite (<context>)") if any number in `result` is

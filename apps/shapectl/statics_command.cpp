@@ -35,12 +35,14 @@ struct StaticsArgs {
   std::string linear_solver;
 };
 
-// Writes RESULT.json (and the VTU) even when Newton failed, so the failure can be inspected,
+// Writes RESULT.json (and the VTU) even when Newton failed (with the contacts at its state when
+// the scene has obstacles), so the failure can be inspected,
 // but never with a non-finite number, and with --vtu or --surface all files or none.
 // `seconds`: set-up and Newton, reported on stderr (not in RESULT.json: it stays reproducible).
 void write_outputs(const StaticsArgs& args, const StaticsResult& r, const Scene& scene,
-                   const TetMesh& mesh, const Positions& rest, const Positions& x,
+                   const ObjectStatics& statics, const Positions& rest, const Positions& x,
                    nlohmann::json result, double seconds) {
+  const TetMesh& mesh = statics.mesh();
   result["converged"] = r.converged();
   result["status"] = to_string(r.status);
   result["reason"] = r.reason;
@@ -48,6 +50,8 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const Scene&
   result["residual"] = r.residual;
   result["energy"] = r.energy;
   result["loads_total"] = vec3_json(scene.loads_total());
+  if (const ObstacleContact* contact = statics.contact())
+    result["contacts"] = contacts_json(*contact, x);
   result["positions"] = positions_json(x);
   require_finite(result, "statics", r.reason);
   std::vector<FileContent> files = {{args.out, to_pretty_json(result)}};
@@ -81,15 +85,14 @@ void run_statics(const StaticsArgs& args) {
       throw InputError(args.joints, "", "joints given, but the scene has no robot");
     ObjectStatics statics(scene);
     const StaticsResult r = statics.solve(x);
-    write_outputs(args, r, scene, statics.mesh(), rest, x, nlohmann::json::object(),
-                  seconds_since(start));
+    write_outputs(args, r, scene, statics, rest, x, nlohmann::json::object(), seconds_since(start));
     return;
   }
   GrippedObject object(scene);
   Eigen::VectorXd joints = object.reference_joints();
   if (!args.joints.empty()) joints = load_joints_file(args.joints, object.robot(), joints);
   const ObjectState state = object.solve_from(joints, x);
-  write_outputs(args, state.statics(), scene, object.mesh(), rest, state.positions(),
+  write_outputs(args, state.statics(), scene, object.statics(), rest, state.positions(),
                 robot_json(scene, joints), seconds_since(start));
 }
 

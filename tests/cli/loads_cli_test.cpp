@@ -19,11 +19,7 @@ using test::run_cli;
 using test::TempDir;
 
 // The clamped test bar (81 nodes, x from −0.16 to 0.16 m) with `extra` keys added.
-std::string bar_with(const std::string& extra) {
-  std::string text = test::kClampedBarScene;
-  text.replace(text.find("\"gravity\""), 9, extra + ", \"gravity\"");
-  return text;
-}
+std::string bar_with(const std::string& extra) { return test::clamped_bar_scene_with(extra); }
 
 const std::string kTip = R"({"box": {"min": [0.159, -1, -1], "max": [1, 1, 1]}, )";
 const std::string kSoft = R"({"youngs_modulus": 5e4, "poisson_ratio": 0.3, "density": 40})";

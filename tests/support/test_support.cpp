@@ -51,6 +51,12 @@ std::string bundled_scene_text(const std::string& name) {
   return text;
 }
 
+std::string clamped_bar_scene_with(const std::string& keys) {
+  std::string text = kClampedBarScene;
+  text.replace(text.find("\"gravity\""), 9, keys + ", \"gravity\"");
+  return text;
+}
+
 std::vector<std::string> cli_command(const std::vector<std::string>& args) {
   std::vector<std::string> command = {SHAPECTL_CLI};
   command.insert(command.end(), args.begin(), args.end());

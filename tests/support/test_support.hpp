@@ -61,6 +61,9 @@ inline constexpr const char* kClampedBarScene = R"({
   "fixed": {"box": {"min": [-0.17, -1, -1], "max": [-0.15, 1, 1]}}
 })";
 
+// kClampedBarScene with `keys` (JSON members, e.g. R"("loads": [...])") added before "gravity".
+std::string clamped_bar_scene_with(const std::string& keys);
+
 // Path of a file in the source tree, e.g. source_path("scenes/yumi_bar.json").
 std::filesystem::path source_path(const std::string& relative);
 

@@ -20,6 +20,7 @@
 #include <shapectl/mesh/surface_mesher.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/robot_model.hpp>
+#include <shapectl/scene_io/obstacle_reader.hpp>
 #include <shapectl/sim/object_statics.hpp>
 #include <shapectl/sim/scene_checks.hpp>
 
@@ -80,6 +81,15 @@ Eigen::Isometry3d read_pose(const JsonInput& j) {
   return T;
 }
 
+double read_mesh_scale(const JsonInput& j) {
+  if (j.has("units") && j.has("scale"))
+    j.at("scale").fail_problem("give \"units\" or \"scale\", not both");
+  if (j.has("scale")) return positive_in(j.at("scale"), 1e-9, 1e9, "");
+  if (!j.has("units")) return 1;
+  if (const auto scale = metres_per_unit(j.at("units").string())) return *scale;
+  j.at("units").fail("\"m\", \"cm\" or \"mm\" (or give \"scale\": factor to metres)");
+}
+
 namespace {
 
 // A generated box: sizes and cell counts bounded, cells not so flat that a tet degenerates.
@@ -117,16 +127,6 @@ std::shared_ptr<const TetMesh> read_box_mesh(const JsonInput& box) {
   } catch (const InputError& e) {
     throw InputError(box.source(), box.path(), e.what());
   }
-}
-
-// "units" or "scale" of a mesh file: the factor from file coordinates to metres.
-double read_mesh_scale(const JsonInput& j) {
-  if (j.has("units") && j.has("scale"))
-    j.at("scale").fail_problem("give \"units\" or \"scale\", not both");
-  if (j.has("scale")) return positive_in(j.at("scale"), 1e-9, 1e9, "");
-  if (!j.has("units")) return 1;
-  if (const auto scale = metres_per_unit(j.at("units").string())) return *scale;
-  j.at("units").fail("\"m\", \"cm\" or \"mm\" (or give \"scale\": factor to metres)");
 }
 
 // A mesh file, its coordinates scaled to metres: a surface before TetGen sees it (so
@@ -420,7 +420,7 @@ ObjectiveWeights read_objective(const JsonInput& o) {
 Scene load_scene(const std::filesystem::path& file) {
   const JsonInput root = JsonInput::load(file);
   root.expect_only({"object", "gravity", "fixed", "loads", "regions", "statics", "robot", "grips",
-                    "grip_stiffness", "objective"});
+                    "grip_stiffness", "objective", "obstacles", "contact"});
   Scene scene;
   scene.source = file;
   read_object(root.at("object"), scene);
@@ -440,6 +440,8 @@ Scene load_scene(const std::filesystem::path& file) {
   if (root.has("grip_stiffness"))
     scene.grip_stiffness = positive_in(root.at("grip_stiffness"), 1e-12, max_stiffness, "N/m");
   if (root.has("objective")) scene.weights = read_objective(root.at("objective"));
+  if (root.has("obstacles")) scene.obstacles = read_obstacles(root.at("obstacles"));
+  if (root.has("contact")) scene.contact = read_contact(root.at("contact"));
   scene.warnings = check_scene(scene);
   refuse_empty_selections(root, scene);
   return scene;

@@ -28,5 +28,8 @@ AlignedBox read_box(const JsonInput& j);
 NodeSelection read_node_selection(const JsonInput& j, int node_count);
 // {"position": [x, y, z], "rpy": [roll, pitch, yaw]} (io/json_eigen.hpp: scene_pose_json).
 Eigen::Isometry3d read_pose(const JsonInput& j);
+// "units" ("m", "cm", "mm") or "scale" of a mesh file: the factor from its coordinates to
+// metres (1 without either).
+double read_mesh_scale(const JsonInput& j);
 
 }  // namespace shapectl

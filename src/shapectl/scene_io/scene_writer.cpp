@@ -62,6 +62,10 @@ nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& sourc
   const auto from_dir = source.parent_path(), to_dir = out.parent_path();
   rebase_member(j["object"], "mesh", from_dir, to_dir);
   if (j["object"]["mesh"].is_object()) rebase_member(j["object"]["mesh"], "file", from_dir, to_dir);
+  if (j.contains("obstacles") && j["obstacles"].is_array())
+    for (auto& obstacle : j["obstacles"])
+      if (obstacle.is_object() && obstacle.contains("mesh"))
+        rebase_member(obstacle["mesh"], "file", from_dir, to_dir);
   if (j.contains("robot")) {
     rebase_member(j["robot"], "urdf", from_dir, to_dir);
     rebase_member(j["robot"], "collision_spheres", from_dir, to_dir);

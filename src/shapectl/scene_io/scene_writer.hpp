@@ -16,7 +16,7 @@ namespace shapectl {
 // form the file used: youngs_modulus/poisson_ratio or mu/kappa; and density), each grip's
 // offset ("offset": {"position", "rpy"}; none when it is the identity) and the object's pose
 // ("object.pose", written only when it differs from the file's), its paths made relative to
-// `out`'s directory.
+// `out`'s directory (obstacle mesh files included; obstacles and contact are written as read).
 nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source,
                                               const Scene& scene, const std::filesystem::path& out);
 

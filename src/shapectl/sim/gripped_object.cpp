@@ -88,6 +88,12 @@ void GrippedObject::carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen
     const Eigen::Isometry3d motion = b.T_world_link[link] * a.T_world_link[link].inverse();
     for (int i : g.nodes) x.segment<3>(3 * i) = motion * at_from.segment<3>(3 * i);
   }
+  // The prediction moves every node straight from at_from: cut short where a surface would
+  // pass through an obstacle on the way (the CCD bound), so the solve starts clear of them.
+  if (const ObstacleContact* contact = statics_->contact()) {
+    const Eigen::VectorXd dx = x - at_from;
+    if (const double alpha = contact->max_step(at_from, dx); alpha < 1) x = at_from + alpha * dx;
+  }
 }
 
 bool GrippedObject::factored(ObjectState& state, double stale_step) const {

@@ -57,7 +57,9 @@ class GrippedObject {
   // A warm start for the equilibrium at `to` from the one at `from`: every gripped node of `x`
   // is set to its position in `at_from` moved rigidly with its end effector from `from` to
   // `to`. A linear prediction dx̂/dθ·Δθ puts them off their anchors by ~ r|Δθ|²/2 — tens of
-  // newtons through stiff grip springs, and Newton iterations to undo.
+  // newtons through stiff grip springs, and Newton iterations to undo. With obstacles the
+  // result is then pulled back towards at_from (an equilibrium, clear of them) as far as the
+  // contact's CCD bound asks, so no surface of the warm start passes through an obstacle.
   void carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                            const Positions& at_from, Positions& x) const;
 

@@ -97,6 +97,17 @@ std::optional<ConstantForce> load_term(const Scene& scene) {
   return ConstantForce("loads", scene.load_forces());
 }
 
+// The barrier on the scene's obstacles: κ as the scene gives it, else scaled to the mean nodal
+// load (default_contact_stiffness) so a resting node sits about d̂/2 off a flat obstacle.
+std::optional<ObstacleContact> contact_term(const Scene& scene, const TetMesh& placed,
+                                            double load) {
+  if (scene.obstacles.empty()) return std::nullopt;
+  const double d = scene.contact.distance;
+  const double kappa = scene.contact.stiffness.value_or(
+      default_contact_stiffness(object_load(placed, scene.material, load), placed.node_count(), d));
+  return ObstacleContact(placed, scene.obstacles, d, kappa);
+}
+
 std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
   std::vector<char> fixed(placed.node_count(), 0);
   if (scene.fixed)
@@ -149,17 +160,19 @@ ObjectStatics::ObjectStatics(const Scene& scene, const std::vector<int>& held_no
       elasticity_(*mesh_, scene.element_materials()),
       gravity_(*mesh_, elasticity_.materials(), scene.gravity),
       loads_(load_term(scene)),
+      contact_(contact_term(scene, *mesh_, applied_load(scene, gravity_.weight()))),
       fixed_node_(fixed_nodes(scene, *mesh_)),
       solver_(mesh_->node_count(), fixed_node_,
               statics_options(scene, *mesh_, applied_load(scene, gravity_.weight()))) {
   std::vector<char> held = fixed_node_;
   for (int i : held_nodes) held[i] = 1;
-  unheld_reason_ = find_unheld_part(*mesh_, held);
+  if (!contact_) unheld_reason_ = find_unheld_part(*mesh_, held);
 }
 
 EnergyTerms ObjectStatics::terms(const EnergyTerm* extra) const {
   EnergyTerms t = {&elasticity_, &gravity_};
   if (loads_) t.push_back(&*loads_);
+  if (contact_) t.push_back(&*contact_);
   if (extra) t.push_back(extra);
   return t;
 }
@@ -176,6 +189,19 @@ StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const Ene
     r.status = StaticsStatus::Singular;
     r.reason = unheld_reason_;
     return r;
+  }
+  if (contact_) {
+    // The barrier is infinite there: say where instead of "a non-finite energy".
+    const auto [obstacle, triangle] = contact_->first_intersection(x);
+    if (obstacle >= 0) {
+      StaticsResult r;
+      r.status = StaticsStatus::Inverted;
+      r.reason = "the starting state touches or intersects obstacle '" +
+                 contact_->obstacles()[static_cast<std::size_t>(obstacle)].name +
+                 "' (object surface triangle " + std::to_string(triangle) +
+                 "): no equilibrium sought from there";
+      return r;
+    }
   }
   return solver_.solve(terms(extra), ws, x, max_iterations, chord, stop);
 }

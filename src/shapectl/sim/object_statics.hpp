@@ -1,11 +1,12 @@
 #pragma once
 // A scene's object as an energy and a statics solver: neo-Hookean elasticity (each element of
-// its region's material), gravity, applied loads, fixed nodes, plus extra terms the caller owns
-// (the robot's grip springs).
+// its region's material), gravity, applied loads, contact with the scene's obstacles, fixed
+// nodes, plus extra terms the caller owns (the robot's grip springs).
 #include <memory>
 #include <optional>
 #include <vector>
 
+#include <shapectl/contact/obstacle_contact.hpp>
 #include <shapectl/fem/gravity.hpp>
 #include <shapectl/fem/neo_hookean.hpp>
 #include <shapectl/sim/scene.hpp>
@@ -18,15 +19,18 @@ namespace shapectl {
 class ObjectStatics {
  public:
   // held_nodes: nodes that extra terms (the robot's grip springs) will hold in place, used only
-  // to detect parts of the object that nothing holds.
+  // to detect parts of the object that nothing holds. With obstacles the object may rest on
+  // them, so that check is left to Newton (a part nothing holds ends Singular or not converged).
   explicit ObjectStatics(const Scene& scene, const std::vector<int>& held_nodes = {});
 
-  // The object's energy terms (elasticity, gravity, the loads if any), plus `extra` if given.
+  // The object's energy terms (elasticity, gravity, the loads and the obstacle contact if any),
+  // plus `extra` if given.
   EnergyTerms terms(const EnergyTerm* extra = nullptr) const;
   StaticsWorkspace make_workspace() const { return solver_.make_workspace(); }
   // Equilibrium from the warm start x (fixed nodes must be at their prescribed positions) with
   // the energy plus `extra`, in `ws` (see StaticsSolver::solve for `chord`). An object that
-  // nothing holds is reported as Singular without iterating.
+  // nothing holds is reported as Singular without iterating; a start that touches or intersects
+  // an obstacle as Inverted without iterating, naming the obstacle.
   StaticsResult solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra = nullptr,
                       int max_iterations = 0, const StaticsWorkspace* chord = nullptr,
                       const StopRequest& stop = {}) const;
@@ -39,6 +43,8 @@ class ObjectStatics {
   const TetMesh& mesh() const { return *mesh_; }
   const std::vector<char>& fixed_node() const { return fixed_node_; }
   double weight() const { return gravity_.weight(); }
+  // The contact with the scene's obstacles; null without obstacles (no contact term at all).
+  const ObstacleContact* contact() const { return contact_ ? &*contact_ : nullptr; }
   // The applied loads' nodal forces (3n, N); zero without loads.
   Eigen::VectorXd load_forces() const;
   // The force Newton stops at: the scene's tolerance, or the round-off floor if larger.
@@ -48,7 +54,8 @@ class ObjectStatics {
   std::shared_ptr<const TetMesh> mesh_;
   NeoHookean elasticity_;
   Gravity gravity_;
-  std::optional<ConstantForce> loads_;  // none without loads: the default terms stay two
+  std::optional<ConstantForce> loads_;      // none without loads: the default terms stay two
+  std::optional<ObstacleContact> contact_;  // none without obstacles
   std::vector<char> fixed_node_;
   std::string unheld_reason_;
   StaticsSolver solver_;

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 
+#include <shapectl/contact/obstacle.hpp>
 #include <shapectl/fem/material.hpp>
 #include <shapectl/linalg/cholesky_backend.hpp>
 #include <shapectl/mesh/tet_mesh.hpp>
@@ -115,6 +116,10 @@ struct Scene {
   std::vector<Grip> grips;
   double grip_stiffness = 1e4;  // K, N/m
   ObjectiveWeights weights;
+  // Static obstacles the object rests on or touches (world frame), and how contact acts; none:
+  // no contact term at all.
+  std::vector<Obstacle> obstacles;
+  ContactSettings contact;
   MeshOrigin mesh_origin;
   // Findings of check_scene where results might be wrong, one line each, "file: field: what";
   // for the commands to print. (Where they would be wrong, load_scene throws instead.)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include <shapectl/contact/obstacle_contact.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/robot/joint_limits.hpp>
 #include <shapectl/robot/kinematics.hpp>
@@ -187,6 +188,68 @@ void check_grips(const Scene& scene, std::vector<std::string>& warnings) {
   }
 }
 
+// The winding number of the closed surface (triangles of `points`) about p: 1 inside, 0 outside
+// (the sum of the triangles' solid angles, Van Oosterom and Strackee 1983, over 4π).
+double winding_number(const std::vector<Vec3>& points,
+                      const std::vector<std::array<int, 3>>& triangles, const Vec3& p) {
+  double sum = 0;
+  for (const auto& t : triangles) {
+    const Vec3 a = points[t[0]] - p, b = points[t[1]] - p, c = points[t[2]] - p;
+    const double la = a.norm(), lb = b.norm(), lc = c.norm();
+    sum += 2 * std::atan2(a.dot(b.cross(c)),
+                          la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb);
+  }
+  return sum / (4 * M_PI);
+}
+
+// Whether one of two surfaces that do not meet holds the other: the obstacle's first point
+// inside the object, or the object's first node inside the obstacle.
+bool one_inside_the_other(const Obstacle& o, const std::vector<Vec3>& nodes,
+                          const std::vector<std::array<int, 3>>& surface) {
+  if (o.plane) return false;  // a half-space: first_intersection sees every node's side
+  if (!o.points.empty() && winding_number(nodes, surface, o.points.front()) > 0.5) return true;
+  const Vec3& node = nodes[static_cast<std::size_t>(surface.front()[0])];
+  if (o.triangles.empty()) {  // a sphere or capsule: within its radius of its point or segment
+    const Vec3 a = o.points.front(), b = o.points.back(), ab = b - a;
+    const double s =
+        ab.squaredNorm() > 0 ? std::clamp((node - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0) : 0.0;
+    return (a + s * ab - node).norm() <= o.radius;
+  }
+  return winding_number(o.points, o.triangles, node) > 0.5;
+}
+
+// The rest shape placed in the world must be clear of every obstacle: the contact barrier is
+// infinite at a gap of zero, so no solve could start there.
+void check_obstacle_gaps(const Scene& scene) {
+  if (scene.obstacles.empty()) return;
+  const ObstacleContact contact(*scene.object_mesh, scene.obstacles, scene.contact.distance, 1.0);
+  const Positions x = scene.world_rest_positions();
+  auto field = [&](std::size_t k) {
+    return "obstacles[" + std::to_string(k) + "] ('" + scene.obstacles[k].name + "')";
+  };
+  const auto [obstacle, triangle] = contact.first_intersection(x);
+  if (obstacle >= 0) {
+    const auto nodes = scene.object_mesh->surface_triangles()[static_cast<std::size_t>(triangle)];
+    throw InputError(scene.source.string(), field(static_cast<std::size_t>(obstacle)),
+                     "the object's rest shape (placed by object.pose) touches or intersects this " +
+                         scene.obstacles[static_cast<std::size_t>(obstacle)].shape +
+                         " at surface triangle " + std::to_string(triangle) + " (nodes " +
+                         std::to_string(nodes[0]) + ", " + std::to_string(nodes[1]) + ", " +
+                         std::to_string(nodes[2]) +
+                         "); move the object or the obstacle so that every gap is positive");
+  }
+  std::vector<Vec3> nodes(x.size() / 3);
+  for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i] = x.segment<3>(3 * i);
+  const auto surface = scene.object_mesh->surface_triangles();
+  for (std::size_t k = 0; k < scene.obstacles.size(); ++k)
+    if (!surface.empty() && one_inside_the_other(scene.obstacles[k], nodes, surface))
+      throw InputError(scene.source.string(), field(k),
+                       "the object's rest shape (placed by object.pose) and this " +
+                           scene.obstacles[k].shape +
+                           " overlap, one wholly inside the other; move the object or the "
+                           "obstacle so that they are apart");
+}
+
 }  // namespace
 
 // A mesh far larger than anything the robot could hold (or than any object, without one) is
@@ -269,6 +332,7 @@ std::vector<std::string> check_scene(const Scene& scene) {
   std::vector<std::string> warnings;
   check_object_size(scene);
   if (const std::string w = tet_count_warning(scene); !w.empty()) warnings.push_back(w);
+  check_obstacle_gaps(scene);
   if (scene.robot) {
     check_joint_limits(scene, warnings);
     check_collisions(scene, warnings);

@@ -202,6 +202,13 @@ std::string StaticsSolver::singular_reason(const StaticsWorkspace& ws) const {
               : "; the held nodes may leave a rigid motion free, e.g. a rotation about one node)");
 }
 
+double StaticsSolver::max_step(const EnergyTerms& terms, const Positions& x,
+                               const Eigen::VectorXd& dx) {
+  double alpha = 1;
+  for (const auto* t : terms) alpha = std::min(alpha, t->max_step(x, dx));
+  return alpha;
+}
+
 double StaticsSolver::largest_node_step(const Eigen::VectorXd& dx) const {
   double step = 0;
   for (int i = 0; i < node_count_; ++i) step = std::max(step, dx.segment<3>(3 * i).norm());
@@ -233,6 +240,8 @@ bool StaticsSolver::chord_step(const EnergyTerms& terms, const StaticsWorkspace&
   const Eigen::VectorXd dx =
       -solve_rotated(chord, chord_rotation(chord, x), at.gradient, options_.single_precision_chord);
   if (!(at.gradient.dot(dx) < 0)) return false;
+  // A chord step is all or nothing: one that would pass an obstacle is left to Newton.
+  if (max_step(terms, x, dx) < 1) return false;
   Positions trial = x + dx;
   Eigen::VectorXd g_trial;  // in one pass with the energy: a chord step is mostly kept
   const double e_trial = energy_and_gradient(terms, trial, g_trial);
@@ -344,7 +353,9 @@ bool StaticsSolver::line_search(const EnergyTerms& terms, const Eigen::VectorXd&
   // watchdog's step): the first finite state is taken.
   const double slope = at.gradient.dot(dx);
   const double noise = energy_noise(at.energy);
-  double alpha = 1.0;
+  // From the longest step on which no surface passes through an obstacle (contact's CCD): the
+  // energy of the end state alone cannot see a surface that went through and out the far side.
+  double alpha = std::min(1.0, max_step(terms, x, dx));
   for (int k = 0; k < 40; ++k, alpha *= 0.5) {
     Positions trial = x + alpha * dx;
     const double e_trial = energy(terms, trial);

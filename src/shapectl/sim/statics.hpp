@@ -181,6 +181,10 @@ class StaticsSolver {
   // Both in one pass over the elements (EnergyTerm::value_and_add_gradient; the same bits).
   double energy_and_gradient(const EnergyTerms& terms, const Positions& x,
                              Eigen::VectorXd& gradient) const;
+  // The longest step α ∈ (0, 1] along dx from x that every term admits the whole way
+  // (EnergyTerm::max_step: contact's continuous collision detection). Every step the solver
+  // takes is bounded by it, so x never passes through an obstacle.
+  static double max_step(const EnergyTerms& terms, const Positions& x, const Eigen::VectorXd& dx);
   // Factors the true Hessian at x into `ws`; false if it is not positive definite (then `ws`
   // holds no factorization).
   bool factor(const EnergyTerms& terms, StaticsWorkspace& ws, const Positions& x) const;
@@ -259,8 +263,8 @@ class StaticsSolver {
   // first Newton step; a failure during the watch goes back, otherwise ends the solve.
   Outcome line_search_step(const EnergyTerms& terms, const StaticsWorkspace& ws, Run& run,
                            const Eigen::VectorXd& dx, NewtonIterate& log) const;
-  // The first of α = 1, 1/2, 1/4, ... whose state lowers the energy enough; relaxed: whose
-  // state is finite (no element inverted; the watchdog's step).
+  // The first of α = a, a/2, a/4, ... whose state lowers the energy enough, a = min(1,
+  // max_step); relaxed: whose state is finite (no element inverted; the watchdog's step).
   bool line_search(const EnergyTerms& terms, const Eigen::VectorXd& dx, Positions& x, Point& at,
                    NewtonIterate& log, bool relaxed) const;
   // The line search's acceptance of a step α·dx from `from` (slope = α ∇E·dx) reaching a state

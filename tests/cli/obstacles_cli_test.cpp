@@ -1,0 +1,132 @@
+// "obstacles" and "contact" through the CLI (issue 34): statics results carry the contacts, bad
+// input names its field and exits 1.
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include <array>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "support/test_support.hpp"
+
+namespace shapectl {
+namespace {
+
+using test::run_cli;
+using test::TempDir;
+
+// The clamped test bar (x from −0.16 to 0.16 m, bottom face at z = −0.015 m) with `extra` keys.
+std::string bar_with(const std::string& extra) { return test::clamped_bar_scene_with(extra); }
+
+// A table 0.5 mm under the bar: its free end sags onto it.
+const std::string kTable =
+    R"("obstacles": [{"name": "table", "plane": {"point": [0, 0, -0.0155], "normal": [0, 0, 1]}}])";
+
+struct Statics {
+  test::CliRun run;
+  nlohmann::json result;
+};
+
+Statics statics(const TempDir& dir, const std::string& scene_text) {
+  const auto scene = dir.write("scene.json", scene_text);
+  const auto out = dir.path() / "result.json";
+  std::filesystem::remove(out);
+  Statics s{run_cli({"statics", scene.string(), "--out", out.string()}), {}};
+  if (std::filesystem::exists(out)) s.result = nlohmann::json::parse(test::read_text(out));
+  return s;
+}
+
+TEST(ObstaclesCli, StaticsOnATableReportsTheContacts) {
+  TempDir dir;
+  const Statics plain = statics(dir, test::kClampedBarScene);
+  ASSERT_EQ(plain.run.exit_code, 0) << plain.run.err;
+  EXPECT_FALSE(plain.result.contains("contacts"));  // no obstacles: nothing to report
+  const Statics s = statics(dir, bar_with(kTable + R"(, "contact": {"distance": 0.001})"));
+  ASSERT_EQ(s.run.exit_code, 0) << s.run.err;
+  ASSERT_TRUE(s.result["converged"].get<bool>());
+  const nlohmann::json& c = s.result["contacts"];
+  EXPECT_GT(c["count"].get<int>(), 0);
+  const double gap = c["min_distance"].get<double>();
+  EXPECT_GT(gap, 0);
+  EXPECT_LE(gap, 0.001);
+  // The table carries part of the bar's weight (113 mN), the clamp the rest; it pushes up only.
+  const double up = c["force_total"][2].get<double>();
+  EXPECT_GT(up, 0.01);
+  EXPECT_LT(up, 0.113);
+  EXPECT_EQ(c["by_obstacle"]["table"]["force"], c["force_total"]);
+  EXPECT_EQ(c["by_obstacle"]["table"]["count"], c["count"]);
+  // Every node above the table.
+  for (const auto& p : s.result["positions"]) EXPECT_GT(p[2].get<double>(), -0.0155);
+}
+
+TEST(ObstaclesCli, AnObstacleOutOfReachGivesNoContactsAndNoDistance) {
+  TempDir dir;
+  const Statics s =
+      statics(dir,
+              bar_with(R"("obstacles": [{"sphere": {"center": [0, 0, -0.5], "radius": 0.03}}])"));
+  ASSERT_EQ(s.run.exit_code, 0) << s.run.err;
+  const nlohmann::json& c = s.result["contacts"];
+  EXPECT_EQ(c["count"], 0);
+  EXPECT_FALSE(c.contains("min_distance"));  // no pair within d̂: no number, never inf or NaN
+  EXPECT_EQ(c["by_obstacle"]["obstacle 1"]["force"], nlohmann::json({0.0, 0.0, 0.0}));
+}
+
+TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
+  TempDir dir;
+  dir.write("open.obj", "v 0 0 -1\nv 1 0 -1\nv 0 1 -1\nf 1 2 3\n");
+  const std::string plane = R"({"plane": {"point": [0, 0, -0.5], "normal": [0, 0, 1]}})";
+  auto obstacles = [](const std::string& list) { return R"("obstacles": [)" + list + "]"; };
+  for (const auto& [extra, where, what] : std::vector<std::array<std::string, 3>>{
+           {obstacles(R"({"plane": {"point": [0, 0, -0.5], "normal": [0, 0, 0]}})"),
+            "obstacles[0].plane.normal", "a non-zero normal"},
+           {obstacles(R"({"sphere": {"center": [0, 0, -0.5], "radius": -1}})"),
+            "obstacles[0].sphere.radius", "expected a positive number"},
+           {obstacles(R"({"box": {"size": [0.1, 0, 0.1]}})"), "obstacles[0].box.size[1]",
+            "expected a positive number"},
+           {obstacles(R"({"sphere": {"center": [0, 0, -1e999], "radius": 0.1}})"),
+            "obstacles[0].sphere.center[2]", "expected a finite number"},
+           {obstacles(R"({"sphere": {"center": [5000, 0, 0], "radius": 0.1}})"),
+            "obstacles[0].sphere.center", "a point of length at most 1000 m"},
+           {obstacles(R"({"capsule": {"a": [0, 0, -1], "b": [0, 0, -1], "radius": 0.1}})"),
+            "obstacles[0].capsule.b", "a point other than \"a\""},
+           {obstacles(R"({"box": {"size": [0.1, 0.1, 0.1], "pose": {"position": [0, 0, -1], )"
+                      R"("rpy": [0, 0, "x"]}}})"),
+            "obstacles[0].box.pose.rpy[2]", "expected a number"},
+           {obstacles(R"({"link": "gripper_l", "sphere": {"center": [0, 0, -1], "radius": 0.1}})"),
+            "obstacles[0].link", "not supported yet"},
+           {obstacles(R"({"cylinder": {"radius": 0.1}})"), "obstacles[0].cylinder", "unknown key"},
+           {obstacles(R"({"name": "table"})"), "obstacles[0]", "exactly one of"},
+           {obstacles(R"({"name": "a", "plane": {"point": [0, 0, -1], "normal": [0, 0, 1]}}, )"
+                      R"({"name": "a", "sphere": {"center": [0, 0, -1], "radius": 0.1}})"),
+            "obstacles[1].name", "a name no other obstacle has"},
+           {obstacles(R"({"mesh": {"file": "open.obj"}})"), "obstacles[0].mesh.file",
+            "not a closed surface"},
+           {obstacles(R"({"mesh": {"file": "open.obj", "units": "inch"}})"),
+            "obstacles[0].mesh.units", "\"m\", \"cm\" or \"mm\""},
+           {obstacles(R"({"name": "ball", "sphere": {"center": [0, 0, 0], "radius": 0.02}})"),
+            "obstacles[0] ('ball')", "touches or intersects"},
+           {obstacles(plane) + R"(, "contact": {"distance": -0.001})", "contact.distance",
+            "expected a positive number"},
+           {obstacles(plane) + R"(, "contact": {"friction": -0.1})", "contact.friction",
+            "expected a non-negative number"},
+           {obstacles(plane) + R"(, "contact": {"friction": 0.3})", "contact.friction",
+            "friction is not supported yet"},
+           {obstacles(plane) + R"(, "contact": {"self": true})", "contact.self",
+            "not supported yet"},
+           {obstacles(plane) + R"(, "contact": {"robot": true})", "contact.robot",
+            "not supported yet"},
+           {obstacles(plane) + R"(, "contact": {"stiffness": 0})", "contact.stiffness",
+            "expected a positive number"},
+           {obstacles(plane) + R"(, "contact": {"gap": 0.1})", "contact.gap", "unknown key"}}) {
+    const Statics s = statics(dir, bar_with(extra));
+    EXPECT_EQ(s.run.exit_code, 1) << extra << "\n" << s.run.err;
+    EXPECT_NE(s.run.err.find("scene.json: " + where + ": "), std::string::npos) << where << ":\n"
+                                                                                << s.run.err;
+    EXPECT_NE(s.run.err.find(what), std::string::npos) << what << ":\n" << s.run.err;
+  }
+}
+
+}  // namespace
+}  // namespace shapectl
