@@ -128,5 +128,45 @@ TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
   }
 }
 
+TEST(ObstaclesCli, TheBundledPegSceneSolvesClearOfThePeg) {
+  TempDir dir;
+  const Statics s = statics(dir, test::bundled_scene_text("yumi_bar_peg.json"));
+  ASSERT_EQ(s.run.exit_code, 0) << s.run.err;
+  EXPECT_TRUE(s.result["converged"].get<bool>());
+  EXPECT_EQ(s.result["contacts"]["by_obstacle"]["peg"]["count"], 0);  // 5 mm in front of the bar
+}
+
+// The 1 m cable lying on the table, both ends gripped: an S drawn on the table (the centre-line
+// of its equilibrium with both wrists turned 0.1 rad: reachable by construction) is reached
+// with the cable still resting on the table.
+TEST(ObstaclesCli, TheCableOnTheTableReachesACentreLineS) {
+  TempDir dir;
+  const std::string text = test::bundled_scene_text("yumi_cable_table.json");
+  const auto scene = dir.write("cable.json", text);
+  nlohmann::json joints = nlohmann::json::parse(text)["robot"]["reference_joints"];
+  for (const char* wrist : {"yumi_joint_7_l", "yumi_joint_7_r"})
+    joints[wrist] = joints[wrist].get<double>() + 0.1;
+  const auto joints_file = dir.write("joints.json", nlohmann::json{{"joints", joints}}.dump());
+  const auto goal_out = dir.path() / "goal.json";
+  const auto goal_run = run_cli(
+      {"statics", scene.string(), "--joints", joints_file.string(), "--out", goal_out.string()});
+  ASSERT_EQ(goal_run.exit_code, 0) << goal_run.err;
+  const auto goal = nlohmann::json::parse(test::read_text(goal_out));
+  ASSERT_GT(goal["contacts"]["count"].get<int>(), 0);
+  // The centre-line nodes of the 50 × 2 × 2 box: j = k = 1, i = 0..50.
+  nlohmann::json line = nlohmann::json::array();
+  for (int i = 0; i <= 50; ++i) line.push_back(goal["positions"][i + 51 * (1 + 3 * 1)]);
+  const auto targets = dir.write("s.json", nlohmann::json{{"centerline", line}}.dump());
+  const auto out = dir.path() / "solve.json";
+  const auto run =
+      run_cli({"solve", scene.string(), "--targets", targets.string(), "--out", out.string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto result = nlohmann::json::parse(test::read_text(out));
+  EXPECT_LT(result["error_mean"].get<double>(), 2e-3) << run.err;
+  EXPECT_GT(result["contacts"]["count"].get<int>(), 0);
+  const double table = 0.1095;  // the scene's table plane
+  for (const auto& p : result["positions"]) EXPECT_GT(p[2].get<double>(), table);
+}
+
 }  // namespace
 }  // namespace shapectl

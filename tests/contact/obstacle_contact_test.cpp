@@ -99,6 +99,26 @@ TEST(ObstacleContact, EnergyIsTheBarrierSumOverVerticesAboveAPlane) {
   EXPECT_EQ(contact.value(x), std::numeric_limits<double>::infinity());
 }
 
+TEST(ObstacleContact, CountsEachContactOnceHoweverManyTrianglesFindIt) {
+  // The object over a closed plate meshed like its own bottom: each bottom vertex sits right
+  // above a plate vertex that six plate triangles, several plate edges and several object
+  // triangles all find. Counted once each, the energy is the plane's: 25 barriers.
+  const TetMesh mesh = object_mesh();
+  const double gap = 0.4 * kDhat;
+  std::vector<Vec3> plate = mesh.rest_positions();
+  for (Vec3& p : plate) p.z() -= 0.02 + gap;
+  const ObstacleContact on_mesh(mesh,
+                                {make_mesh_obstacle("plate", plate, mesh.surface_triangles())},
+                                kDhat, 2.0);
+  const ObstacleContact on_plane(mesh,
+                                 {make_plane("table", Vec3(0, 0, -0.01 - gap), Vec3::UnitZ())},
+                                 kDhat, 2.0);
+  const Positions x = mesh.rest_vector();
+  EXPECT_EQ(on_mesh.summary(x).count, 25);
+  EXPECT_NEAR(on_mesh.value(x), 25 * 2.0 * barrier(gap, kDhat).value, 1e-9 * on_plane.value(x));
+  EXPECT_NEAR(on_mesh.value(x), on_plane.value(x), 1e-9 * on_plane.value(x));
+}
+
 // Collects every block a term gives, in order.
 class BlockSink : public ElementHessianSink {
  public:
@@ -240,63 +260,57 @@ void expect_no_intersection_on_the_way(const ObstacleContact& contact, const Pos
   }
 }
 
-TEST(ObstacleContact, MaxStepStopsAStepThroughAThinBox) {
-  const TetMesh mesh = object_mesh();
-  // A plate 1 mm thick, 5 mm below the object; the step would carry the object 10 cm down,
-  // wholly through it.
-  const ObstacleContact contact(mesh,
-                                {make_box("plate", Vec3(0.3, 0.3, 0.001),
-                                          Eigen::Isometry3d(
-                                              Eigen::Translation3d(0, 0, -0.01 - 0.005 - 0.0005)))},
-                                0.001, 1.0);
+// The object at rest (its bottom at z = −0.01) against `obstacle`, every node stepping by
+// `step`: max_step cuts the step short of where the full one passes through the obstacle, and
+// nothing intersects anywhere on the way to it. Returns α.
+double expect_step_stopped(const TetMesh& mesh, const Obstacle& obstacle, const Vec3& step) {
+  const ObstacleContact contact(mesh, {obstacle}, 0.001, 1.0);
   const Positions x = mesh.rest_vector();
   Eigen::VectorXd dx = Eigen::VectorXd::Zero(x.size());
-  for (int i = 0; i < mesh.node_count(); ++i) dx.segment<3>(3 * i) = Vec3(0.01, 0.003, -0.1);
+  for (int i = 0; i < mesh.node_count(); ++i) dx.segment<3>(3 * i) = step;
   const double alpha = contact.max_step(x, dx);
   EXPECT_GT(alpha, 0);
+  EXPECT_LT(alpha, 1);
+  expect_no_intersection_on_the_way(contact, x, dx, alpha);
+  // The full step does pass through: the checks above could fail.
+  EXPECT_TRUE(intersects_on_the_way(contact, x, dx));
+  return alpha;
+}
+
+TEST(ObstacleContact, MaxStepStopsAStepThroughAThinBox) {
+  // A plate 1 mm thick, 5 mm below the object; the step would carry the object 10 cm down,
+  // wholly through it.
+  const TetMesh mesh = object_mesh();
+  const Obstacle plate = make_box("plate", Vec3(0.3, 0.3, 0.001),
+                                  Eigen::Isometry3d(Eigen::Translation3d(0, 0, -0.0155)));
+  const double alpha = expect_step_stopped(mesh, plate, Vec3(0.01, 0.003, -0.1));
   EXPECT_LT(alpha, 0.05);  // 0.1 α ≤ 5 mm
   // The gap keeps at least 10 % of the 5 mm it started with.
-  EXPECT_GE(contact.summary(x + alpha * dx).min_distance, 0.1 * 0.005 * (1 - 1e-9));
-  expect_no_intersection_on_the_way(contact, x, dx, alpha);
-  // The full step does pass through: the check above could fail.
-  EXPECT_TRUE(intersects_on_the_way(contact, x, dx));
+  const ObstacleContact contact(mesh, {plate}, 0.001, 1.0);
+  Positions y = mesh.rest_vector();
+  for (int i = 0; i < mesh.node_count(); ++i)
+    y.segment<3>(3 * i) += alpha * Vec3(0.01, 0.003, -0.1);
+  EXPECT_GE(contact.summary(y).min_distance, 0.1 * 0.005 * (1 - 1e-9));
 }
 
 TEST(ObstacleContact, MaxStepStopsATriangleFallingOntoAPinBetweenItsVertices) {
   // One cell: the bottom face is two triangles 10 cm across; the pin, 4 mm wide and 1 mm thick,
   // sits under its middle, away from every vertex and edge of the object.
-  const TetMesh mesh = make_box_mesh({0.1, 0.1, 0.02}, {1, 1, 1});
-  const ObstacleContact contact(
-      mesh,
-      {make_box("pin", Vec3(0.004, 0.004, 0.001),
-                Eigen::Isometry3d(Eigen::Translation3d(0.02, -0.015, -0.01 - 0.003 - 0.0005)))},
-      0.001, 1.0);
-  const Positions x = mesh.rest_vector();
-  Eigen::VectorXd dx = Eigen::VectorXd::Zero(x.size());
-  for (int i = 0; i < mesh.node_count(); ++i) dx.segment<3>(3 * i) = Vec3(0, 0, -0.1);
-  const double alpha = contact.max_step(x, dx);
-  EXPECT_GT(alpha, 0);
+  const double alpha =
+      expect_step_stopped(make_box_mesh({0.1, 0.1, 0.02}, {1, 1, 1}),
+                          make_box("pin", Vec3(0.004, 0.004, 0.001),
+                                   Eigen::Isometry3d(Eigen::Translation3d(0.02, -0.015, -0.0135))),
+                          Vec3(0, 0, -0.1));
   EXPECT_LT(alpha, 0.03);
-  expect_no_intersection_on_the_way(contact, x, dx, alpha);
-  EXPECT_TRUE(intersects_on_the_way(contact, x, dx));
 }
 
 TEST(ObstacleContact, MaxStepStopsAnEdgeSweepingAcrossACapsule) {
   // A thin capsule (1 mm) crossing under the object's bottom edges; the object slides 10 cm
   // sideways and down: its edges would cut through the capsule between vertices.
-  const TetMesh mesh = make_box_mesh({0.1, 0.1, 0.02}, {1, 1, 1});
-  const ObstacleContact contact(mesh,
-                                {make_capsule("wire", Vec3(0.08, -0.2, -0.0125),
-                                              Vec3(0.08, 0.2, -0.0125), 0.0005)},
-                                0.001, 1.0);
-  const Positions x = mesh.rest_vector();
-  Eigen::VectorXd dx = Eigen::VectorXd::Zero(x.size());
-  for (int i = 0; i < mesh.node_count(); ++i) dx.segment<3>(3 * i) = Vec3(0.1, 0, -0.004);
-  const double alpha = contact.max_step(x, dx);
-  EXPECT_GT(alpha, 0);
-  EXPECT_LT(alpha, 1);
-  expect_no_intersection_on_the_way(contact, x, dx, alpha);
-  EXPECT_TRUE(intersects_on_the_way(contact, x, dx));
+  expect_step_stopped(make_box_mesh({0.1, 0.1, 0.02}, {1, 1, 1}),
+                      make_capsule("wire", Vec3(0.08, -0.2, -0.0125), Vec3(0.08, 0.2, -0.0125),
+                                   0.0005),
+                      Vec3(0.1, 0, -0.004));
 }
 
 TEST(ObstacleContact, FirstIntersectionFindsAPlantedIntersection) {

@@ -9,6 +9,24 @@ namespace {
 constexpr int kLeafSize = 4;
 }
 
+bool segment_overlaps(const Vec3& a, const Vec3& b, const Aabb& box) {
+  // The parameter interval [t0, t1] of the segment inside each slab, intersected.
+  double t0 = 0, t1 = 1;
+  const Vec3 d = b - a;
+  for (int k = 0; k < 3; ++k) {
+    if (d[k] == 0) {
+      if (a[k] < box.min[k] || a[k] > box.max[k]) return false;
+      continue;
+    }
+    double near = (box.min[k] - a[k]) / d[k], far = (box.max[k] - a[k]) / d[k];
+    if (near > far) std::swap(near, far);
+    t0 = std::max(t0, near);
+    t1 = std::min(t1, far);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
 Bvh::Bvh(const std::vector<Aabb>& boxes) : boxes_(boxes), order_(boxes.size()) {
   if (boxes.empty()) return;
   std::iota(order_.begin(), order_.end(), 0);

@@ -26,6 +26,9 @@ struct Aabb {
   }
 };
 
+// Whether segment ab meets `box` (slab test).
+bool segment_overlaps(const Vec3& a, const Vec3& b, const Aabb& box);
+
 // A binary tree of boxes, split at the median of the longest axis, built once.
 class Bvh {
  public:

@@ -11,7 +11,6 @@
 #include <shapectl/contact/barrier.hpp>
 #include <shapectl/contact/bvh.hpp>
 #include <shapectl/contact/distance_piece.hpp>
-#include <shapectl/contact/point_point_distance.hpp>
 #include <shapectl/contact/point_segment_distance.hpp>
 #include <shapectl/contact/point_triangle_distance.hpp>
 #include <shapectl/contact/segment_segment_distance.hpp>
@@ -55,6 +54,7 @@ struct Triangle {
   int obstacle;
   Vec3 a, b, c;
   double radius;
+  Vec3 normal;                 // unit (zero if degenerate)
   std::array<int, 3> corners;  // into Impl::points
   std::array<int, 3> sides;    // into Impl::segments: side k joins corners k and k + 1
 };
@@ -135,42 +135,31 @@ struct ObstacleContact::Impl {
     }
   }
 
-  // The gap d of pair p with its object nodes at `at`; its gradient and Hessian with respect to
-  // their coordinates if asked (may be null).
+  // The gap of candidate p with its object nodes at `at`: the distance between its two
+  // primitives less the obstacle's radius (for CCD; the energy uses contact_gap).
   template <int K>
-  double gap(const Pair& p, const std::array<Vec3, K>& at, VecN<3 * K>* g, MatN<3 * K>* h) const {
-    constexpr int N = 3 * K;
+  double candidate_gap(const Pair& p, const std::array<Vec3, K>& at) const {
+    constexpr std::array<bool, 4> fixed{false, false, false, false};
     if constexpr (K == 1) {
       switch (p.kind) {
-        case PairKind::VertexHalfSpace: {
-          const HalfSpace& s = planes[p.other].h;
-          if (g) *g = s.normal;
-          if (h) h->setZero();
-          return (at[0] - s.point).dot(s.normal);
-        }
+        case PairKind::VertexHalfSpace:
+          return (at[0] - planes[p.other].h.point).dot(planes[p.other].h.normal);
         case PairKind::VertexTriangle: {
           const Triangle& t = obstacle_triangles[p.other];
-          return point_triangle_distance<N>(at[0], t.a, t.b, t.c, {true, false, false, false}, g,
-                                            h) -
-                 t.radius;
+          return point_triangle_distance<0>(at[0], t.a, t.b, t.c, fixed) - t.radius;
         }
         case PairKind::VertexSegment: {
           const Segment& s = segments[p.other];
-          return point_segment_distance<N>(at[0], s.a, s.b, {true, false, false}, g, h) - s.radius;
+          return point_segment_distance<0>(at[0], s.a, s.b, {false, false, false}) - s.radius;
         }
-        default: {
-          const Point& q = points[p.other];
-          return point_point_distance<N>(at[0], q.p, {true, false}, g, h) - q.radius;
-        }
+        default: return (at[0] - points[p.other].p).norm() - points[p.other].radius;
       }
     } else if constexpr (K == 2) {
       const Segment& s = segments[p.other];
-      return segment_segment_distance<N>(at[0], at[1], s.a, s.b, {true, true, false, false}, g, h) -
-             s.radius;
+      return segment_segment_distance<0>(at[0], at[1], s.a, s.b, fixed) - s.radius;
     } else {
       const Point& q = points[p.other];
-      return point_triangle_distance<N>(q.p, at[0], at[1], at[2], {false, true, true, true}, g, h) -
-             q.radius;
+      return point_triangle_distance<0>(q.p, at[0], at[1], at[2], fixed) - q.radius;
     }
   }
 
@@ -399,7 +388,15 @@ struct ObstacleContact::Impl {
       }
       if (!vertex_searches) continue;
       const Aabb box = box_of({vertices[v]});
-      triangle_bvh.query(box, [&](int i) { visit(Pair{PairKind::VertexTriangle, v, i}); });
+      const Vec3 q = dx ? Vec3(p + dx->segment<3>(3 * vertices[v])) : p;
+      triangle_bvh.query(box, [&](int i) {
+        // Far from the triangle's plane all the way (its distance is at least that): no pair.
+        const Triangle& t = obstacle_triangles[i];
+        const double far = t.radius + inflate, dp = (p - t.a).dot(t.normal),
+                     dq = (q - t.a).dot(t.normal);
+        if ((dp >= far && dq >= far) || (dp <= -far && dq <= -far)) return;
+        visit(Pair{PairKind::VertexTriangle, v, i});
+      });
       vertex_segment_bvh.query(box, [&](int i) {
         visit(Pair{PairKind::VertexSegment, v, vertex_segments[i]});
       });
@@ -408,14 +405,25 @@ struct ObstacleContact::Impl {
       });
     }
     if (!segment_bvh.empty())
-      for (int e = 0; e < static_cast<int>(edges.size()); ++e)
-        segment_bvh.query(box_of({edges[e][0], edges[e][1]}), [&](int i) {
-          visit(Pair{PairKind::SegmentEdge, e, i});
+      for (int e = 0; e < static_cast<int>(edges.size()); ++e) {
+        const Aabb box = box_of({edges[e][0], edges[e][1]});
+        segment_bvh.query(box, [&](int i) {
+          // A long segment (a box's diagonal) has a big box: test the segment itself.
+          const Segment& s = segments[i];
+          if (segment_overlaps(s.a, s.b, box.inflated(s.radius)))
+            visit(Pair{PairKind::SegmentEdge, e, i});
         });
+      }
     if (!point_bvh.empty())
       for (int t = 0; t < static_cast<int>(triangles.size()); ++t) {
         const auto& tri = triangles[t];
+        const Vec3 a = node(x, tri[0]);
+        Vec3 n = (node(x, tri[1]) - a).cross(node(x, tri[2]) - a);
+        n /= n.norm();
         point_bvh.query(box_of({tri[0], tri[1], tri[2]}), [&](int i) {
+          // At x only (the plane turns along a step): far from the triangle's plane.
+          const Point& q = points[i];
+          if (!dx && std::abs((q.p - a).dot(n)) >= q.radius + inflate) return;
           visit(Pair{PairKind::PointTriangle, t, i});
         });
       }
@@ -518,8 +526,10 @@ ObstacleContact::ObstacleContact(const TetMesh& mesh, std::vector<Obstacle> obst
         corners[k] = first_point + i;
         sides[k] = side->second;
       }
-      m->obstacle_triangles.push_back(
-          {o, ob.points[t[0]], ob.points[t[1]], ob.points[t[2]], r, corners, sides});
+      const Vec3 n = (ob.points[t[1]] - ob.points[t[0]]).cross(ob.points[t[2]] - ob.points[t[0]]);
+      m->obstacle_triangles.push_back({o, ob.points[t[0]], ob.points[t[1]], ob.points[t[2]], r,
+                                       n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero(), corners,
+                                       sides});
       triangle_boxes.push_back(box_of({ob.points[t[0]], ob.points[t[1]], ob.points[t[2]]}, r));
     }
   }
@@ -612,7 +622,7 @@ double ObstacleContact::max_step(const Positions& x, const Eigen::VectorXd& dx) 
       constexpr int K = decltype(k)::value;
       const std::array<int, K> nodes = m.nodes<K>(p);
       std::array<Vec3, K> at = m.positions<K>(p, x);
-      const double d0 = m.gap<K>(p, at, nullptr, nullptr);
+      const double d0 = m.candidate_gap<K>(p, at);
       if (!(d0 > 0)) return;  // already intersecting: no step keeps it out
       const double target = 0.1 * d0;
       if (p.kind == PairKind::VertexHalfSpace) {  // the gap is linear in α: exact
@@ -630,7 +640,7 @@ double ObstacleContact::max_step(const Positions& x, const Eigen::VectorXd& dx) 
         t += (d - target) / l;
         if (t >= alpha) return;
         for (int a = 0; a < K; ++a) at[a] = node(x, nodes[a]) + t * dx.segment<3>(3 * nodes[a]);
-        d = m.gap<K>(p, at, nullptr, nullptr);
+        d = m.candidate_gap<K>(p, at);
         // Close enough to the target: further steps would shrink geometrically.
         if (d - target <= 0.1 * (d0 - target)) break;
       }
