@@ -17,6 +17,10 @@
 #include <shapectl/contact/segment_triangle_distance.hpp>
 #include <shapectl/contact/triangle_edges.hpp>
 
+// How the terms are found: the broad phase lists candidates, pairs of primitives (Pair) whose
+// boxes overlap; IPC's classification of where their closest points lie turns each into a
+// Contact, a pair of features, and a contact found by several candidates counts once. The CCD
+// bound works on the candidates themselves.
 namespace shapectl {
 
 namespace {
