@@ -2,7 +2,7 @@
 // sags onto, with a table, a box and a ball beside it. Checked in the page's scene graph against
 // the server's messages (each obstacle drawn where the scene puts it, an arrow per contact
 // point along its force to the scale shown) and in a screenshot (the contact dots are drawn,
-// and gone once the Contacts box is unticked).
+// and gone once the Contacts box is unticked). Then the bundled scenes/yumi_cable_table.json.
 import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
@@ -120,6 +120,23 @@ describe('obstacles and contacts', () => {
 
     await page.check('#show-contacts');
     assert.equal((await hooks(page, () => window.shapectl.contacts())).visible, true);
+    assert.deepEqual(page.problems, []);
+  });
+
+  it('shows the bundled cable on its table, and nothing of the peg scene after it', async () => {
+    await page.locator('#scene-select').selectOption('yumi_cable_table.json');
+    const shown = await waitFor(async () => {
+      const s = await hooks(page, () => ({ scene: window.shapectl.scene.scene, state: window.shapectl.state,
+        obstacles: window.shapectl.obstacles(), drawn: window.shapectl.contacts() }));
+      return s.scene === 'yumi_cable_table.json' && s.state?.scene === s.scene && s.state.contacts?.count > 0 &&
+        s.drawn.points === s.state.contacts.points.length && s;
+    }, 'the cable scene with its contacts');
+    assert.deepEqual(shown.obstacles.map((o) => [o.name, o.shape, o.visible]), [['table', 'plane', true]]);
+    const { contacts } = shown.state;
+    assert.equal(contacts.by_obstacle.table.count, contacts.count);
+    assert.deepEqual(Object.keys(contacts.by_obstacle), ['table'], 'the peg scene\'s obstacles are gone');
+    assert.ok(contacts.force_total[2] > 0, 'the table pushes the cable up');
+    assert.equal(shown.drawn.arrows.length, contacts.points.length);
     assert.deepEqual(page.problems, []);
   });
 });
