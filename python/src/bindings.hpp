@@ -109,6 +109,19 @@ std::map<std::string, Pose> tool_poses(const Scene& scene, const Eigen::VectorXd
 // Every joint of `full_joints` outside its hard limits (the CLI's "limit_violations").
 std::vector<LimitViolation> violations_at(const RobotModel& robot, const Eigen::VectorXd& active);
 
+// A result's contacts with the scene's obstacles (docs/contact.md): computed without the GIL,
+// handed to Python as a dict by contacts_dict.
+struct ContactsResult {
+  ContactSummary summary;
+  std::vector<std::string> obstacle_names;
+};
+// Those at x of the statics' contact term; none without obstacles.
+std::optional<ContactsResult> contacts_at(const ObjectStatics& statics, const Positions& x);
+// {"count", "min_distance" (m; None without a pair within the contact distance), "force_total"
+// ((3,) N, the obstacles' force on the object), "by_obstacle": {name: {"count", "force"}}}, the
+// fields of RESULT.json's "contacts"; None without obstacles.
+py::object contacts_dict(const std::optional<ContactsResult>& contacts);
+
 void bind_scene(py::module_& m);
 void bind_statics(py::module_& m);
 void bind_kinematics(py::module_& m);

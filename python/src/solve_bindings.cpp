@@ -32,6 +32,7 @@ struct SolveResult {
   std::optional<double> min_clearance;
   std::vector<LimitViolation> limit_violations;
   Vec3 loads_total = Vec3::Zero();
+  std::optional<ContactsResult> contacts;
   Positions positions;
   ShapeTargets targets;
   std::vector<HistoryEntry> history;
@@ -111,6 +112,7 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
   out.limit_violations = violations_at(object.robot(), best.joints());
   out.loads_total = s.scene->loads_total();
   out.positions = best.positions();
+  out.contacts = contacts_at(object.statics(), out.positions);
   out.targets = objective.targets();
   out.history = result.history;
   out.timing = objective.timing();
@@ -177,6 +179,10 @@ void bind_solve(py::module_& m) {
                     "Joints outside their hard limits.")
       .def_readonly("loads_total", &SolveResult::loads_total,
                     "Sum of the scene's applied loads, N, world frame: array of shape (3,).")
+      .def_property_readonly(
+          "contacts", [](const SolveResult& r) { return contacts_dict(r.contacts); },
+          "Contacts with the scene's obstacles at the best θ, as StaticsSolution.contacts; None "
+          "without obstacles.")
       .def_property_readonly(
           "positions", [](const SolveResult& r) { return positions_array(r.positions); },
           "Equilibrium at the best θ: array of shape (n, 3).")

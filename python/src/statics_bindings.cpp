@@ -13,6 +13,7 @@ namespace {
 struct StaticsSolution {
   StaticsResult result;
   Vec3 loads_total = Vec3::Zero();
+  std::optional<ContactsResult> contacts;
   Positions positions;
   std::optional<Eigen::VectorXd> joints;
   std::vector<std::string> joint_names;
@@ -27,7 +28,9 @@ StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in)
       throw InputError("joints", "", "joints given, but the scene has no robot");
     py::gil_scoped_release release;
     out.positions = s.scene->world_rest_positions();
-    out.result = ObjectStatics(*s.scene).solve(out.positions);
+    const ObjectStatics statics(*s.scene);
+    out.result = statics.solve(out.positions);
+    out.contacts = contacts_at(statics, out.positions);
     return out;
   }
   const GrippedObject& object = *s.object;
@@ -37,6 +40,7 @@ StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in)
       object.solve_from(joints, object.reference_positions(), 0, nullptr, {}, s.workspaces);
   out.result = state.statics();
   out.positions = state.positions();
+  out.contacts = contacts_at(object.statics(), out.positions);
   out.joints = joints;
   out.joint_names = object.robot().active_joint_names();
   out.tools = tool_poses(*s.scene, joints);
@@ -120,6 +124,11 @@ void bind_statics(py::module_& m) {
       .def_readonly("result", &StaticsSolution::result, "The full StaticsResult.")
       .def_readonly("loads_total", &StaticsSolution::loads_total,
                     "Sum of the scene's applied loads, N, world frame: array of shape (3,).")
+      .def_property_readonly(
+          "contacts", [](const StaticsSolution& s) { return contacts_dict(s.contacts); },
+          "Contacts with the scene's obstacles at the equilibrium: {'count', 'min_distance' (m or "
+          "None), 'force_total' ((3,) N, the obstacles' force on the object), 'by_obstacle': "
+          "{name: {'count', 'force'}}}; None without obstacles (docs/contact.md).")
       .def_property_readonly(
           "positions", [](const StaticsSolution& s) { return positions_array(s.positions); },
           "Equilibrium positions, world frame, metres: array of shape (n, 3), mesh node order.")

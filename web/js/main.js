@@ -100,6 +100,8 @@ function onScene(scene) {
   $('face-bar').disabled = !scene.bar;
   $('sketch').title = scene.bar ? 'Sketch a centre-line with the mouse (C)' : 'Only for bar-like objects';
   $('link-section').hidden = !scene.link;
+  $('contacts-toggle').hidden = !scene.obstacles?.length;
+  $('contact-scale').textContent = '';
   jointPanel.setRobot(scene.robot);
   showRobotWarnings(scene.warnings ?? []);
 }
@@ -127,6 +129,7 @@ function onState(state) {
   // Red: links that overlap, and those a refused jog would have made overlap.
   view.robotView.setCollisions([...state.colliding_links, ...state.jog_refused_links], state.closest_pair);
   view.setState(state);
+  $('contact-scale').textContent = view.contactsView.scaleLabel && `(${view.contactsView.scaleLabel})`;
   editor.update(state);
   tools.setState(state);
   plot.add(state.time, plotValues(state), state.editing);
@@ -144,6 +147,7 @@ function onState(state) {
   const whole = (part) => part.replaceAll(' ', '\u00a0');
   const parts = [`${state.targets.length} targets`, `${state.iterations} iterations`, `${state.clients} page(s)`];
   if (state.min_clearance !== null) parts.push(`clearance ${(1000 * state.min_clearance).toFixed(0)} mm`);
+  if (state.contacts) parts.push(contactSummary(state.contacts));
   if (!state.safe) parts.push('UNSAFE');
   $('status-detail').textContent = parts.map(whole).join(' · ') + (state.last_error ? ` · ${state.last_error}` : '');
   $('pause').textContent = state.paused ? 'Resume' : 'Pause';
@@ -167,6 +171,14 @@ function onState(state) {
 }
 
 const observationRate = new ObservationRate();
+
+// The status line's contacts: how many pairs touch, the smallest gap and the obstacles' total
+// force on the object.
+function contactSummary(c) {
+  if (!c.count) return 'no contact';
+  const f = Math.hypot(...c.force_total);
+  return `${c.count} contacts, gap ${mm(c.min_distance)} mm, ${f.toPrecision(3)} N`;
+}
 
 // The Real object panel's line: observations, the errors, what the gate refused and why the
 // newest was ignored or gated (docs/calibration.md, Safety).
@@ -221,6 +233,7 @@ $('show-wireframe').onchange = (e) => view.setWireframe(e.target.checked);
 $('show-spheres').onchange = (e) => view.setSpheresVisible(e.target.checked);
 $('show-robot').onchange = (e) => view.setRobotVisible(e.target.checked);
 $('show-points').onchange = (e) => view.setObservedPointsVisible(e.target.checked);
+$('show-contacts').onchange = (e) => view.setContactsVisible(e.target.checked);
 $('scene-select').onchange = (e) => command(Command.LoadScene, { scene: e.target.value });
 $('feedback').onchange = (e) => command(Command.SetFeedback, { on: e.target.checked });
 $('arm').onclick = () => command(Command.Arm);
@@ -268,6 +281,9 @@ window.shapectl = {
   cameraPosition: () => view.camera.position.toArray(),
   get renderPending() { return view.renderPending; },
   observedPoints: () => view.observedPoints(),
+  // The obstacles and contacts as drawn (obstacles_view.js, contacts_view.js).
+  obstacles: () => view.obstaclesView.describe(),
+  contacts: () => view.contactsView.describe(),
   robotColors: () => view.robotView.visualColors(),
   robotMeshes: () => view.robotView.meshVisuals(),
   get robotWarnings() { return page.robotWarnings; },

@@ -6,6 +6,8 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { ObjectView } from './object_view.js';
 import { RobotView } from './robot_view.js';
 import { GhostView } from './ghost_view.js';
+import { ObstaclesView } from './obstacles_view.js';
+import { ContactsView } from './contacts_view.js';
 import { TargetControls } from './target_controls.js';
 import { TargetGizmo } from './target_gizmo.js';
 import { fitCamera } from './fit_view.js';
@@ -61,7 +63,9 @@ export class View3D {
     this.robotView = new RobotView();
     this.ghostView = new GhostView();
     this.objectView = new ObjectView();
-    this.scene.add(this.robotView.group, this.ghostView.group, this.objectView.group);
+    this.obstaclesView = new ObstaclesView();
+    this.contactsView = new ContactsView();
+    this.scene.add(this.robotView.group, this.ghostView.group, this.objectView.group, this.obstaclesView.group, this.contactsView.group);
     this.targetControls = new TargetControls(this.camera, this.objectView, this.renderer.domElement);
     this.gizmo = new TargetGizmo(this.camera, this.renderer.domElement, this.scene);
     this.targetControls.yieldsTo = (event) => this.gizmo.hits(event);
@@ -175,6 +179,9 @@ export class View3D {
     if (this.robotSeeThrough) this.setRobotSeeThrough(true);
     this.ghostView.setRobot(description.robot);
     this.objectView.setScene(description);
+    this.obstaclesView.setObstacles(description.obstacles);
+    this.contactsView.set(null);
+    this.obstaclesCentred = false;  // a plane goes under the object once its shape arrived
     this.state = null;
     this.fitPending = true;
     this.requestRender();
@@ -182,6 +189,10 @@ export class View3D {
 
   setPositions(positions) {
     this.objectView.setPositions(positions);
+    if (!this.obstaclesCentred) {
+      this.obstaclesView.centreUnder(this.objectView.centroid(this.scratch));
+      this.obstaclesCentred = true;
+    }
     this.fitOnceShown();
     this.requestRender();
   }
@@ -204,6 +215,7 @@ export class View3D {
     this.objectView.setTargets(state.targets, state.centerline.length === 0);  // the curve is the handle there
     this.objectView.setObservedMarkers(state.observed_markers);
     this.objectView.setObservedPoints(state.observed_points);
+    this.contactsView.set(state.contacts);
     this.placeGizmo();
     this.fitOnceShown();
     this.requestRender();
@@ -285,6 +297,7 @@ export class View3D {
   setRobotVisible(on) { this.robotView.setVisible(on); this.requestRender(); }
   setObjectVisible(on) { this.objectView.setVisible(on); this.requestRender(); }
   setObservedPointsVisible(on) { this.objectView.setObservedPointsVisible(on); this.requestRender(); }
+  setContactsVisible(on) { this.contactsView.setEnabled(on); this.requestRender(); }
 
   // ---- for tests and tools (new arrays and vectors: callers keep them) ----
   nodePosition(node) { return this.objectView.nodePosition(node, new THREE.Vector3()); }

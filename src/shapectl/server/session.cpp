@@ -13,7 +13,9 @@
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/runtime/runtime_policy.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
+#include <shapectl/server/contact_message.hpp>
 #include <shapectl/server/http_rules.hpp>  // robot_mesh_prefix
+#include <shapectl/sim/object_statics.hpp>
 
 namespace shapectl::server {
 
@@ -366,6 +368,9 @@ void Session::load(const SceneEntry& entry) {
   // Only an armed link has something to say about it (at start-up it is disarmed already).
   if (link_ && link_->status().armed) link_->disarm("scene changed to " + entry.name);
   robot_meshes_ = find_visual_meshes(*scene.robot->model, package_paths_);
+  statics_ = scene.obstacles.empty() ? nullptr : std::make_unique<ObjectStatics>(scene);
+  contacts_ = nullptr;
+  update_contacts();
   scene_description_ = describe_scene();
 }
 
@@ -539,6 +544,15 @@ void Session::tick() {
   }
   if (world_ && link_) observe_world(t);
   calibration_->poll(t);
+  update_contacts();
+}
+
+void Session::update_contacts() {
+  const ObstacleContact* contact = statics_ ? statics_->contact() : nullptr;
+  if (!contact || (!contacts_.is_null() && snapshot_->sequence == contacts_sequence_)) return;
+  if (snapshot_->positions.size() != 3 * controller_->mesh().node_count()) return;  // none yet
+  contacts_sequence_ = snapshot_->sequence;
+  contacts_ = contacts_json(contact->summary(snapshot_->positions), contact->obstacles());
 }
 
 void Session::set_world(std::unique_ptr<SimulatedWorld> world) {
@@ -581,6 +595,7 @@ nlohmann::json Session::describe_scene() const {
            {"thickness", axis->thickness}};
   nlohmann::json scenes = nlohmann::json::array();
   for (const auto& s : scenes_) scenes.push_back(s.name);
+  const ObstacleContact* contact = statics_ ? statics_->contact() : nullptr;
   return {{"type", "scene"},
           {"protocol", protocol_version},
           {"scene", scene_name_},
@@ -592,6 +607,10 @@ nlohmann::json Session::describe_scene() const {
           {"robot",
            scene.robot ? robot_json(*scene.robot, robot_meshes_) : nlohmann::json(nullptr)},
           {"warnings", mesh_warnings(scene, robot_meshes_)},
+          {"obstacles", obstacles_json(scene.obstacles)},
+          {"contact", contact ? nlohmann::json{{"distance", contact->distance()},
+                                               {"stiffness", contact->stiffness()}}
+                              : nlohmann::json(nullptr)},
           {"link", link_ != nullptr},
           {"limits",
            {{"max_message_bytes", max_message_bytes},
@@ -614,7 +633,7 @@ std::string Session::state_message(int clients) const {
   nlohmann::json links = nlohmann::json::array();
   for (const auto& T : s.T_world_link) links.push_back(message_pose_json(T));
   const double t = now();
-  const nlohmann::json m = {
+  nlohmann::json m = {
       {"type", "state"},
       {"scene", scene_name_},
       {"seq", s.sequence},
@@ -661,6 +680,7 @@ std::string Session::state_message(int clients) const {
       {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)},
       {"measured_links",
        link_ ? measured_links_json(controller_->scene(), link_->status()) : nlohmann::json()}};
+  if (!contacts_.is_null()) m["contacts"] = contacts_;  // only with obstacles
   return m.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 

@@ -21,6 +21,7 @@
 #include <shapectl/server/protocol.hpp>
 
 namespace shapectl {
+class ObjectStatics;
 class RobotLink;
 class SessionLog;
 }  // namespace shapectl
@@ -112,6 +113,7 @@ class Session {
   nlohmann::json describe_scene() const;
   double now() const;
   void observe_world(double time);
+  void update_contacts();
 
   std::vector<SceneEntry> scenes_;
   std::string scene_name_;
@@ -124,6 +126,12 @@ class Session {
   nlohmann::json scene_description_;  // the static part of scene_message()
   std::vector<std::filesystem::path> package_paths_;
   std::vector<VisualMesh> robot_meshes_;  // of the current scene's robot, found or not
+  // The scene object's energy, for its contact term (null without obstacles): the same obstacles,
+  // d̂ and κ as the controller's statics. The states' "contacts", of the snapshot
+  // contacts_sequence_.
+  std::unique_ptr<ObjectStatics> statics_;
+  nlohmann::json contacts_;
+  std::uint64_t contacts_sequence_ = 0;
   ShapeTargets targets_;  // node targets as the clients set them (a centre-line clears them)
   std::chrono::steady_clock::time_point started_;
   double last_edit_time_ = -1e9;
