@@ -1,6 +1,6 @@
 // shapectl calibrate SCENE.json --observations OBS.json --out CALIBRATED.json
 //   [--fit youngs_modulus,poisson_ratio,density,grip_offsets,object_pose] [--report REPORT.json]
-//   [--max-iterations N] [--max-seconds S]
+//   [--prior LIST] [--bounds LIST] [--max-iterations N] [--max-seconds S]
 // Fits the scene's physical parameters to observed frames of the real object
 // (docs/calibration.md) and writes the scene with the fitted values.
 #include <algorithm>
@@ -26,7 +26,8 @@ namespace {
 struct CalibrateArgs {
   std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
   std::string scene, observations, out, report;
-  std::string fit;  // default: default_fit(scene)
+  std::string fit;            // default: default_fit(scene)
+  std::string prior, bounds;  // parse_priors, parse_bounds
   std::string linear_solver;
   int max_iterations = 30;
   double max_seconds = 300;  // the whole command
@@ -50,6 +51,32 @@ FitSelection fit_selection(const CalibrateArgs& args, const Scene& scene) {
   return fit;
 }
 
+// --prior and --bounds; a bad entry → InputError naming the option and the entry. The scene's
+// material must lie within the bounds.
+void priors_and_bounds(const CalibrateArgs& args, const Scene& scene, const FitSelection& fit,
+                       CalibrationOptions& options) {
+  try {
+    options.priors = parse_priors(args.prior);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("--prior", "", e.what());
+  }
+  try {
+    options.bounds = parse_bounds(args.bounds);
+    const std::string name =
+        outside_bounds(ParameterSpace(scene, fit), PhysicalParameters::of(scene), options.bounds);
+    if (!name.empty())
+      throw std::invalid_argument(name + ": the scene's value (" + args.scene +
+                                  ") is outside these bounds");
+  } catch (const std::invalid_argument& e) {
+    throw InputError("--bounds", "", e.what());
+  }
+}
+
+// A value's prior σ, or null without one.
+nlohmann::ordered_json or_null(double value, bool present) {
+  return present ? nlohmann::ordered_json(value) : nlohmann::ordered_json();
+}
+
 nlohmann::ordered_json report_json(const CalibrationResult& r) {
   nlohmann::ordered_json out;
   out["converged"] = r.converged;
@@ -58,21 +85,26 @@ nlohmann::ordered_json report_json(const CalibrationResult& r) {
   out["seconds"] = r.seconds;
   out["parameters"] = nlohmann::ordered_json::array();
   for (const FittedParameter& p : r.parameters)
-    out["parameters"].push_back(
-        {{"name", p.name},
-         {"unit", p.unit},
-         {"initial", p.initial},
-         {"fitted", p.fitted},
-         {"standard_deviation",
-          p.held ? nlohmann::ordered_json() : nlohmann::ordered_json(p.standard_deviation)},
-         {"identifiable", !p.held}});
+    out["parameters"].push_back({{"name", p.name},
+                                 {"unit", p.unit},
+                                 {"initial", p.initial},
+                                 {"fitted", p.fitted},
+                                 {"standard_deviation", or_null(p.standard_deviation, !p.held)},
+                                 {"identifiable", !p.held},
+                                 {"verdict", to_string(p.verdict)},
+                                 {"prior", or_null(p.prior, p.prior > 0)},
+                                 {"implausible", p.implausible},
+                                 {"trades_off_with", p.trades_off_with},
+                                 {"suggestion", p.suggestion}});
+  out["implausible"] = r.implausible;
   out["identifiability"] = nlohmann::ordered_json::array();
   for (const UnidentifiedDirection& d : r.unidentified) {
     nlohmann::ordered_json combination;
     for (const auto& [name, weight] : d.combination) combination[name] = weight;
     out["identifiability"].push_back({{"not_determined", combination},
                                       {"standard_deviation_in_scales", d.standard_deviation},
-                                      {"held_at_initial_value", d.held}});
+                                      {"held_at_initial_value", d.held},
+                                      {"suggestion", d.suggestion}});
   }
   out["rms_before"] = r.rms_before;
   out["rms_after"] = r.rms_after;
@@ -89,17 +121,24 @@ nlohmann::ordered_json report_json(const CalibrationResult& r) {
 
 void print_summary(const CalibrationResult& r) {
   for (const UnidentifiedDirection& d : r.unidentified) {
-    std::cerr << "calibrate: not identifiable from these observations:";
+    std::cerr << "calibrate: not determined by these observations:";
     for (const auto& [name, weight] : d.combination)
       std::cerr << " " << name << " (" << weight << ")";
-    std::cerr << " together; " << d.held << " held at its initial value\n";
+    std::cerr << " together; " << d.held
+              << " held at its initial value; would determine it: " << d.suggestion << "\n";
   }
   for (const FittedParameter& p : r.parameters) {
     std::cerr << "  " << p.name << ": " << p.initial << " -> " << p.fitted;
-    if (p.held) std::cerr << " (held)";
-    else std::cerr << " ± " << p.standard_deviation;
-    std::cerr << " " << p.unit << "\n";
+    if (!p.held) std::cerr << " ± " << p.standard_deviation;
+    std::cerr << " " << p.unit << " (" << to_string(p.verdict);
+    if (p.prior > 0) std::cerr << "; prior σ " << p.prior << " " << p.unit;
+    std::cerr << ")\n";
   }
+  for (const FittedParameter& p : r.parameters)
+    if (p.implausible)
+      std::cerr << "calibrate: warning: " << p.name << " moved " << p.fitted - p.initial << " "
+                << p.unit << ", more than 3 prior σ (" << p.prior << " " << p.unit
+                << "): implausible; the model may miss something the fit absorbs here\n";
   std::cerr << "calibrate: " << r.reason << "; RMS residual " << r.rms_before * 1e3 << " mm -> "
             << r.rms_after * 1e3 << " mm (χ²/dof " << r.chi_squared_per_dof << ") in " << r.seconds
             << " s\n";
@@ -121,14 +160,16 @@ void run_calibrate(const CalibrateArgs& args) {
   apply_linear_solver_option(args.linear_solver, scene);
   print_scene_notes(scene, args.package_paths);
   const FitSelection fit = fit_selection(args, scene);
+  CalibrationOptions options{.max_iterations = args.max_iterations};
+  priors_and_bounds(args, scene, fit, options);
   const Observations observations =
       load_observations(args.observations,
                         {.node_count = scene.object_mesh->node_count(),
                          .robot = scene.robot ? scene.robot->model.get() : nullptr});
   CalibrationResult result;
   try {
-    result = calibrate(scene, observations, fit,
-                       {.max_iterations = args.max_iterations, .max_seconds = remaining()});
+    options.max_seconds = remaining();
+    result = calibrate(scene, observations, fit, options);
   } catch (const std::runtime_error& e) {
     throw SolverFailure(std::string("calibrate: ") + e.what() +
                         (remaining() > 0 ? "" : " (--max-seconds reached)"));
@@ -164,6 +205,15 @@ void add_calibrate_command(CLI::App& app) {
       "parameters to fit, comma-separated: youngs_modulus, poisson_ratio, density, grip_offsets, "
       "object_pose (default youngs_modulus,grip_offsets with a robot, "
       "youngs_modulus,object_pose for an object held by fixed nodes alone)");
+  cmd->add_option("--prior", args->prior,
+                  "priors on the fitted values' change from the scene's, comma-separated "
+                  "NAME=SIGMA: object_pose.translation=10mm, object_pose.rotation=2deg, "
+                  "grip_offsets=5mm/3deg, youngs_modulus=50% (mm, m, deg, rad; % for material); "
+                  "none disables one, off alone all (defaults: object_pose 10mm/2deg, "
+                  "grip_offsets 5mm/3deg, none on material)");
+  cmd->add_option("--bounds", args->bounds,
+                  "hard bounds on the material, comma-separated NAME=LOWER:UPPER (a side may be "
+                  "empty): youngs_modulus=1e3:1e8, density=100:2000, poisson_ratio=0.2:0.49");
   cmd->add_option("--report", args->report,
                   "REPORT.json: values, standard deviations, residuals, identifiability")
       ->check(writable_output());

@@ -211,11 +211,17 @@ class FittedParameter:
     fitted: float
     standard_deviation: Optional[float]
     identifiable: bool
+    verdict: str
+    prior: Optional[float]
+    implausible: bool
+    trades_off_with: List[str]
+    suggestion: str
 
 class UnidentifiedDirection:
     not_determined: Dict[str, float]
     standard_deviation_in_scales: float
     held_at_initial_value: str
+    suggestion: str
 
 class FrameFit:
     rms_before: float
@@ -232,6 +238,7 @@ class CalibrationResult:
     seconds: float
     parameters: List[FittedParameter]
     identifiability: List[UnidentifiedDirection]
+    implausible: List[str]
     rms_before: float
     rms_after: float
     chi_squared_per_dof: float
@@ -241,7 +248,8 @@ Observations = Union[str, os.PathLike, Mapping[str, Any]]
 
 def calibrate(scene: Scene, observations: Observations, *,
               fit: Optional[Union[str, Sequence[str]]] = None,
-              max_iterations: int = 30) -> CalibrationResult: ...
+              max_iterations: int = 30, max_seconds: float = 300.0, prior: str = "",
+              bounds: str = "") -> CalibrationResult: ...
 
 def configure_runtime(*, threads: Optional[int] = None, blas_threads: Optional[int] = None,
                       blas_idle_timeout: Optional[int] = None,

@@ -59,10 +59,32 @@ bool finite(const CalibrationResult& r) {
   return ok;
 }
 
+// prior= and bounds= as the CLI's --prior and --bounds; a bad entry → ValueError naming it.
+void priors_and_bounds(const std::string& prior, const std::string& bounds, const Scene& scene,
+                       const FitSelection& fit, CalibrationOptions& options) {
+  try {
+    options.priors = parse_priors(prior);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("prior", "", e.what());
+  }
+  try {
+    options.bounds = parse_bounds(bounds);
+  } catch (const std::invalid_argument& e) {
+    throw InputError("bounds", "", e.what());
+  }
+  const std::string outside =
+      outside_bounds(ParameterSpace(scene, fit), PhysicalParameters::of(scene), options.bounds);
+  if (!outside.empty())
+    throw InputError("bounds", "", outside + ": the scene's value is outside these bounds");
+}
+
 Calibration run_calibrate(const SceneHandle& s, const py::object& observations_in,
-                          const py::object& fit_in, Integer max_iterations, Real max_seconds) {
+                          const py::object& fit_in, Integer max_iterations, Real max_seconds,
+                          const std::string& prior, const std::string& bounds) {
   const Scene& scene = *s.scene;
   const FitSelection fit = fit_from(fit_in.is_none() ? py::str(default_fit(scene)) : fit_in);
+  CalibrationOptions options{.max_iterations = max_iterations};
+  priors_and_bounds(prior, bounds, scene, fit, options);
   if (max_iterations < 1 || max_iterations > 1000)
     throw InputError("max_iterations", "", "a number from 1 to 1000", max_iterations);
   if (!(max_seconds > 0)) throw InputError("max_seconds", "", "a positive number", max_seconds);
@@ -71,9 +93,8 @@ Calibration run_calibrate(const SceneHandle& s, const py::object& observations_i
   py::gil_scoped_release release;
   Calibration out;
   try {
-    static_cast<CalibrationResult&>(out) =
-        calibrate(scene, observations, fit,
-                  {.max_iterations = max_iterations, .max_seconds = max_seconds.value});
+    options.max_seconds = max_seconds.value;
+    static_cast<CalibrationResult&>(out) = calibrate(scene, observations, fit, options);
   } catch (const std::invalid_argument&) {
     throw;
   } catch (const std::runtime_error& e) {  // a frame's equilibrium not found
@@ -103,7 +124,24 @@ void bind_calibration(py::module_& m) {
           "Its standard deviation (from the frames' sigma); None when held.")
       .def_property_readonly(
           "identifiable", [](const FittedParameter& p) { return !p.held; },
-          "False: the observations cannot determine it; held at its initial value.");
+          "False: the observations cannot determine it; held at its initial value.")
+      .def_property_readonly(
+          "verdict", [](const FittedParameter& p) { return std::string(to_string(p.verdict)); },
+          "'determined', 'weakly determined' (fitted, its standard deviation large) or 'not "
+          "determined' (held), judged at the fitted point.")
+      .def_property_readonly(
+          "prior",
+          [](const FittedParameter& p) -> std::optional<double> {
+            if (p.prior > 0) return p.prior;
+            return std::nullopt;
+          },
+          "Its prior's standard deviation in `unit`; None without a prior.")
+      .def_readonly("implausible", &FittedParameter::implausible,
+                    "Fitted more than 3 prior standard deviations from its initial value.")
+      .def_readonly("trades_off_with", &FittedParameter::trades_off_with,
+                    "The parameters it trades off with (not or weakly determined).")
+      .def_readonly("suggestion", &FittedParameter::suggestion,
+                    "What observations would determine it; empty when determined.");
 
   py::class_<UnidentifiedDirection>(
       m, "UnidentifiedDirection",
@@ -118,7 +156,9 @@ void bind_calibration(py::module_& m) {
       .def_readonly("standard_deviation_in_scales", &UnidentifiedDirection::standard_deviation,
                     "Its standard deviation in units of the coordinates' typical scales.")
       .def_readonly("held_at_initial_value", &UnidentifiedDirection::held,
-                    "The parameter kept at its initial value for it.");
+                    "The parameter kept at its initial value for it.")
+      .def_readonly("suggestion", &UnidentifiedDirection::suggestion,
+                    "What observations would determine it.");
 
   py::class_<FrameFit>(m, "FrameFit", "The fit of one observed frame.")
       .def_readonly("rms_before", &FrameFit::rms_before, "RMS residual before, m.")
@@ -143,6 +183,8 @@ void bind_calibration(py::module_& m) {
                     "One FittedParameter per fitted coordinate (held ones included, marked).")
       .def_readonly("identifiability", &CalibrationResult::unidentified,
                     "One UnidentifiedDirection per combination the observations cannot determine.")
+      .def_readonly("implausible", &CalibrationResult::implausible,
+                    "Names of the parameters fitted more than 3 prior standard deviations away.")
       .def_readonly("rms_before", &CalibrationResult::rms_before,
                     "RMS residual over all frames before, m.")
       .def_readonly("rms_after", &CalibrationResult::rms_after,
@@ -151,18 +193,21 @@ void bind_calibration(py::module_& m) {
                     "χ²/dof: about 1 when the model fits to the noise level.")
       .def_readonly("frames", &CalibrationResult::frames, "One FrameFit per observed frame.");
 
-  m.def("calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
-        py::arg("fit") = py::none(), py::arg("max_iterations") = 30, py::arg("max_seconds") = 300.0,
-        "Fits the scene's physical parameters to observations of the real object, as `shapectl "
-        "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
-        "of its schema (numpy arrays allowed; a points_file relative to the current "
-        "directory). fit: a comma-separated string or a list of youngs_modulus, poisson_ratio, "
-        "density, grip_offsets, object_pose (default: youngs_modulus and grip_offsets with a "
-        "robot, youngs_modulus and object_pose without). max_seconds: the fit's time budget; "
-        "spent, it stops with the best values so far (converged False). Raises ValueError for bad "
-        "input (the CLI's message; a dict is named 'observations'), SolverError when a frame's "
-        "equilibrium cannot be found or the budget is spent before a first fit. Releases the GIL "
-        "while it runs.");
+  m.def(
+      "calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
+      py::arg("fit") = py::none(), py::arg("max_iterations") = 30, py::arg("max_seconds") = 300.0,
+      py::arg("prior") = "", py::arg("bounds") = "",
+      "Fits the scene's physical parameters to observations of the real object, as `shapectl "
+      "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
+      "of its schema (numpy arrays allowed; a points_file relative to the current "
+      "directory). fit: a comma-separated string or a list of youngs_modulus, poisson_ratio, "
+      "density, grip_offsets, object_pose (default: youngs_modulus and grip_offsets with a "
+      "robot, youngs_modulus and object_pose without). max_seconds: the fit's time budget; "
+      "spent, it stops with the best values so far (converged False). prior, bounds: as the CLI's "
+      "--prior and --bounds (docs/calibration.md). Raises ValueError for bad "
+      "input (the CLI's message; a dict is named 'observations'), SolverError when a frame's "
+      "equilibrium cannot be found or the budget is spent before a first fit. Releases the GIL "
+      "while it runs.");
 }
 
 }  // namespace shapectl::python

@@ -40,14 +40,20 @@ inline SimulatedCamera depth_camera_with_outliers() {
 }
 
 // Stiffness and density asked for from shape alone (the first two parameters): one direction
-// the data cannot determine, made of the two, with density held at its initial value.
+// the data cannot determine, made of the two, with density held at its initial value: "not
+// determined", trading off with Young's modulus, a different load suggested; E fitted.
 inline void expect_density_held_for_stiffness(const CalibrationResult& r) {
   ASSERT_EQ(r.unidentified.size(), 1u);
   EXPECT_EQ(r.unidentified[0].held, "density");
   ASSERT_EQ(r.unidentified[0].combination.size(), 2u);  // youngs_modulus and density together
+  EXPECT_NE(r.unidentified[0].suggestion.find("different load"), std::string::npos);
   ASSERT_GE(r.parameters.size(), 2u);
   EXPECT_FALSE(r.parameters[0].held);
+  EXPECT_NE(r.parameters[0].verdict, Verdict::NotDetermined);
   EXPECT_TRUE(r.parameters[1].held);
+  EXPECT_EQ(r.parameters[1].verdict, Verdict::NotDetermined);
+  EXPECT_EQ(r.parameters[1].trades_off_with, std::vector<std::string>{"youngs_modulus"});
+  EXPECT_NE(r.parameters[1].suggestion.find("hanging weight"), std::string::npos);
   EXPECT_EQ(r.parameters[1].fitted, r.parameters[1].initial);
 }
 

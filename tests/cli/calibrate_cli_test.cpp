@@ -98,11 +98,70 @@ TEST_F(CalibrateCli, StiffnessAndDensityTogetherAreReportedNotIdentifiable) {
       run_cli({"calibrate", kCantilever.string(), "--observations", observations.string(), "--out",
                out, "--report", report, "--fit", "youngs_modulus,density"});
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_NE(run.err.find("not identifiable"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("not determined by these observations"), std::string::npos) << run.err;
   const nlohmann::json r = nlohmann::json::parse(test::read_text(report));
   ASSERT_EQ(r["identifiability"].size(), 1u);
   EXPECT_EQ(r["identifiability"][0]["held_at_initial_value"], "density");
   EXPECT_TRUE(r["parameters"][1]["standard_deviation"].is_null());
+  EXPECT_EQ(r["parameters"][1]["verdict"], "not determined");
+  EXPECT_EQ(r["parameters"][1]["trades_off_with"], nlohmann::json::array({"youngs_modulus"}));
+  EXPECT_NE(r["parameters"][1]["suggestion"].get<std::string>().find("hanging weight"),
+            std::string::npos);
+  EXPECT_NE(run.err.find("hanging weight"), std::string::npos) << run.err;
+}
+
+// Issue 35: each value with its prior (physical units) and verdict; the defaults' priors on the
+// grip offsets (5 mm, 3°), none on the material.
+TEST_F(CalibrateCli, TheReportGivesPriorsAndVerdicts) {
+  const auto run = run_cli({"calibrate", kCantilever.string(), "--observations",
+                            observations.string(), "--out", out, "--report", report});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json r = nlohmann::json::parse(test::read_text(report));
+  EXPECT_TRUE(r["parameters"][0]["prior"].is_null());
+  EXPECT_EQ(r["parameters"][0]["verdict"], "determined");
+  EXPECT_EQ(r["parameters"][1]["name"], "grip_offsets.left.x");
+  EXPECT_NEAR(r["parameters"][1]["prior"].get<double>(), 0.005, 1e-15);
+  EXPECT_NEAR(r["parameters"][4]["prior"].get<double>(), 3 * M_PI / 180, 1e-15);
+  EXPECT_FALSE(r["parameters"][1]["implausible"].get<bool>());
+  EXPECT_EQ(r["implausible"], nlohmann::json::array());
+  EXPECT_NE(run.err.find("(determined; prior σ 0.005 m)"), std::string::npos) << run.err;
+  // --prior changes them, --prior off removes them.
+  const auto changed =
+      run_cli({"calibrate", kCantilever.string(), "--observations", observations.string(), "--out",
+               out, "--report", report, "--prior", "grip_offsets=2mm/1deg,youngs_modulus=50%"});
+  ASSERT_EQ(changed.exit_code, 0) << changed.err;
+  const nlohmann::json c = nlohmann::json::parse(test::read_text(report));
+  EXPECT_NEAR(c["parameters"][0]["prior"].get<double>(), 0.5 * youngs_modulus_of(model.material),
+              1e-6);
+  EXPECT_NEAR(c["parameters"][1]["prior"].get<double>(), 0.002, 1e-15);
+  const auto off =
+      run_cli({"calibrate", kCantilever.string(), "--observations", observations.string(), "--out",
+               out, "--report", report, "--prior", "off"});
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  for (const auto& p : nlohmann::json::parse(test::read_text(report))["parameters"])
+    EXPECT_TRUE(p["prior"].is_null()) << p["name"];
+}
+
+TEST_F(CalibrateCli, BadPriorsAndBoundsExitOneNamingTheOptionAndTheEntry) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--prior", "object_pose.rotation=2furlongs"},
+      {"--prior", "grip_offsets=5mm"},
+      {"--prior", "stiffness=50%"},
+      {"--prior", "youngs_modulus=-5%"},
+      {"--bounds", "youngs_modulus=1e8:1e3"},
+      {"--bounds", "poisson_ratio=0.1:0.9"},
+      {"--bounds", "density=x:2000"},
+      {"--bounds", "youngs_modulus=1e6:1e8"},  // the scene's 200 kPa outside
+  };
+  for (const auto& [option, entry] : cases) {
+    const auto run = run_cli({"calibrate", kCantilever.string(), "--observations",
+                              observations.string(), "--out", out, option, entry});
+    EXPECT_EQ(run.exit_code, 1) << option << " " << entry << ": " << run.err;
+    EXPECT_NE(run.err.find(option + ": "), std::string::npos) << run.err;
+    const std::string name = entry.substr(0, entry.find('='));
+    EXPECT_NE(run.err.find(name), std::string::npos) << run.err;
+    EXPECT_FALSE(std::filesystem::exists(out)) << entry;
+  }
 }
 
 TEST_F(CalibrateCli, BadObservationsExitOneNamingTheField) {
@@ -283,6 +342,29 @@ TEST_F(CalibrateFixedCli, EveryFormOfAPathIsAccepted) {
         fs::exists(fs::path(f.report).is_absolute() ? fs::path(f.report) : f.cwd / f.report))
         << f.name;
   }
+}
+
+// Issue 35: Young's modulus held at the scene's value (the real bar 4x softer), the clamp's pose
+// fitted: it tilts to absorb the sag, and the tilt beyond 3 prior σ is flagged (exit 0).
+TEST_F(CalibrateFixedCli, APoseBeyondItsPriorIsFlaggedImplausible) {
+  Scene softer = model;
+  softer.material = material_from_youngs(youngs_modulus_of(model.material) / 4,
+                                         poisson_ratio_of(model.material), model.material.density);
+  const auto obs = dir.write("softer.json", clamped_observations(softer).dump());
+  const auto run = run_cli({"calibrate", kClamped.string(), "--observations", obs.string(), "--out",
+                            out, "--report", report, "--fit", "object_pose"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json r = nlohmann::json::parse(test::read_text(report));
+  ASSERT_FALSE(r["implausible"].empty()) << run.err;
+  const std::string name = r["implausible"][0];
+  EXPECT_NE(run.err.find("warning: " + name), std::string::npos) << run.err;
+  for (const auto& p : r["parameters"])
+    if (p["name"] == name) EXPECT_TRUE(p["implausible"].get<bool>());
+  // Without priors there is nothing to judge it by.
+  const auto off = run_cli({"calibrate", kClamped.string(), "--observations", obs.string(), "--out",
+                            out, "--report", report, "--fit", "object_pose", "--prior", "off"});
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  EXPECT_TRUE(nlohmann::json::parse(test::read_text(report))["implausible"].empty());
 }
 
 TEST_F(CalibrateFixedCli, AFrameWithJointsExitsOneNamingTheField) {

@@ -140,3 +140,24 @@ def test_a_calibration_in_a_thread_does_not_block_other_python_threads(model):
     observations = synthetic_observations(model)
     advanced = counted_during(lambda: shapectl.calibrate(model, observations, fit=["youngs_modulus"]))
     assert advanced and advanced[-1] > 0, advanced
+
+
+def test_verdicts_priors_and_bad_priors(model):
+    """Issue 35: each parameter's verdict and prior (the grips' default 5 mm / 3°), as the CLI's
+    report; prior= and bounds= take the CLI's syntax and name a bad entry."""
+    observations = synthetic_observations(model)
+    result = shapectl.calibrate(model, observations, fit="youngs_modulus,density")
+    stiffness, density = result.parameters
+    assert stiffness.verdict == "determined" and stiffness.prior is None
+    assert density.verdict == "not determined" and not density.identifiable
+    assert density.trades_off_with == ["youngs_modulus"]
+    assert "hanging weight" in density.suggestion
+    assert result.implausible == []
+    grips = shapectl.calibrate(model, observations, prior="grip_offsets=2mm/1deg")
+    assert grips.parameters[1].name.startswith("grip_offsets.") and grips.parameters[1].prior == 0.002
+    assert grips.parameters[4].prior == pytest.approx(np.radians(1))
+    assert all(not p.implausible for p in grips.parameters)
+    with pytest.raises(ValueError, match="prior: object_pose.rotation=2furlongs"):
+        shapectl.calibrate(model, observations, prior="object_pose.rotation=2furlongs")
+    with pytest.raises(ValueError, match="bounds: youngs_modulus: the scene.s value is outside"):
+        shapectl.calibrate(model, observations, bounds="youngs_modulus=1e6:1e8")

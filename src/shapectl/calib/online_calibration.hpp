@@ -61,7 +61,14 @@ struct OnlineCalibrationOptions {
   double same_pose = 0.005;  // rad (m for prismatic joints), largest joint difference
   // A fit that takes longer than max_seconds stops with what it has (not converged, not
   // applied unless it lowered the residuals): a session is never stuck "running".
-  CalibrationOptions calibration{.max_iterations = 8, .max_seconds = 30};
+  // Stricter than `shapectl calibrate`: a model handed to a running controller takes no weakly
+  // determined jump, so anything not determined at the start is held and never freed (a window
+  // of nearby poses determines E to ±25 %, and fitted it went to 0.3x of a truth 1.5x the
+  // scene's). Priors on the pose and grips as calibrate's.
+  CalibrationOptions calibration{.max_iterations = 8,
+                                 .degenerate_threshold = 0.1,
+                                 .release_chi_squared = INFINITY,
+                                 .max_seconds = 30};
   std::size_t max_drawn_points = 1000;  // of the newest cloud, for a GUI to draw
   ModelBounds bounds = {};
   // A fit whose residuals stay above this χ²/dof (RMS 10σ) does not explain its window: frames
