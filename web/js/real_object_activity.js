@@ -31,21 +31,25 @@ export class ObservationRate {
   }
 }
 
-// The panel's activity lines for a state and the measured rate.
+// The panel's activity lines for a state and the measured rate. Nothing before the first
+// observation unless the feedback is on (the line above already says "no observations yet"):
+// the panel keeps its height at 1280×800 until there is something to say.
 export function activityLines(state, rate) {
   const lines = [];
+  const a = state.authority;
   if (!state.observations) {
-    lines.push('observations: none yet (a camera program sends them, or serve --world simulates one)');
-  } else if (rate.quietSeconds !== null && rate.quietSeconds > 2) {
+    if (state.feedback) lines.push('feedback on: waiting for observations to correct the targets');
+    return lines;
+  }
+  if (rate.quietSeconds !== null && rate.quietSeconds > 2) {
     lines.push(`observations: ${state.observations}, none for ${Math.round(rate.quietSeconds)} s`);
   } else {
     const perSecond = rate.perSecond === null ? '' : ` at ${rate.perSecond.toFixed(1)}/s`;
     lines.push(`observations: arriving${perSecond} (${state.observations} so far)`);
   }
-  const a = state.authority;
   if (!state.feedback) {
     lines.push('feedback off: the robot follows the model alone');
-  } else if (!state.observations || !a) {
+  } else if (!a) {
     lines.push('feedback on: waiting for observations to correct the targets');
   } else {
     lines.push(`feedback on: targets corrected by up to ${mm(a.largest)} mm` +
