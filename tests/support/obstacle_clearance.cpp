@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include <Eigen/Geometry>
+
 #include "support/triangle_intersection.hpp"
 
 namespace shapectl::test {
