@@ -38,7 +38,7 @@ export function activityLines(state, rate) {
   const lines = [];
   const a = state.authority;
   if (!state.observations) {
-    if (state.feedback) lines.push('feedback on: waiting for observations to correct the targets');
+    if (state.feedback) lines.push('feedback on: waiting for observations of the target nodes to correct the targets');
     return lines;
   }
   if (rate.quietSeconds !== null && rate.quietSeconds > 2) {
@@ -50,7 +50,7 @@ export function activityLines(state, rate) {
   if (!state.feedback) {
     lines.push('feedback off: the robot follows the model alone');
   } else if (!a) {
-    lines.push('feedback on: waiting for observations to correct the targets');
+    lines.push('feedback on: waiting for observations of the target nodes to correct the targets');
   } else {
     lines.push(`feedback on: targets corrected by up to ${mm(a.largest)} mm` +
       ` (at most ${mm(a.max_correction)}); joints ${degrees(a.joint_offset)}° from where the loop started`);
