@@ -73,6 +73,24 @@ TEST(ObstaclesCli, AnObstacleOutOfReachGivesNoContactsAndNoDistance) {
   EXPECT_EQ(c["by_obstacle"]["obstacle 1"]["force"], nlohmann::json({0.0, 0.0, 0.0}));
 }
 
+// A peg whose position was typed in mm lands 390 m away: legal, but it can never be touched.
+TEST(ObstaclesCli, AnObstacleFarBeyondTheObjectIsWarnedAbout) {
+  TempDir dir;
+  const std::string peg = R"("obstacles": [{"name": "peg", "box": {"size": [0.02, 0.02, 0.1], )"
+                          R"("pose": {"position": [390, 0, 0]}}}])";
+  const Statics far = statics(dir, bar_with(peg));
+  ASSERT_EQ(far.run.exit_code, 0) << far.run.err;
+  EXPECT_NE(far.run.err.find("warning: "), std::string::npos) << far.run.err;
+  EXPECT_NE(far.run.err.find("obstacles[0] ('peg'): 390 m from the object"), std::string::npos)
+      << far.run.err;
+  // The same peg 0.2 m from the bar: no warning.
+  const std::string near = R"("obstacles": [{"name": "peg", "box": {"size": [0.02, 0.02, 0.1], )"
+                           R"("pose": {"position": [0.4, 0, 0]}}}])";
+  const Statics close = statics(dir, bar_with(near));
+  ASSERT_EQ(close.run.exit_code, 0) << close.run.err;
+  EXPECT_EQ(close.run.err.find("obstacles[0]"), std::string::npos) << close.run.err;
+}
+
 TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
   TempDir dir;
   dir.write("open.obj", "v 0 0 -1\nv 1 0 -1\nv 0 1 -1\nf 1 2 3\n");
@@ -119,7 +137,10 @@ TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
             "not supported yet"},
            {obstacles(plane) + R"(, "contact": {"stiffness": 0})", "contact.stiffness",
             "expected a positive number"},
-           {obstacles(plane) + R"(, "contact": {"gap": 0.1})", "contact.gap", "unknown key"}}) {
+           {obstacles(plane) + R"(, "contact": {"gap": 0.1})", "contact.gap", "unknown key"},
+           // d̂ in metres meant as mm: the barrier would act across the whole bar.
+           {obstacles(plane) + R"(, "contact": {"distance": 1})", "contact.distance",
+            "was it meant in mm?"}}) {
     const Statics s = statics(dir, bar_with(extra));
     EXPECT_EQ(s.run.exit_code, 1) << extra << "\n" << s.run.err;
     EXPECT_NE(s.run.err.find("scene.json: " + where + ": "), std::string::npos) << where << ":\n"

@@ -220,6 +220,61 @@ bool one_inside_the_other(const Obstacle& o, const std::vector<Vec3>& nodes,
 
 // The rest shape placed in the world must be clear of every obstacle: the contact barrier is
 // infinite at a gap of zero, so no solve could start there.
+// d̂ is the gap at which contact forces start; one near the object's size (a distance meant in
+// mm written as metres) makes the barrier act across the whole object and Newton fail.
+void check_contact_distance(const Scene& scene) {
+  const double size = (scene.object_mesh->bounds_max() - scene.object_mesh->bounds_min()).norm();
+  const double limit = max_contact_distance_fraction * size;
+  if (scene.contact.distance <= limit) return;
+  throw InputError(scene.source.string(), "contact.distance",
+                   "at most " + show(limit) + " m (a tenth of the object's " + show(size) +
+                       " m bounding-box diagonal); got " + show(scene.contact.distance) +
+                       " m: the barrier acts on gaps below this distance (typically 1e-3 of the "
+                       "object's size, e.g. 0.001): was it meant in mm?");
+}
+
+// Distance between the object's rest bounding box and an obstacle (0 when they overlap).
+double obstacle_distance(const Obstacle& obstacle, const Vec3& lo, const Vec3& hi) {
+  if (obstacle.plane) {
+    double nearest = INFINITY;
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 p((corner & 1) ? hi.x() : lo.x(), (corner & 2) ? hi.y() : lo.y(),
+                   (corner & 4) ? hi.z() : lo.z());
+      nearest =
+          std::min(nearest, std::abs((p - obstacle.plane->point).dot(obstacle.plane->normal)));
+    }
+    return nearest;
+  }
+  Vec3 olo = Vec3::Constant(INFINITY), ohi = Vec3::Constant(-INFINITY);
+  for (const Vec3& p : obstacle.points) {
+    olo = olo.cwiseMin(p);
+    ohi = ohi.cwiseMax(p);
+  }
+  const Vec3 gap = (olo - hi).cwiseMax(lo - ohi).cwiseMax(0.0);
+  return std::max(0.0, gap.norm() - obstacle.radius);
+}
+
+// An obstacle far beyond anything the object could reach is nearly always given in mm or cm.
+void warn_distant_obstacles(const Scene& scene, std::vector<std::string>& warnings) {
+  const Positions x = scene.world_rest_positions();
+  Vec3 lo = Vec3::Constant(INFINITY), hi = Vec3::Constant(-INFINITY);
+  for (Eigen::Index i = 0; i < x.size() / 3; ++i) {
+    lo = lo.cwiseMin(x.segment<3>(3 * i));
+    hi = hi.cwiseMax(x.segment<3>(3 * i));
+  }
+  double reach = (hi - lo).norm();
+  if (scene.robot) reach += robot_extent(*scene.robot);
+  const double limit = std::max(distant_obstacle_floor, distant_obstacle_factor * reach);
+  for (std::size_t k = 0; k < scene.obstacles.size(); ++k) {
+    const double d = obstacle_distance(scene.obstacles[k], lo, hi);
+    if (d > limit)
+      warnings.push_back(scene.source.string() + ": obstacles[" + std::to_string(k) + "] ('" +
+                         scene.obstacles[k].name + "'): " + show(d) +
+                         " m from the object, which can never reach it (limit " + show(limit) +
+                         " m); scene lengths are metres: were its coordinates given in mm?");
+  }
+}
+
 void check_obstacle_gaps(const Scene& scene) {
   if (scene.obstacles.empty()) return;
   const ObstacleContact contact(*scene.object_mesh, scene.obstacles, scene.contact.distance, 1.0);
@@ -332,7 +387,9 @@ std::vector<std::string> check_scene(const Scene& scene) {
   std::vector<std::string> warnings;
   check_object_size(scene);
   if (const std::string w = tet_count_warning(scene); !w.empty()) warnings.push_back(w);
+  check_contact_distance(scene);
   check_obstacle_gaps(scene);
+  warn_distant_obstacles(scene, warnings);
   if (scene.robot) {
     check_joint_limits(scene, warnings);
     check_collisions(scene, warnings);

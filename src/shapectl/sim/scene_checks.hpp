@@ -22,6 +22,12 @@ inline constexpr int grip_warning_node_count = 3;
 // the reference joints (at least 1 m) — the robot could not hold it.
 inline constexpr double max_object_extent = 10.0;
 inline constexpr double object_reach_factor = 10.0;
+// contact.distance (d̂) above this fraction of the object's bounding-box diagonal is refused.
+inline constexpr double max_contact_distance_fraction = 0.1;
+// An obstacle farther from the object's rest box than distant_obstacle_factor × (the object's
+// diagonal + the robot's span), and at least distant_obstacle_floor m, gets a warning.
+inline constexpr double distant_obstacle_factor = 3.0;
+inline constexpr double distant_obstacle_floor = 2.0;
 // Tet count above which the time per target change is worth a warning.
 inline constexpr int tet_warning_count = 5000;
 
