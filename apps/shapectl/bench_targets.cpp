@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <shapectl/contact/obstacle_contact.hpp>
+
 namespace shapectl::cli {
 
 double seconds_between(BenchClock::time_point a, BenchClock::time_point b) {
@@ -16,12 +18,16 @@ double percentile(std::vector<double> v, double p) {
 }
 
 bool random_goal(const ReducedObjective& objective, const Evaluation& reference, std::mt19937& rng,
-                 ShapeTargets& targets) {
-  std::uniform_real_distribution<double> u(-0.15, 0.15);
+                 ShapeTargets& targets, double amplitude, int min_contacts) {
+  std::uniform_real_distribution<double> u(-amplitude, amplitude);
   Eigen::VectorXd theta = reference.joints();
   for (int j = 0; j < theta.size(); ++j) theta[j] += u(rng);
   const Evaluation goal = objective.evaluate(theta, reference.positions());
   if (!goal.safe()) return false;
+  if (min_contacts > 0) {
+    const ObstacleContact* contact = objective.object().statics().contact();
+    if (!contact || contact->summary(goal.positions()).count < min_contacts) return false;
+  }
   const int n = static_cast<int>(goal.positions().size() / 3);
   std::vector<int> nodes(n);
   for (int i = 0; i < n; ++i) nodes[i] = i;
@@ -36,7 +42,7 @@ bool random_goal(const ReducedObjective& objective, const Evaluation& reference,
 
 std::optional<std::pair<double, int>> steps_to_1mm(const ReducedObjective& goal,
                                                    const Evaluation& reference, OptimizerKind kind,
-                                                   double max_seconds) {
+                                                   double max_seconds, Evaluation* end) {
   Evaluation current = reference;
   goal.rescore(current);
   auto optimizer = make_optimizer(kind, GradientMethod::Sensitivity);
@@ -47,8 +53,11 @@ std::optional<std::pair<double, int>> steps_to_1mm(const ReducedObjective& goal,
     if (optimizer->step(goal, current) != StepOutcome::Improved) break;
     ++it;
   }
-  if (current.error.mean >= 1e-3) return std::nullopt;
-  return std::pair{seconds_between(t0, BenchClock::now()), it};
+  const double seconds = seconds_between(t0, BenchClock::now());
+  const bool reached = current.error.mean < 1e-3;
+  if (end) *end = std::move(current);
+  if (!reached) return std::nullopt;
+  return std::pair{seconds, it};
 }
 
 }  // namespace shapectl::cli

@@ -4,7 +4,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -147,6 +149,56 @@ TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
                                                                                 << s.run.err;
     EXPECT_NE(s.run.err.find(what), std::string::npos) << what << ":\n" << s.run.err;
   }
+}
+
+// The bundled peg scene's purpose: bend the bar around the peg. Centre-line targets make a
+// parabola whose vertex rests against the peg's near face and whose ends pass its far face;
+// the solve reaches it with the peg pushing back and no node inside the peg.
+TEST(ObstaclesCli, TheBarWrapsThePeg) {
+  TempDir dir;
+  const auto scene = dir.write("peg.json", test::bundled_scene_text("yumi_bar_peg.json"));
+  const auto rest_out = dir.path() / "rest.json";
+  ASSERT_EQ(run_cli({"statics", scene.string(), "--out", rest_out.string()}).exit_code, 0);
+  const auto rest = nlohmann::json::parse(test::read_text(rest_out));
+  // The scene: bar centre at x = 0.39047, z = 0.25527, along y (±0.16 m), 3 cm thick; the peg
+  // a 2 × 2 cm box at x = 0.42047 (faces at 0.41047 and 0.43047), |y| ≤ 0.01.
+  const double centre_x = 0.39047, centre_z = 0.25527, near_face = 0.41047, far_face = 0.43047;
+  const double vertex_x = near_face - 0.015 - 0.0003, depth = 0.04;  // the gap at rest ~ d̂/2
+  nlohmann::json line = nlohmann::json::array();
+  std::vector<std::array<double, 3>> axis;
+  for (const auto& p : rest["positions"])
+    if (std::abs(p[0].get<double>() - centre_x) < 1e-3 &&
+        std::abs(p[2].get<double>() - centre_z) < 1e-3)
+      axis.push_back({p[0].get<double>(), p[1].get<double>(), p[2].get<double>()});
+  ASSERT_EQ(axis.size(), 17u);  // 16 cells along the bar
+  std::sort(axis.begin(), axis.end(), [](const auto& a, const auto& b) { return a[1] < b[1]; });
+  for (const auto& p : axis)
+    line.push_back({vertex_x + depth * std::pow(p[1] / 0.16, 2), p[1], p[2]});
+  const auto targets = dir.write("wrap.json", nlohmann::json{{"centerline", line}}.dump());
+  const auto out = dir.path() / "solve.json";
+  const auto run =
+      run_cli({"solve", scene.string(), "--targets", targets.string(), "--out", out.string()});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const auto result = nlohmann::json::parse(test::read_text(out));
+  EXPECT_LT(result["error_mean"].get<double>(), 1e-3) << run.err;
+  const nlohmann::json& peg = result["contacts"]["by_obstacle"]["peg"];
+  EXPECT_GE(peg["count"].get<int>(), 10);
+  EXPECT_LT(peg["force"][0].get<double>(), -0.5);  // the peg pushes the bar back, newtons
+  double ends_x = 0, middle_x = -INFINITY;         // the end faces' mean x; the middle's front
+  int end_nodes = 0;
+  for (std::size_t i = 0; i < result["positions"].size(); ++i) {
+    const auto& p = result["positions"][i];
+    const double x = p[0].get<double>(), y = p[1].get<double>(), z = p[2].get<double>();
+    const double rest_y = rest["positions"][i][1].get<double>();
+    const bool inside_peg =
+        x > near_face && x < far_face && std::abs(y) < 0.01 && std::abs(z - centre_z) < 0.05;
+    EXPECT_FALSE(inside_peg) << x << " " << y << " " << z;
+    if (std::abs(rest_y) > 0.155) ends_x += x, ++end_nodes;
+    if (std::abs(rest_y) < 0.01) middle_x = std::max(middle_x, x);
+  }
+  ASSERT_GT(end_nodes, 0);
+  EXPECT_GT(ends_x / end_nodes, far_face);  // the ends past the peg...
+  EXPECT_LT(middle_x, near_face);           // ...the middle in front of it: wrapped
 }
 
 TEST(ObstaclesCli, TheBundledPegSceneSolvesClearOfThePeg) {
