@@ -37,6 +37,7 @@
 #include <shapectl/scene_io/scene_file.hpp>
 
 #include "commands.hpp"
+#include "grasp_axes.hpp"
 #include "output_option.hpp"
 #include "robot_mesh_options.hpp"
 
@@ -65,6 +66,9 @@ struct AuthorOptions {
   std::string units;                     // of --mesh: "m", "cm" or "mm"; empty: metres
   std::string active_joints;             // NAME,...: exactly these; empty: those that move a tool
   std::optional<double> finger_opening;  // value of the joints that move no tool
+  std::vector<std::string> approaches;   // NAME=X,Y,Z: world approach direction (grasp_axes.hpp)
+  std::vector<std::string> grip_axes;    // NAME=X,Y,Z: world closing direction
+  std::vector<std::string> tool_axes;    // NAME=A,C: the tool's approach and closing axes
   double sphere_margin = 0.005;
   unsigned seed = 1;
   std::string out;
@@ -143,6 +147,61 @@ std::vector<EndEffector> read_end_effectors(const AuthorOptions& o, const RobotM
                        bounded_preview(name));
   }
   return ees;
+}
+
+// The index of end effector `name` in `ees`; `option` names the option in errors.
+std::size_t end_effector_index(const std::vector<EndEffector>& ees, const std::string& name,
+                               const std::string& option) {
+  for (std::size_t e = 0; e < ees.size(); ++e)
+    if (ees[e].name == name) return e;
+  throw InputError("command line", option, "the name of one of --end-effectors",
+                   bounded_preview(name));
+}
+
+// "x", "-y", "+z" → a unit axis.
+Vec3 axis_named(const std::string& text, const std::string& option, const std::string& expected) {
+  const bool negative = !text.empty() && text[0] == '-';
+  const std::string axis =
+      (!text.empty() && (text[0] == '-' || text[0] == '+')) ? text.substr(1) : text;
+  if (axis.size() != 1 || axis[0] < 'x' || axis[0] > 'z')
+    throw InputError("command line", option, expected, bounded_preview(text));
+  const Vec3 unit = Vec3::Unit(axis[0] - 'x');
+  return negative ? Vec3(-unit) : unit;
+}
+
+// --approach, --grip-axis and --tool-axes, one GraspAxes per end effector.
+std::vector<GraspAxes> read_grasp_axes(const AuthorOptions& o,
+                                       const std::vector<EndEffector>& ees) {
+  std::vector<GraspAxes> axes(ees.size());
+  for (auto [list, option, field] :
+       {std::tuple{&o.approaches, "--approach", &GraspAxes::approach_world},
+        std::tuple{&o.grip_axes, "--grip-axis", &GraspAxes::closing_world}}) {
+    const std::string expected = std::string("NAME=X,Y,Z: a non-zero world direction");
+    for (const auto& text : *list) {
+      const auto [name, value] = named(text, option, expected);
+      const auto xyz = numbers(value, option, expected, {3});
+      const Vec3 direction(xyz[0], xyz[1], xyz[2]);
+      if (!(direction.norm() > 1e-9))
+        throw InputError("command line", option, expected, bounded_preview(text));
+      axes[end_effector_index(ees, name, option)].*field = direction.normalized();
+    }
+  }
+  const std::string expected =
+      "NAME=A,C: the tool's approach and closing axes in its link frame, each x, y or z with an "
+      "optional sign (e.g. z,x)";
+  for (const auto& text : o.tool_axes) {
+    const auto [name, value] = named(text, "--tool-axes", expected);
+    const auto comma = value.find(',');
+    if (comma == std::string::npos)
+      throw InputError("command line", "--tool-axes", expected, bounded_preview(text));
+    GraspAxes& a = axes[end_effector_index(ees, name, "--tool-axes")];
+    a.approach_link = axis_named(value.substr(0, comma), "--tool-axes", expected);
+    a.closing_link = axis_named(value.substr(comma + 1), "--tool-axes", expected);
+    if (std::abs(a.approach_link.dot(*a.closing_link)) > 0.5)
+      throw InputError("command line", "--tool-axes", expected + ", two different axes",
+                       bounded_preview(text));
+  }
+  return axes;
 }
 
 struct ObjectMesh {
@@ -513,6 +572,7 @@ void run(const AuthorOptions& o) {
     if (w.find("collision meshes ignored") == std::string::npos) warnings.push_back(w);
   check_meshes_found(o, model);
   const std::vector<EndEffector> ees = read_end_effectors(o, model);
+  const std::vector<GraspAxes> grasp_axes = read_grasp_axes(o, ees);
   const std::map<std::string, double> fixed_joints = choose_active_joints(o, ees, model);
   const ObjectMesh object = read_object_mesh(o, scene_dir);
   const Spheres spheres = generate_spheres(o, model, warnings);
@@ -546,10 +606,13 @@ void run(const AuthorOptions& o) {
 
   std::vector<IkGoal> goals;
   for (std::size_t e = 0; e < ees.size(); ++e) {
-    IkGoal goal;  // position only
+    IkGoal goal;  // position, and the orientation asked for
     goal.link = ees[e].link;
     goal.point_link = ees[e].tcp_link;
     goal.position_world = grips[e].centre_world;
+    orient_goal(grasp_axes[e], model,
+                start_state.T_world_link[static_cast<std::size_t>(ees[e].link)].linear(),
+                o.approaches.empty() ? "--grip-axis" : "--approach", goal);
     goals.push_back(goal);
   }
   IkOptions ik_options{.collisions = &collision,
@@ -574,11 +637,19 @@ void run(const AuthorOptions& o) {
     if (!(distance <= tool_tolerance))
       throw SolverFailure("tool '" + ees[e].name + "' ends " + std::to_string(distance) +
                           " m from its grip region");
+    const Eigen::Matrix3d R =
+        reference.T_world_link[static_cast<std::size_t>(ees[e].link)].linear();
+    const GraspAxes& axes = grasp_axes[e];
+    const Vec3 closing_link = axes.closing_link
+                                  ? *axes.closing_link
+                                  : finger_axis(model, ees[e].link).value_or(Vec3(Vec3::UnitY()));
     grip_report.push_back({{"end_effector", ees[e].name},
                            {"link", model.links()[static_cast<std::size_t>(ees[e].link)].name},
                            {"node_count", grips[e].nodes.size()},
                            {"region_centre", vec3_json(grips[e].centre_world)},
-                           {"tool_distance", distance}});
+                           {"tool_distance", distance},
+                           {"approach_axis", vec3_json(R * axes.approach_link)},
+                           {"closing_axis", vec3_json(R * closing_link)}});
   }
   if (!violations.empty() || !(clearance > 0))
     throw SolverFailure("inverse kinematics returned joints outside their limits or in collision");
@@ -728,6 +799,15 @@ void add_author_command(CLI::App& app) {
   c->add_option("--finger-opening", o->finger_opening,
                 "Value (m or rad) of the joints that move no tool, e.g. gripper fingers "
                 "(default: nearest 0 within their limits)");
+  c->add_option("--approach", o->approaches,
+                "NAME=X,Y,Z: world direction the tool approaches the object along (its approach "
+                "axis, see --tool-axes, points this way), e.g. left=0,0,-1 from above; repeatable");
+  c->add_option("--grip-axis", o->grip_axes,
+                "NAME=X,Y,Z: world direction the fingers close along (e.g. across the object's "
+                "thin side); with --approach the grasp is fully set; repeatable");
+  c->add_option("--tool-axes", o->tool_axes,
+                "NAME=A,C: the tool's approach and closing axes in its link frame, e.g. z,x "
+                "(default: z, and the fingers' joint axis, else y); repeatable");
   c->add_option("--sphere-margin", o->sphere_margin,
                 "Collision margin written to the sphere file (m)")
       ->capture_default_str();

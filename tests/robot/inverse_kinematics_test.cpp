@@ -78,6 +78,58 @@ TEST(InverseKinematics, JacobianMatchesCentralDifferences) {
   }
 }
 
+// Goals that FK at `q` meets, each tool's point and one axis of its frame (5-DOF goals).
+std::vector<IkGoal> axis_goals_at(const RobotModel& model, const Eigen::VectorXd& q) {
+  std::vector<IkGoal> goals = goals_at(model, q, false);
+  const KinematicsState s = forward_kinematics(model, q);
+  for (IkGoal& g : goals) {
+    g.axis_link = Vec3(1, 2, -1).normalized();
+    g.axis_world = s.T_world_link[g.link].linear() * *g.axis_link;
+  }
+  return goals;
+}
+
+TEST(InverseKinematics, AxisGoalJacobianMatchesCentralDifferences) {
+  const RobotModel model = two_arms();
+  std::mt19937 rng(43);
+  for (int trial = 0; trial < 5; ++trial) {
+    auto goals = axis_goals_at(model, random_joints(model, 0.1, rng));
+    goals[1].axis_world = Eigen::AngleAxisd(0.5, Vec3::UnitY()) * goals[1].axis_world;
+    const Eigen::VectorXd q = random_joints(model, 0.1, rng);
+    Eigen::VectorXd r;
+    Eigen::MatrixXd J;
+    ik_residuals(model, goals, {}, q, r, &J);
+    ASSERT_EQ(J.rows(), 12);
+    const auto residuals = [&](const Eigen::VectorXd& joints) -> Eigen::VectorXd {
+      Eigen::VectorXd residual;
+      ik_residuals(model, goals, {}, joints, residual);
+      return residual;
+    };
+    EXPECT_TRUE(test::derivative_matches(J, test::central_difference_jacobian(residuals, q, 1e-6),
+                                         1e-6, "IK axis residual Jacobian"))
+        << "trial " << trial;
+  }
+}
+
+TEST(InverseKinematics, ReachesAxisGoalsTakenFromOtherJoints) {
+  const RobotModel model = two_arms();
+  std::mt19937 rng(3);
+  for (int trial = 0; trial < 5; ++trial) {
+    const auto goals = axis_goals_at(model, random_joints(model, 0.2, rng));
+    const IkResult result = solve_inverse_kinematics(model, goals, Eigen::VectorXd::Zero(6));
+    EXPECT_EQ(result.status, IkStatus::Converged) << result.reason;
+    EXPECT_LE(result.orientation_error, 1e-3);
+    const KinematicsState s = forward_kinematics(model, result.joints);
+    for (const auto& g : goals)
+      EXPECT_GT((s.T_world_link[g.link].linear() * *g.axis_link).dot(g.axis_world), std::cos(1e-3));
+  }
+  // A non-unit axis is invalid input, not a silent rescale.
+  auto goals = axis_goals_at(model, Eigen::VectorXd::Zero(6));
+  goals[0].axis_world *= 2;
+  EXPECT_EQ(solve_inverse_kinematics(model, goals, Eigen::VectorXd::Zero(6)).status,
+            IkStatus::InvalidInput);
+}
+
 TEST(InverseKinematics, ReachesPositionGoalsTakenFromOtherJoints) {
   const RobotModel model = two_arms();
   std::mt19937 rng(1);

@@ -50,6 +50,9 @@ Eigen::VectorXd clamp(const Eigen::VectorXd& q, const Bounds& b) {
   return q.cwiseMax(b.lower).cwiseMin(b.upper);
 }
 
+// Angle between two unit vectors, accurate near 0 and π.
+double axis_angle(const Vec3& a, const Vec3& b) { return std::atan2(a.cross(b).norm(), a.dot(b)); }
+
 struct Errors {
   double position = 0;
   double orientation = 0;
@@ -67,6 +70,8 @@ Errors goal_errors(const RobotModel& model, const std::vector<IkGoal>& goals,
       e.orientation =
           std::max(e.orientation,
                    Eigen::AngleAxisd(T.linear() * g.rotation_world->transpose()).angle());
+    else if (g.axis_link)
+      e.orientation = std::max(e.orientation, axis_angle(T.linear() * *g.axis_link, g.axis_world));
   }
   if (options.collisions) e.clearance = options.collisions->min_clearance(state);
   return e;
@@ -131,7 +136,7 @@ void ik_residuals(const RobotModel& model, const std::vector<IkGoal>& goals,
                   Eigen::VectorXd& residuals, Eigen::MatrixXd* jacobian) {
   const int n = model.active_count();
   int rows = 0;
-  for (const auto& g : goals) rows += g.rotation_world ? 12 : 3;
+  for (const auto& g : goals) rows += g.rotation_world ? 12 : g.axis_link ? 6 : 3;
   const int collision_rows = options.collisions ? options.collisions->pair_count() : 0;
   residuals.resize(rows + collision_rows);
   if (jacobian) jacobian->setZero(rows + collision_rows, n);
@@ -143,6 +148,21 @@ void ik_residuals(const RobotModel& model, const std::vector<IkGoal>& goals,
     residuals.segment<3>(row) = p - g.position_world;
     if (jacobian) point_jacobian_world(model, state, g.link, p, jacobian->block(row, 0, 3, n));
     row += 3;
+    if (!g.rotation_world && g.axis_link) {
+      // w (R a − a*); d(R a)/dθ_j = ω_j × (R a) for a revolute joint with world axis ω_j.
+      const Vec3 axis = T.linear() * *g.axis_link;
+      residuals.segment<3>(row) = g.orientation_weight * (axis - g.axis_world);
+      if (jacobian)
+        for (const auto& entry : model.jacobian_entries(g.link)) {
+          const Joint& joint = model.joints()[static_cast<std::size_t>(entry.joint)];
+          if (joint.type == JointType::Prismatic) continue;
+          jacobian->block(row, entry.column, 3, 1) +=
+              g.orientation_weight * entry.scale *
+              state.joint_axes_world[static_cast<std::size_t>(entry.joint)].cross(axis);
+        }
+      row += 3;
+      continue;
+    }
     if (!g.rotation_world) continue;
     // w (R − R*), column-major; dR/dθ_j = [ω_j]× R for a revolute joint with world axis ω_j.
     const Eigen::Matrix3d R = T.linear();
@@ -183,6 +203,10 @@ IkResult solve_inverse_kinematics(const RobotModel& model, const std::vector<IkG
     if (goals[k].link < 0 || goals[k].link >= model.link_count() ||
         !goals[k].position_world.allFinite() || !goals[k].point_link.allFinite()) {
       result.reason = "goal " + std::to_string(k) + ": unknown link or non-finite point";
+      return result;
+    } else if (goals[k].axis_link && !(std::abs(goals[k].axis_link->norm() - 1) < 1e-9 &&
+                                       std::abs(goals[k].axis_world.norm() - 1) < 1e-9)) {
+      result.reason = "goal " + std::to_string(k) + ": an axis that is not a unit vector";
       return result;
     }
   const Bounds bounds = inner_bounds(model, options.joint_limit_margin);

@@ -3,6 +3,7 @@
 // frames at goal orientations), within joint limits and clear of self-collision.
 // Damped least squares (Levenberg–Marquardt) on
 //   ½ Σ_goals |p(θ) − p*|² + ½ w_R² |R(θ) − R*|²_F + collision_weight · (sphere barrier),
+// or, for an axis goal, ½ w_R² |R(θ) a − a*|² in place of the rotation term,
 // every step clamped to the joint limits moved inwards by `joint_limit_margin`. Deterministic:
 // restarts from seeded random joints (std::mt19937) when the start does not converge.
 #include <optional>
@@ -22,6 +23,11 @@ struct IkGoal {
   Vec3 position_world = Vec3::Zero();  // where the tool point should be, metres
   // Wanted orientation of the link frame (world), or none for a position-only goal.
   std::optional<Eigen::Matrix3d> rotation_world = std::nullopt;
+  // Or one axis only (a 5-DOF goal: free to turn about it): the unit link-frame axis
+  // `axis_link` should point along the unit world direction `axis_world` (e.g. a gripper's
+  // approach axis straight down). Ignored when rotation_world is set.
+  std::optional<Vec3> axis_link = std::nullopt;
+  Vec3 axis_world = Vec3::UnitZ();
   double orientation_weight = 0.1;  // metres per unit of |R − R*|_F: trades rotation for position
 };
 
@@ -45,7 +51,7 @@ struct IkResult {
   std::string reason;            // "goal 1 is 0.12 m away after 9 starts", ...
   Eigen::VectorXd joints;        // the best θ found (active joints); always within the limits
   double position_error = 0;     // m, largest over goals
-  double orientation_error = 0;  // rad, largest over goals with an orientation
+  double orientation_error = 0;  // rad, largest over goals with an orientation or an axis
   double min_clearance = 0;      // m, +inf without collision model or pairs
   int iterations = 0;            // over all starts
   int starts = 0;                // starts tried (1 + restarts used)
