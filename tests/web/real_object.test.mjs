@@ -147,6 +147,9 @@ describe('the real object: plot and calibration (serve --world)', () => {
     const cells = await row.locator('td').allTextContents();
     assert.equal(cells[0], "Young's modulus");
     assert.equal(cells[3], 'kPa');
+    // The verdict (docs/calibration.md): Young's modulus alone, seen by 30 µm markers: determined.
+    assert.equal(cells[4], 'determined');
+    assert.match(await row.getAttribute('title'), /^Young's modulus: determined/);
     const [fitted, deviation] = cells[2].split('±').map(Number);
     assert.ok(deviation > 0 && deviation < 0.2 * fitted, `fitted ${cells[2]} kPa`);
     assert.ok(Math.abs(fitted - 300) < Math.abs(fitted - 200), `E ${fitted} kPa: nearer the world's 300 than the model's 200`);

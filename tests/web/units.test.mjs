@@ -4,7 +4,7 @@ import { describe, it } from 'node:test';
 import assert from 'node:assert/strict';
 import { formatValue, formatWithDeviation, shownUnit } from '../../web/js/units.js';
 import { Unit } from '../../web/js/protocol.js';
-import { heldExplanation } from '../../web/js/calibration_panel.js';
+import { heldExplanation, verdictOf } from '../../web/js/calibration_panel.js';
 
 describe('readable units', () => {
   it('shows each SI unit of a calibration parameter in its readable unit', () => {
@@ -30,5 +30,21 @@ describe('readable units', () => {
       'the observations leave it undetermined: ± 0.62 × its typical size (identifiable below 0.1)');
     // The server sends an infinite deviation as null: no exception, a sentence.
     assert.equal(heldExplanation(null), 'the observations do not constrain it at all');
+  });
+
+  it('gives each fitted parameter its verdict, prior, trade-off and suggestion', () => {
+    const weak = verdictOf({ name: 'youngs_modulus', unit: 'Pa', verdict: 'weakly determined', prior: null,
+      implausible: false, trades_off_with: ['density'], suggestion: 'add a frame with a known load' });
+    assert.equal(weak.short, 'weak');
+    assert.equal(weak.className, 'muted');
+    assert.equal(weak.explanation, "Young's modulus: weakly determined\ntrades off with density\nadd a frame with a known load");
+    const tilted = verdictOf({ name: 'object_pose.rotation.x', unit: 'rad', verdict: 'determined', prior: 0.0349,
+      implausible: true, trades_off_with: [], suggestion: '' });
+    assert.equal(tilted.short, 'determined, implausible');
+    assert.equal(tilted.className, 'warning');
+    assert.match(tilted.explanation, /prior: ± 0\.035 rad around its start\nimplausible: more than 3 prior σ/);
+    // From a server that sends no verdict yet: held is not determined, fitted is determined.
+    assert.equal(verdictOf({ name: 'density', unit: 'kg/m^3', held: true }).short, 'held');
+    assert.equal(verdictOf({ name: 'density', unit: 'kg/m^3', held: false }).short, 'determined');
   });
 });

@@ -25,6 +25,21 @@ export function heldExplanation(deviation) {
   return `the observations leave it undetermined: ± ${deviation.toPrecision(2)} × its typical size (identifiable below 0.1)`;
 }
 
+// The verdict cell of a fitted parameter (docs/calibration.md, "Verdicts"): a short word, its
+// style, and the row's hover text: the interval, the prior, what it trades off with and what
+// would determine it.
+export function verdictOf(p) {
+  const verdict = p.verdict ?? (p.held ? 'not determined' : 'determined');
+  const short = { determined: 'determined', 'weakly determined': 'weak', 'not determined': 'held' }[verdict] ?? verdict;
+  const lines = [`${parameterLabel(p.name)}: ${verdict}`];
+  if (p.prior !== null && p.prior !== undefined) lines.push(`prior: ± ${p.prior.toPrecision(2)} ${p.unit} around its start`);
+  if (p.implausible) lines.push('implausible: more than 3 prior σ from its start (a model error it absorbs?)');
+  if (p.trades_off_with?.length) lines.push(`trades off with ${p.trades_off_with.join(', ')}`);
+  if (p.suggestion) lines.push(p.suggestion);
+  const className = p.implausible ? 'warning' : verdict === 'determined' ? '' : 'muted';
+  return { short: p.implausible ? `${short}, implausible` : short, className, explanation: lines.join('\n') };
+}
+
 const mm = (m) => (Number.isFinite(m) ? (1000 * m).toFixed(2) : '–');
 
 // Writes only changes: states arrive 30 times a second.
@@ -114,7 +129,7 @@ export class CalibrationPanel {
       const decimals = decimalsFor(p.fitted * scale, p.held ? NaN : p.standard_deviation * scale);
       row.append(cell(parameterLabel(p.name)), cell(formatValue(p.initial, p.unit, decimals), 'number'));
       if (p.held) {
-        const held = cell('held (not identifiable)', 'muted');
+        const held = cell('held (not determined)', 'muted');
         // That deviation is in units of the parameter's typical size (docs/calibration.md).
         if (unidentified.has(p.name)) held.title = heldExplanation(unidentified.get(p.name));
         row.append(held);
@@ -122,6 +137,10 @@ export class CalibrationPanel {
         row.append(cell(formatWithDeviation(p.fitted, p.standard_deviation, p.unit), 'number'));
       }
       row.append(cell(symbol, 'unit'));
+      const v = verdictOf(p);
+      row.append(cell(v.short, v.className));
+      row.dataset.verdict = p.verdict ?? (p.held ? 'not determined' : 'determined');
+      row.title = v.explanation;
       body.append(row);
     }
     const notes = result.reason && (!result.converged || !result.applied) ? ` (${result.reason})` : '';

@@ -68,7 +68,12 @@ nlohmann::json calibration_json(const OnlineCalibrationStatus& c) {
                             {"initial", finite_or_null(p.initial)},
                             {"fitted", finite_or_null(p.fitted)},
                             {"standard_deviation", finite_or_null(p.standard_deviation)},
-                            {"held", p.held}});
+                            {"held", p.held},
+                            {"verdict", to_string(p.verdict)},
+                            {"prior", p.prior > 0 ? finite_or_null(p.prior) : nullptr},
+                            {"implausible", p.implausible},
+                            {"trades_off_with", p.trades_off_with},
+                            {"suggestion", p.suggestion}});
     nlohmann::json unidentified = nlohmann::json::array();
     for (const UnidentifiedDirection& d : r->unidentified)
       unidentified.push_back(
