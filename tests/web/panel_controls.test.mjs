@@ -226,8 +226,8 @@ describe('panel controls', () => {
     await setPaused(page, false);
     await page.keyboard.press('f');  // the front view: a handle dragged up on the screen goes up
     const target = await clickCentroid(page);  // where its node is: reached at once
-    // Optimizing while its handle is dragged 150 px up (out of reach): a number. Sampled at
-    // every frame, as drawn.
+    // Optimizing while its handle is dragged up on the screen to where a point 0.2 m above it is
+    // drawn (out of reach): a number. Sampled at every frame, as drawn.
     await hooks(page, () => {
       window.rateSamples = [];
       const tick = () => {
@@ -238,9 +238,10 @@ describe('panel controls', () => {
       tick();
     });
     const from = await hooks(page, (p) => window.shapectl.worldToPage(p), target.position);
+    const to = await hooks(page, (p) => window.shapectl.worldToPage([p[0], p[1], p[2] + 0.2]), target.position);
     await page.mouse.move(from.x, from.y);
     await page.mouse.down();
-    await page.mouse.move(from.x, from.y - 150, { steps: 25 });
+    await page.mouse.move(from.x, to.y, { steps: 25 });
     await page.mouse.up();
     await waitFor(() => hooks(page, () => window.rateSamples.some(([status, rate]) => status === 'optimizing' && /^\d+$/.test(rate))),
       'a rate while optimizing').catch(async (e) => {

@@ -45,6 +45,9 @@ describe('robot visuals in the 3D view', () => {
   });
 
   it('draws each visual in its URDF material colour', async () => {
+    // Solid links: a link hiding the object would be drawn see-through (occlusion.js).
+    await page.click('#see-through-arms');
+    await waitFor(() => hooks(page, () => window.shapectl.ready), 'the page to draw solid links');
     const expected = urdfVisualColors(path.join(sourceDir, 'data/robots/yumi/yumi.urdf'));
     const drawn = await hooks(page, () => window.shapectl.robotColors());
     let coloured = 0;

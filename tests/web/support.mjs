@@ -16,9 +16,11 @@ export async function loadPlaywright() {
   return import(path.join(sourceDir, 'web/node_modules/playwright-core/index.mjs'));
 }
 
-// Starts the server on port 0 and resolves once it printed its URL.
+// Starts the server on port 0 and resolves once it printed its URL. It serves sourceDir's web/,
+// whatever its own default: a CLI built elsewhere then serves the pages under test.
 export function startServer(args = []) {
-  const proc = spawn(cli, ['serve', ...args, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
+  const web = args.includes('--web-root') ? [] : ['--web-root', path.join(sourceDir, 'web')];
+  const proc = spawn(cli, ['serve', ...web, ...args, '--port', '0'], { stdio: ['ignore', 'pipe', 'pipe'] });
   let log = '';
   proc.stderr.on('data', (d) => { log += d; });
   return new Promise((resolve, reject) => {

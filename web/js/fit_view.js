@@ -25,9 +25,22 @@ export function fitCamera(camera, orbit, centre, direction, forEachPoint) {
     distance = Math.max(distance,
       Math.abs(_offset.dot(_right)) / tanHorizontal - ahead, Math.abs(_offset.dot(_up)) / tanVertical - ahead);
   });
-  distance *= MARGIN;
+  place(camera, orbit, centre, direction, distance * MARGIN);
+}
+
+// The camera looks at a sphere from `direction` (as above), just far enough back that all of it is
+// inside the narrower of the view's angles, with the same margin: the sphere fills the view.
+export function fitSphere(camera, orbit, centre, radius, direction) {
+  const tanVertical = Math.tan(MathUtils.degToRad(camera.fov) / 2);
+  const halfAngle = Math.atan(Math.min(tanVertical, tanVertical * camera.aspect));
+  place(camera, orbit, centre, direction, MARGIN * radius / Math.sin(halfAngle));
+}
+
+// The camera `distance` from `centre` towards `direction`, looking at it, orbiting about it.
+function place(camera, orbit, centre, direction, distance) {
+  _offset.copy(direction).normalize();
   orbit.target.copy(centre);
-  camera.position.copy(centre).addScaledVector(_forward, -distance);
+  camera.position.copy(centre).addScaledVector(_offset, distance);
   camera.near = Math.max(0.001, distance / 1000);
   camera.far = Math.max(50, 4 * distance);
   camera.updateProjectionMatrix();

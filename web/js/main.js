@@ -232,6 +232,7 @@ $('face-bar').onclick = () => { if (page.scene?.bar) view.faceBar(page.scene.bar
 $('show-wireframe').onchange = (e) => view.setWireframe(e.target.checked);
 $('show-spheres').onchange = (e) => view.setSpheresVisible(e.target.checked);
 $('show-robot').onchange = (e) => view.setRobotVisible(e.target.checked);
+$('see-through-arms').onchange = (e) => view.setSeeThroughArms(e.target.checked);
 $('show-points').onchange = (e) => view.setObservedPointsVisible(e.target.checked);
 $('show-contacts').onchange = (e) => view.setContactsVisible(e.target.checked);
 $('scene-select').onchange = (e) => command(Command.LoadScene, { scene: e.target.value });
@@ -243,7 +244,7 @@ window.addEventListener('keydown', (e) => {
   if (e.key === 'Delete' || e.key === 'Backspace') deleteSelected();
   else if (e.key === 'c') setSketchMode(!view.sketchMode);
   else if (e.key === 'Escape') setSketchMode(false);
-  else if (e.key === 'f') view.fitView();
+  else if (e.key === 'f') view.fitObject();
   else if (e.key === 't') view.setRobotSeeThrough(!view.robotSeeThrough);
   else if (e.key === ' ') $('pause').click();
   else return;
@@ -285,6 +286,8 @@ window.shapectl = {
   obstacles: () => view.obstaclesView.describe(),
   contacts: () => view.contactsView.describe(),
   robotColors: () => view.robotView.visualColors(),
+  // Names of the links hiding the object in the last frame drawn (drawn see-through: occlusion.js).
+  hidingLinks: () => view.occlusion.hidingNames(),
   robotMeshes: () => view.robotView.meshVisuals(),
   get robotWarnings() { return page.robotWarnings; },
   highlightedSpheres: () => view.robotView.highlightedSpheres(),

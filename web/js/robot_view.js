@@ -67,6 +67,34 @@ function paintCollision(material, red) {
   if (material.emissive) material.emissive.copy(red ? COLLIDING_EMISSIVE : material.userData.emissive);
 }
 
+// What a faded material draws with: transparent, no depth written (what is behind shows), and
+// the first faded surface at a pixel marks the stencil so the others leave that pixel alone: one
+// veil over the object however many links (or sides of one) line up in front of it.
+const FADED = {
+  transparent: true, depthWrite: false,
+  stencilWrite: true, stencilRef: 1, stencilFunc: THREE.NotEqualStencilFunc, stencilZPass: THREE.ReplaceStencilOp,
+};
+
+// Fades a material towards `opacity` by `amount` (0: its own opacity, kept at the first fade,
+// 1: `opacity`, if that is lower). The view's renderer needs a stencil buffer.
+function fade(material, amount, opacity) {
+  const solid = material.userData.solid;
+  if (amount <= 0) {
+    if (!solid) return;
+    Object.assign(material, solid);
+    delete material.userData.solid;
+    material.needsUpdate = true;
+    return;
+  }
+  if (!solid) {
+    material.userData.solid = Object.fromEntries(['opacity', ...Object.keys(FADED)].map((key) => [key, material[key]]));
+    Object.assign(material, FADED);
+    material.needsUpdate = true;
+  }
+  const own = material.userData.solid.opacity;
+  material.opacity = own + (Math.min(own, opacity) - own) * Math.min(1, amount);
+}
+
 export class RobotView {
   // `opacity` scales every visual's alpha; `spheres`: whether to draw the collision spheres.
   constructor({ opacity = 1, spheres = true } = {}) {
@@ -212,6 +240,14 @@ export class RobotView {
         return { rgb: [srgb.r, srgb.g, srgb.b], opacity: material.opacity };
       }),
     }));
+  }
+
+  // Fades link `k`'s visuals (not its collision spheres) towards `opacity` by `amount` (0: solid).
+  fadeLink(k, amount, opacity) {
+    this.linkGroups[k]?.traverse((o) => {
+      if (!o.isMesh || this.sphereMeshes.includes(o)) return;
+      for (const material of Array.isArray(o.material) ? o.material : [o.material]) fade(material, amount, opacity);
+    });
   }
 
   // For tests: each link's pose as drawn, 16 numbers (column-major T_world_link).

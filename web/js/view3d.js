@@ -10,28 +10,13 @@ import { ObstaclesView } from './obstacles_view.js';
 import { ContactsView } from './contacts_view.js';
 import { TargetControls } from './target_controls.js';
 import { TargetGizmo } from './target_gizmo.js';
-import { fitCamera } from './fit_view.js';
+import { fitCamera, fitSphere } from './fit_view.js';
+import { Occlusion } from './occlusion.js';
 
 const MOVE_INTERVAL_MS = 33;       // ~30 target edits per second while dragging
 const LOCAL_TARGET_HOLD_MS = 300;  // a dropped target shows where it was left until the server has it
 const FRONT_VIEW = new THREE.Vector3(0.95, -0.5, 0.45);  // fit-view: from the scene towards the camera
 const UP = new THREE.Vector3(0, 0, 1);
-
-const SEE_THROUGH_OPACITY = 0.2;
-
-// Fades a robot material to SEE_THROUGH_OPACITY (on) or back to what it was.
-function seeThrough(material, on) {
-  if (!material || !!material.userData.solid === on) return;
-  if (on) {
-    const { opacity, transparent, depthWrite } = material;
-    material.userData.solid = { opacity, transparent, depthWrite };
-    Object.assign(material, { opacity: Math.min(opacity, SEE_THROUGH_OPACITY), transparent: true, depthWrite: false });
-  } else {
-    Object.assign(material, material.userData.solid);
-    delete material.userData.solid;
-  }
-  material.needsUpdate = true;
-}
 
 export class View3D {
   constructor(container, callbacks) {
@@ -39,7 +24,7 @@ export class View3D {
     // addTarget(node, position), moveTarget(node, position), sketch(points), select(node), and
     // beginEdit() before a gesture changes the targets (for undo)
     this.callbacks = callbacks;
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true, stencil: true });  // stencil: robot_view.js' fade
     this.renderer.setPixelRatio(window.devicePixelRatio);
     container.appendChild(this.renderer.domElement);
 
@@ -65,6 +50,7 @@ export class View3D {
     this.objectView = new ObjectView();
     this.obstaclesView = new ObstaclesView();
     this.contactsView = new ContactsView();
+    this.occlusion = new Occlusion(this.robotView, this.objectView);
     this.scene.add(this.robotView.group, this.ghostView.group, this.objectView.group, this.obstaclesView.group, this.contactsView.group);
     this.targetControls = new TargetControls(this.camera, this.objectView, this.renderer.domElement);
     this.gizmo = new TargetGizmo(this.camera, this.renderer.domElement, this.scene);
@@ -72,7 +58,7 @@ export class View3D {
 
     this.robotSeeThrough = false;  // the t key
     this.fitPending = false;       // a new scene waits for its shape and pose to be framed
-    this.framed = false;           // the camera is as fit-view left it: a resize frames anew
+    this.framed = null;            // 'all' or 'object': the camera is as fitView/fitObject left it, a resize frames anew
     this.state = null;             // the last state message shown
     this.frames = 0;               // frames rendered (tests wait for a few)
     this.renderPending = false;
@@ -83,7 +69,7 @@ export class View3D {
     this.wireTargetControls();
     // Render on demand only: software WebGL (headless, remote desktops) can't afford 60 fps.
     this.orbit.addEventListener('change', () => this.requestRender());
-    this.orbit.addEventListener('start', () => { this.framed = false; });  // the user's view now
+    this.orbit.addEventListener('start', () => { this.framed = null; });  // the user's view now
     new ResizeObserver(() => this.resize()).observe(container);
     this.resize();
   }
@@ -159,13 +145,16 @@ export class View3D {
     this.renderer.setSize(w, h, false);
     this.camera.aspect = w / h;
     this.camera.updateProjectionMatrix();
-    if (this.framed) this.fitView(this.scratch.subVectors(this.camera.position, this.orbit.target));
+    const from = this.scratch.subVectors(this.camera.position, this.orbit.target);
+    if (this.framed === 'all') this.fitView(from);
+    else if (this.framed === 'object') this.fitObject(from);
     this.requestRender();
   }
 
   render() {
     const size = this.renderer.getSize(this.viewSize);
     this.objectView.fitToScreen(this.camera, size.x, size.y);
+    if (this.occlusion.update(this.camera, performance.now())) this.requestRender();  // a link still fading
     this.renderer.render(this.scene, this.camera);
     this.frames++;
   }
@@ -176,7 +165,7 @@ export class View3D {
     this.gizmo.attach(null);
     this.orbit.enabled = true;
     this.robotView.setRobot(description.robot);
-    if (this.robotSeeThrough) this.setRobotSeeThrough(true);
+    this.occlusion.setScene(description);
     this.ghostView.setRobot(description.robot);
     this.objectView.setScene(description);
     this.obstaclesView.setObstacles(description.obstacles);
@@ -230,7 +219,7 @@ export class View3D {
 
   // Frames the robot and the object from `direction` (towards the camera; by default the front,
   // +x where the robot faces, a little from the side and above), all of both in view (on load,
-  // on a scene switch, the f key, and on a resize from where the camera looks).
+  // on a scene switch, and on a resize from where the camera looks).
   fitView(direction = FRONT_VIEW) {
     if (!this.objectView.positions) return;
     const robot = this.robotView.group, object = this.objectView.positionAttribute, point = new THREE.Vector3();
@@ -244,7 +233,17 @@ export class View3D {
         for (let i = 0; i < (vertices?.count ?? 0); i++) visit(point.fromBufferAttribute(vertices, i).applyMatrix4(mesh.matrixWorld));
       });
     });
-    this.framed = true;
+    this.framed = 'all';
+    this.requestRender();
+  }
+
+  // Frames the object alone (the f key): its bounding sphere fills the view, seen from `direction`
+  // as fitView; the robot may reach out of view.
+  fitObject(direction = FRONT_VIEW) {
+    if (!this.objectView.positions) return;
+    const sphere = this.objectView.surfaceGeometry.boundingSphere;  // kept by setPositions
+    fitSphere(this.camera, this.orbit, sphere.center, sphere.radius, direction);
+    this.framed = 'object';
     this.requestRender();
   }
 
@@ -255,7 +254,7 @@ export class View3D {
     this.objectView.centroid(this.orbit.target);
     this.camera.position.copy(this.orbit.target).addScaledVector(side, 0.8);
     this.camera.position.z += 0.2;
-    this.framed = false;
+    this.framed = null;
     this.orbit.update();
     this.camera.updateMatrixWorld();
   }
@@ -289,9 +288,11 @@ export class View3D {
   // A see-through robot: targets behind the arms show through them.
   setRobotSeeThrough(on) {
     this.robotSeeThrough = on;
-    this.robotView.group.traverse((o) => seeThrough(o.material, on));
+    this.occlusion.setAll(on);
     this.requestRender();
   }
+  // The links hiding the object drawn see-through (occlusion.js).
+  setSeeThroughArms(on) { this.occlusion.setEnabled(on); this.requestRender(); }
   // Handles, arrows and the gizmo (tests compare the view with and without them).
   setTargetsVisible(on) { this.objectView.glyphs.group.visible = on; this.gizmo.setVisible(on); this.requestRender(); }
   setRobotVisible(on) { this.robotView.setVisible(on); this.requestRender(); }
