@@ -220,6 +220,14 @@ TEST(XacroExpanderErrors, UnsupportedXacroTagsPointToTheConversionRoute) {
                        "xacro:element is not supported"));
 }
 
+TEST(XacroExpanderErrors, TheOldSyntaxWithoutThePrefixIsRefused) {
+  EXPECT_EQ(error_of("  <include filename=\"parts.xacro\"/>\n"),
+            "DIR/robot.urdf.xacro:3: <include> without the xacro: prefix (xacro's old syntax) is "
+            "not supported: write <xacro:include>");
+  EXPECT_TRUE(contains(expand("  <gazebo><property>kept</property></gazebo>\n"),
+                       "<property>kept</property>"));  // not a robot's child: plain XML
+}
+
 TEST(XacroExpanderErrors, MissingIncludeAndIncludeCycle) {
   EXPECT_EQ(error_of("\n  <xacro:include filename=\"nowhere.xacro\"/>\n"),
             "DIR/robot.urdf.xacro:4: included file 'DIR/nowhere.xacro' not found");

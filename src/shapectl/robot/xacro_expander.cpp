@@ -64,6 +64,13 @@ const std::set<std::string> supported_tags = {"property", "macro", "include",   
                                               "unless",   "arg",   "insert_block"};
 const std::set<std::string> unsupported_tags = {"call", "element", "attribute", "eval-comments",
                                                 "load_yaml"};
+// xacro's old syntax, tags without the prefix: copied as they are they would silently do nothing.
+const std::set<std::string> legacy_tags = {"include", "property", "macro"};
+
+bool is_top_level(const TiXmlElement* element) {
+  const TiXmlNode* parent = element->Parent();
+  return parent && parent->ToElement() && parent->Parent() && parent->Parent()->ToDocument();
+}
 
 // Splits a macro's params at blanks outside single quotes: xyz:='0 0 0' is one parameter.
 std::vector<std::string> split_params(const std::string& text) {
@@ -320,6 +327,11 @@ class Expander {
       xacro_element(element, tag.substr(6), scope, out);
       return;
     }
+    if (legacy_tags.count(tag) && is_top_level(element))
+      fail(element, "<" + tag +
+                        "> without the xacro: prefix (xacro's old syntax) is not "
+                        "supported: write <xacro:" +
+                        tag + ">");
     auto* copy = new TiXmlElement(tag);
     count_output(node, 2 * tag.size() + 5);
     out->LinkEndChild(copy);
