@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 packages=(
   build-essential cmake pkg-config
   libeigen3-dev libsuitesparse-dev libopenblas-dev libtbb-dev
-  liburdfdom-dev liborocos-kdl-dev libtet1.5-dev
+  liburdfdom-dev libtinyxml-dev liborocos-kdl-dev libtet1.5-dev
   nlohmann-json3-dev libcli11-dev liblbfgspp-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev chromium

@@ -265,7 +265,7 @@ std::vector<CollisionSphere> cover_meshes(const AuthorOptions& o, const RobotMod
                                           std::vector<std::string>& warnings) {
   const std::vector<fs::path> paths = package_paths(o.package_paths);
   std::vector<CollisionSphere> spheres;
-  for (const auto& m : read_mesh_collisions(model, o.urdf)) {
+  for (const auto& m : read_mesh_collisions(model, o.urdf, xacro_options(o.package_paths))) {
     const std::string& link = model.links()[static_cast<std::size_t>(m.link)].name;
     const auto file = resolve_mesh_file(m.filename, fs::path(o.urdf).parent_path(), paths);
     if (!file || !is_surface_file(*file)) {
@@ -288,7 +288,7 @@ std::vector<CollisionSphere> cover_meshes(const AuthorOptions& o, const RobotMod
 std::vector<std::string> missing_meshes(const AuthorOptions& o, const RobotModel& model) {
   const std::vector<fs::path> paths = package_paths(o.package_paths);
   std::set<std::string> missing;
-  for (const auto& m : read_mesh_collisions(model, o.urdf))
+  for (const auto& m : read_mesh_collisions(model, o.urdf, xacro_options(o.package_paths)))
     if (!resolve_mesh_file(m.filename, fs::path(o.urdf).parent_path(), paths))
       missing.insert(bounded_preview(m.filename));
   for (const auto& m : find_visual_meshes(model, paths))
@@ -564,7 +564,7 @@ void run(const AuthorOptions& o) {
     throw InputError("command line", "--sphere-margin", "a distance from 0 to 0.1 m",
                      o.sphere_margin);
 
-  RobotModel model = RobotModel::load_urdf_file(o.urdf);
+  RobotModel model = RobotModel::load_urdf_file(o.urdf, xacro_options(o.package_paths));
   // The loader's note that collision meshes are ignored does not apply here: they are covered
   // with spheres below.
   std::vector<std::string> warnings;
@@ -766,7 +766,7 @@ void add_author_command(CLI::App& app) {
   auto o = std::make_shared<AuthorOptions>();
   CLI::App* c =
       app.add_subcommand("author", "Propose a scene from a URDF robot and an object mesh");
-  c->add_option("robot", o->urdf, "Robot description (URDF)")->required();
+  c->add_option("robot", o->urdf, "Robot description (URDF, or URDF xacro)")->required();
   c->add_option("--mesh", o->mesh,
                 "Object mesh: .msh, .node/.ele, or a closed surface .obj/.stl/.off (metres)");
   c->add_option("--box", o->box, "Instead of --mesh: a box LX,LY,LZ (metres)");

@@ -1,6 +1,6 @@
-// shapectl kinematics ROBOT.urdf [--joints JOINTS.json|RESULT.json] [--spheres SPHERES.json] --out
-// OUT.json Link poses at one configuration, and optionally self-collision clearances and limit
-// checks.
+// shapectl kinematics ROBOT.urdf[.xacro] [--joints JOINTS.json|RESULT.json] [--spheres
+// SPHERES.json] --out OUT.json Link poses at one configuration, and optionally self-collision
+// clearances and limit checks.
 #include <iostream>
 #include <limits>
 #include <map>
@@ -28,6 +28,7 @@ namespace {
 struct KinematicsOptions {
   std::string urdf;
   std::vector<std::string> package_paths;  // --package-path: the URDF's package:// meshes
+  std::vector<std::string> xacro_args;     // --xacro-arg NAME:=VALUE
   std::string joints;
   std::string spheres;
   std::string out;
@@ -62,7 +63,8 @@ nlohmann::ordered_json collision_json(const RobotModel& robot, const CollisionMo
 }
 
 void run(const KinematicsOptions& options) {
-  RobotModel robot = RobotModel::load_urdf_file(options.urdf);
+  RobotModel robot = RobotModel::load_urdf_file(options.urdf, xacro_options(options.package_paths,
+                                                                            options.xacro_args));
   print_robot_notes(robot, options.package_paths);
   // A joints file or a result of statics, solve or run (its fixed joints too); missing joints 0.
   Eigen::VectorXd active = Eigen::VectorXd::Zero(robot.active_count());
@@ -98,7 +100,8 @@ void add_kinematics_command(CLI::App& app) {
   auto options = std::make_shared<KinematicsOptions>();
   CLI::App* command = app.add_subcommand(
       "kinematics", "Link poses of a URDF robot at given joint values; clearances with --spheres");
-  command->add_option("robot", options->urdf, "Robot description (URDF)")->required();
+  command->add_option("robot", options->urdf, "Robot description (URDF, or URDF xacro)")
+      ->required();
   command->add_option("--joints", options->joints,
                       "JOINTS.json {\"joints\": {\"name\": radians}}, or a result of statics, "
                       "solve or run; missing joints are 0");
@@ -107,6 +110,7 @@ void add_kinematics_command(CLI::App& app) {
       ->required()
       ->check(writable_output());
   add_package_path_option(*command, options->package_paths);
+  add_xacro_arg_option(*command, options->xacro_args);
   command->callback([options] { run(*options); });
 }
 

@@ -2,6 +2,7 @@
 
 #include <iostream>
 
+#include <shapectl/io/input_error.hpp>
 #include <shapectl/robot/mesh_resource.hpp>
 
 namespace shapectl::cli {
@@ -14,6 +15,25 @@ void add_package_path_option(CLI::App& cmd, std::vector<std::string>& package_pa
 
 std::vector<std::filesystem::path> package_paths(const std::vector<std::string>& given) {
   return with_ros_package_path({given.begin(), given.end()});
+}
+
+void add_xacro_arg_option(CLI::App& cmd, std::vector<std::string>& xacro_args) {
+  cmd.add_option("--xacro-arg", xacro_args,
+                 "NAME:=VALUE for $(arg NAME) of a ROBOT.urdf.xacro (repeatable; others take "
+                 "their xacro:arg default)");
+}
+
+XacroOptions xacro_options(const std::vector<std::string>& given,
+                           const std::vector<std::string>& xacro_args) {
+  XacroOptions options;
+  options.package_paths = {given.begin(), given.end()};
+  for (const std::string& arg : xacro_args) {
+    const auto at = arg.find(":=");
+    if (at == std::string::npos || at == 0)
+      throw InputError("--xacro-arg", "", "expected NAME:=VALUE", "'" + arg + "'");
+    options.args[arg.substr(0, at)] = arg.substr(at + 2);
+  }
+  return options;
 }
 
 std::vector<std::string> robot_notes(const RobotModel& model,

@@ -54,6 +54,16 @@ std::optional<std::filesystem::path> resolve_mesh_file(
   return std::nullopt;
 }
 
+std::optional<std::filesystem::path> find_ros_package(
+    const std::string& package, const std::vector<std::filesystem::path>& package_paths) {
+  std::error_code error;
+  for (const auto& dir : package_paths) {
+    if (std::filesystem::is_directory(dir, error) && is_package_dir(dir, package)) return dir;
+    if (std::filesystem::is_directory(dir / package, error)) return dir / package;
+  }
+  return std::nullopt;
+}
+
 std::vector<std::filesystem::path> with_ros_package_path(std::vector<std::filesystem::path> given) {
   if (const char* env = std::getenv("ROS_PACKAGE_PATH")) {
     std::istringstream entries(env);

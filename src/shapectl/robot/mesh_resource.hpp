@@ -16,6 +16,12 @@ std::optional<std::filesystem::path> resolve_mesh_file(
     const std::string& filename, const std::filesystem::path& urdf_directory,
     const std::vector<std::filesystem::path>& package_paths);
 
+// The folder of ROS package `package` ($(find package) in xacro): for each dir of package_paths,
+// dir itself when it is that package (named so, or so declared in its package.xml), else
+// dir/package when that is a folder.
+std::optional<std::filesystem::path> find_ros_package(
+    const std::string& package, const std::vector<std::filesystem::path>& package_paths);
+
 // `given` followed by the entries of $ROS_PACKAGE_PATH (colon-separated, empty ones skipped).
 std::vector<std::filesystem::path> with_ros_package_path(std::vector<std::filesystem::path> given);
 

@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include <shapectl/robot/xacro_expander.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {
@@ -67,7 +68,10 @@ class RobotModel {
  public:
   // Errors (missing file, URDF syntax, kinematic loops, non-finite numbers, bad limits) throw
   // InputError naming the file and the element, e.g. "arm.urdf:12: joint 'j2': ...".
-  static RobotModel load_urdf_file(const std::filesystem::path& file);
+  // ROBOT.urdf.xacro is expanded first (read_robot_description); line numbers of errors found
+  // after the expansion are lines of the expanded text.
+  static RobotModel load_urdf_file(const std::filesystem::path& file,
+                                   const XacroOptions& xacro = {});
   static RobotModel from_urdf_string(const std::string& xml, const std::string& source_name);
 
   const std::string& name() const { return name_; }

@@ -4,7 +4,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include <shapectl/io/input_error.hpp>
-#include <shapectl/io/input_file.hpp>
+#include <shapectl/robot/robot_description.hpp>
 
 namespace shapectl {
 
@@ -28,8 +28,9 @@ Eigen::Isometry3d to_isometry(const urdf::Pose& pose) {
 }  // namespace
 
 std::vector<MeshCollision> read_mesh_collisions(const RobotModel& model,
-                                                const std::filesystem::path& urdf_file) {
-  const std::string xml = read_input_file(urdf_file, max_urdf_file_bytes, "URDF");
+                                                const std::filesystem::path& urdf_file,
+                                                const XacroOptions& xacro) {
+  const std::string xml = read_robot_description(urdf_file, xacro);
   SilentLog silent;
   console_bridge::useOutputHandler(&silent);
   urdf::ModelInterfaceSharedPtr urdf;

@@ -21,8 +21,10 @@ struct MeshCollision {
 };
 
 // Every <collision><geometry><mesh> of `urdf_file`, in link order. Call only after
-// RobotModel::load_urdf_file accepted the same file (it bounds size, depth and counts).
+// RobotModel::load_urdf_file accepted the same file and `xacro` (it bounds size, depth and
+// counts).
 std::vector<MeshCollision> read_mesh_collisions(const RobotModel& model,
-                                                const std::filesystem::path& urdf_file);
+                                                const std::filesystem::path& urdf_file,
+                                                const XacroOptions& xacro = {});
 
 }  // namespace shapectl

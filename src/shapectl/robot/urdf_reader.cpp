@@ -14,7 +14,9 @@
 
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/io/input_file.hpp>
+#include <shapectl/robot/robot_description.hpp>
 #include <shapectl/robot/robot_model.hpp>
+#include <shapectl/robot/xml_depth.hpp>
 
 namespace shapectl {
 
@@ -29,58 +31,9 @@ class CapturedLog : public console_bridge::OutputHandler {
   std::vector<std::string> lines;
 };
 
-// Bounds checked before urdfdom sees the text: TinyXML recurses once per nested element, and
-// urdfdom's links free each other recursively down a chain.
-constexpr int max_xml_depth = 100;
+// Bounds checked before urdfdom sees the text: TinyXML recurses once per nested element
+// (max_xml_depth), and urdfdom's links free each other recursively down a chain.
 constexpr std::size_t max_urdf_elements = 2000;  // links and joints each; YuMi has 38 links
-
-// Where `xml` nests elements deeper than `max_depth` (byte offset), or npos. One pass, no
-// recursion: skips comments, CDATA, declarations and quoted attribute values.
-std::size_t xml_too_deep_at(std::string_view xml, int max_depth) {
-  int depth = 0;
-  auto skip_past = [&](std::size_t from, std::string_view end) {
-    const std::size_t at = xml.find(end, from);
-    return at == std::string_view::npos ? xml.size() : at + end.size();
-  };
-  for (std::size_t i = xml.find('<'); i < xml.size(); i = xml.find('<', i)) {
-    const std::string_view rest = xml.substr(i);
-    if (rest.starts_with("<!--")) {
-      i = skip_past(i + 4, "-->");
-      continue;
-    }
-    if (rest.starts_with("<![CDATA[")) {
-      i = skip_past(i + 9, "]]>");
-      continue;
-    }
-    if (rest.starts_with("<?")) {
-      i = skip_past(i + 2, "?>");
-      continue;
-    }
-    if (rest.starts_with("<!")) {
-      i = skip_past(i + 2, ">");
-      continue;
-    }
-    if (rest.starts_with("</")) {
-      --depth;
-      i = skip_past(i + 2, ">");
-      continue;
-    }
-    // An opening tag: find its end outside quoted attribute values.
-    char quote = 0;
-    std::size_t j = i + 1;
-    for (; j < xml.size(); ++j) {
-      const char c = xml[j];
-      if (quote) {
-        if (c == quote) quote = 0;
-      } else if (c == '"' || c == '\'') quote = c;
-      else if (c == '>') break;
-    }
-    if (j >= xml.size()) return std::string_view::npos;  // unterminated: TinyXML reports it
-    if (xml[j - 1] != '/' && ++depth > max_depth) return i;
-    i = j + 1;
-  }
-  return std::string_view::npos;
-}
 
 // The value of attribute `name` in an element's opening tag `head`, or nullopt.
 std::optional<std::string> attribute(std::string_view head, std::string_view name) {
@@ -470,8 +423,9 @@ RobotModel RobotModel::from_urdf_string(const std::string& xml, const std::strin
   return UrdfReader(xml, source_name).read(xml);
 }
 
-RobotModel RobotModel::load_urdf_file(const std::filesystem::path& file) {
-  return from_urdf_string(read_input_file(file, max_urdf_file_bytes, "URDF"), file.string());
+RobotModel RobotModel::load_urdf_file(const std::filesystem::path& file,
+                                      const XacroOptions& xacro) {
+  return from_urdf_string(read_robot_description(file, xacro), file.string());
 }
 
 }  // namespace shapectl
