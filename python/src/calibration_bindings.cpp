@@ -196,21 +196,22 @@ void bind_calibration(py::module_& m) {
                     "χ²/dof: about 1 when the model fits to the noise level.")
       .def_readonly("frames", &CalibrationResult::frames, "One FrameFit per observed frame.");
 
-  m.def(
-      "calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
-      py::arg("fit") = py::none(), py::arg("max_iterations") = 30, py::arg("max_seconds") = 300.0,
-      py::arg("prior") = "", py::arg("bounds") = "",
-      "Fits the scene's physical parameters to observations of the real object, as `shapectl "
-      "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
-      "of its schema (numpy arrays allowed; a points_file relative to the current "
-      "directory). fit: a comma-separated string or a list of youngs_modulus, poisson_ratio, "
-      "density, grip_offsets, object_pose (default: youngs_modulus and grip_offsets with a "
-      "robot, youngs_modulus and object_pose without). max_seconds: the fit's time budget; "
-      "spent, it stops with the best values so far (converged False). prior, bounds: as the CLI's "
-      "--prior and --bounds (docs/calibration.md). Raises ValueError for bad "
-      "input (the CLI's message; a dict is named 'observations'), SolverError when a frame's "
-      "equilibrium cannot be found or the budget is spent before a first fit. Releases the GIL "
-      "while it runs.");
+  m.def("calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
+        py::arg("fit") = py::none(), py::arg("max_iterations") = 30, py::arg("max_seconds") = 300.0,
+        py::arg("prior") = "", py::arg("bounds") = "",
+        "Fits the scene's physical parameters to observations of the real object, as `shapectl "
+        "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
+        "of its schema (numpy arrays allowed; a points_file relative to the current "
+        "directory; a frame's loads and object_pose as in the file). fit: a comma-separated "
+        "string or a list of youngs_modulus, poisson_ratio, density, grip_offsets, object_pose, "
+        "regions[K].youngs_modulus (.poisson_ratio, .density) (default: youngs_modulus and "
+        "grip_offsets with a robot, youngs_modulus and object_pose without). max_seconds: the "
+        "fit's time budget; spent, it stops with the best values so far (converged False). prior, "
+        "bounds: as the CLI's --prior and --bounds (docs/calibration.md), over the observations' "
+        "own \"priors\" and \"bounds\". Raises ValueError for bad "
+        "input (the CLI's message; a dict is named 'observations'), SolverError when a frame's "
+        "equilibrium cannot be found or the budget is spent before a first fit. Releases the GIL "
+        "while it runs.");
 }
 
 }  // namespace shapectl::python

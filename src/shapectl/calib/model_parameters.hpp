@@ -37,7 +37,7 @@ struct FitSelection {
   bool density = false;
   bool grip_offsets = false;
   bool object_pose = false;
-  std::vector<RegionParameter> regions;
+  std::vector<RegionParameter> regions = {};
   bool empty() const {
     return !(youngs_modulus || poisson_ratio || density || grip_offsets || object_pose) &&
            regions.empty();

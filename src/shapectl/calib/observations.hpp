@@ -63,9 +63,10 @@ struct ObservationFrame {
 };
 
 struct Observations {
-  std::vector<ObservationFrame> frames;     // at least one
-  std::optional<CalibrationPriors> priors;  // "priors": the defaults changed by its entries
-  std::optional<MaterialBounds> bounds;     // "bounds"
+  std::vector<ObservationFrame> frames;  // at least one
+  // "priors" and "bounds": --prior's and --bounds' defaults changed by the file's entries.
+  std::optional<CalibrationPriors> priors = std::nullopt;
+  std::optional<MaterialBounds> bounds = std::nullopt;
 };
 
 struct ObservationContext {
