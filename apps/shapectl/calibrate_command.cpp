@@ -1,5 +1,6 @@
 // shapectl calibrate SCENE.json --observations OBS.json --out CALIBRATED.json
-//   [--fit youngs_modulus,poisson_ratio,density,grip_offsets,object_pose] [--report REPORT.json]
+//   [--fit youngs_modulus,poisson_ratio,density,grip_offsets,object_pose,regions[K].youngs_modulus]
+//   [--report REPORT.json]
 //   [--prior LIST] [--bounds LIST] [--max-iterations N] [--max-seconds S]
 // Fits the scene's physical parameters to observed frames of the real object
 // (docs/calibration.md) and writes the scene with the fitted values.
@@ -51,25 +52,29 @@ FitSelection fit_selection(const CalibrateArgs& args, const Scene& scene) {
   return fit;
 }
 
-// --prior and --bounds; a bad entry → InputError naming the option and the entry. The scene's
-// material must lie within the bounds.
+// --prior and --bounds over the observations file's "priors" and "bounds" (the command line's
+// entries win); a bad entry → InputError naming the option and the entry. The scene's material
+// must lie within the bounds.
 void priors_and_bounds(const CalibrateArgs& args, const Scene& scene, const FitSelection& fit,
-                       CalibrationOptions& options) {
+                       const Observations& observations, CalibrationOptions& options) {
   try {
-    options.priors = parse_priors(args.prior);
+    options.priors = parse_priors(args.prior, observations.priors.value_or(CalibrationPriors{}));
   } catch (const std::invalid_argument& e) {
     throw InputError("--prior", "", e.what());
   }
   try {
-    options.bounds = parse_bounds(args.bounds);
-    const std::string name =
-        outside_bounds(ParameterSpace(scene, fit), PhysicalParameters::of(scene), options.bounds);
-    if (!name.empty())
-      throw std::invalid_argument(name + ": the scene's value (" + args.scene +
-                                  ") is outside these bounds");
+    options.bounds = parse_bounds(args.bounds, observations.bounds.value_or(MaterialBounds{}));
   } catch (const std::invalid_argument& e) {
     throw InputError("--bounds", "", e.what());
   }
+  const std::string name =
+      outside_bounds(ParameterSpace(scene, fit), PhysicalParameters::of(scene), options.bounds);
+  if (name.empty()) return;
+  const std::string problem =
+      name + ": the scene's value (" + args.scene + ") is outside these bounds";
+  // Bounds the file alone gave are named where they were written.
+  if (args.bounds.empty()) throw InputError(args.observations, "bounds", problem);
+  throw InputError("--bounds", "", problem);
 }
 
 // A value's prior σ, or null without one.
@@ -160,16 +165,19 @@ void run_calibrate(const CalibrateArgs& args) {
   apply_linear_solver_option(args.linear_solver, scene);
   print_scene_notes(scene, args.package_paths);
   const FitSelection fit = fit_selection(args, scene);
-  CalibrationOptions options{.max_iterations = args.max_iterations};
-  priors_and_bounds(args, scene, fit, options);
   const Observations observations =
       load_observations(args.observations,
                         {.node_count = scene.object_mesh->node_count(),
-                         .robot = scene.robot ? scene.robot->model.get() : nullptr});
+                         .robot = scene.robot ? scene.robot->model.get() : nullptr,
+                         .mesh = scene.object_mesh.get()});
+  CalibrationOptions options{.max_iterations = args.max_iterations};
+  priors_and_bounds(args, scene, fit, observations, options);
   CalibrationResult result;
   try {
     options.max_seconds = remaining();
     result = calibrate(scene, observations, fit, options);
+  } catch (const std::invalid_argument& e) {  // a selection these observations refuse
+    throw InputError("--fit", "", std::string(e.what()) + " (" + args.observations + ")");
   } catch (const std::runtime_error& e) {
     throw SolverFailure(std::string("calibrate: ") + e.what() +
                         (remaining() > 0 ? "" : " (--max-seconds reached)"));
@@ -203,7 +211,8 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option(
       "--fit", args->fit,
       "parameters to fit, comma-separated: youngs_modulus, poisson_ratio, density, grip_offsets, "
-      "object_pose (default youngs_modulus,grip_offsets with a robot, "
+      "object_pose, regions[K].youngs_modulus (also .poisson_ratio, .density: region K's "
+      "material) (default youngs_modulus,grip_offsets with a robot, "
       "youngs_modulus,object_pose for an object held by fixed nodes alone)");
   cmd->add_option("--prior", args->prior,
                   "priors on the fitted values' change from the scene's, comma-separated "

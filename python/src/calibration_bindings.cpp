@@ -18,6 +18,7 @@ struct Calibration : CalibrationResult {
 Observations observations_from(const py::handle& in, const Scene& scene) {
   const ObservationContext context{.node_count = scene.object_mesh->node_count(),
                                    .robot = scene.robot ? scene.robot->model.get() : nullptr,
+                                   .mesh = scene.object_mesh.get(),
                                    .allow_points_files = true};
   if (py::isinstance<py::dict>(in))
     return read_observations(JsonInput(json_from(in, "observations"), "observations"), context);
@@ -59,16 +60,18 @@ bool finite(const CalibrationResult& r) {
   return ok;
 }
 
-// prior= and bounds= as the CLI's --prior and --bounds; a bad entry → ValueError naming it.
+// prior= and bounds= as the CLI's --prior and --bounds, over the observations' "priors" and
+// "bounds"; a bad entry → ValueError naming it.
 void priors_and_bounds(const std::string& prior, const std::string& bounds, const Scene& scene,
-                       const FitSelection& fit, CalibrationOptions& options) {
+                       const FitSelection& fit, const Observations& observations,
+                       CalibrationOptions& options) {
   try {
-    options.priors = parse_priors(prior);
+    options.priors = parse_priors(prior, observations.priors.value_or(CalibrationPriors{}));
   } catch (const std::invalid_argument& e) {
     throw InputError("prior", "", e.what());
   }
   try {
-    options.bounds = parse_bounds(bounds);
+    options.bounds = parse_bounds(bounds, observations.bounds.value_or(MaterialBounds{}));
   } catch (const std::invalid_argument& e) {
     throw InputError("bounds", "", e.what());
   }
@@ -84,11 +87,11 @@ Calibration run_calibrate(const SceneHandle& s, const py::object& observations_i
   const Scene& scene = *s.scene;
   const FitSelection fit = fit_from(fit_in.is_none() ? py::str(default_fit(scene)) : fit_in);
   CalibrationOptions options{.max_iterations = max_iterations};
-  priors_and_bounds(prior, bounds, scene, fit, options);
   if (max_iterations < 1 || max_iterations > 1000)
     throw InputError("max_iterations", "", "a number from 1 to 1000", max_iterations);
   if (!(max_seconds > 0)) throw InputError("max_seconds", "", "a positive number", max_seconds);
   const Observations observations = observations_from(observations_in, scene);
+  priors_and_bounds(prior, bounds, scene, fit, observations, options);
 
   py::gil_scoped_release release;
   Calibration out;
@@ -193,21 +196,22 @@ void bind_calibration(py::module_& m) {
                     "χ²/dof: about 1 when the model fits to the noise level.")
       .def_readonly("frames", &CalibrationResult::frames, "One FrameFit per observed frame.");
 
-  m.def(
-      "calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
-      py::arg("fit") = py::none(), py::arg("max_iterations") = 30, py::arg("max_seconds") = 300.0,
-      py::arg("prior") = "", py::arg("bounds") = "",
-      "Fits the scene's physical parameters to observations of the real object, as `shapectl "
-      "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
-      "of its schema (numpy arrays allowed; a points_file relative to the current "
-      "directory). fit: a comma-separated string or a list of youngs_modulus, poisson_ratio, "
-      "density, grip_offsets, object_pose (default: youngs_modulus and grip_offsets with a "
-      "robot, youngs_modulus and object_pose without). max_seconds: the fit's time budget; "
-      "spent, it stops with the best values so far (converged False). prior, bounds: as the CLI's "
-      "--prior and --bounds (docs/calibration.md). Raises ValueError for bad "
-      "input (the CLI's message; a dict is named 'observations'), SolverError when a frame's "
-      "equilibrium cannot be found or the budget is spent before a first fit. Releases the GIL "
-      "while it runs.");
+  m.def("calibrate", &run_calibrate, py::arg("scene"), py::arg("observations"), py::kw_only(),
+        py::arg("fit") = py::none(), py::arg("max_iterations") = 30, py::arg("max_seconds") = 300.0,
+        py::arg("prior") = "", py::arg("bounds") = "",
+        "Fits the scene's physical parameters to observations of the real object, as `shapectl "
+        "calibrate` (docs/calibration.md). observations: an OBSERVATIONS.json path, or a dict "
+        "of its schema (numpy arrays allowed; a points_file relative to the current "
+        "directory; a frame's loads and object_pose as in the file). fit: a comma-separated "
+        "string or a list of youngs_modulus, poisson_ratio, density, grip_offsets, object_pose, "
+        "regions[K].youngs_modulus (.poisson_ratio, .density) (default: youngs_modulus and "
+        "grip_offsets with a robot, youngs_modulus and object_pose without). max_seconds: the "
+        "fit's time budget; spent, it stops with the best values so far (converged False). prior, "
+        "bounds: as the CLI's --prior and --bounds (docs/calibration.md), over the observations' "
+        "own \"priors\" and \"bounds\". Raises ValueError for bad "
+        "input (the CLI's message; a dict is named 'observations'), SolverError when a frame's "
+        "equilibrium cannot be found or the budget is spent before a first fit. Releases the GIL "
+        "while it runs.");
 }
 
 }  // namespace shapectl::python

@@ -5,6 +5,7 @@
 #include <string>
 
 #include <shapectl/io/input_error.hpp>
+#include <shapectl/mesh/box_mesh.hpp>
 
 #include "support/test_support.hpp"
 
@@ -96,7 +97,8 @@ TEST(Observations, BadFramesAreErrorsNamingTheField) {
   EXPECT_NO_THROW(parse(frame(marker), context));
   EXPECT_EQ(error_of(R"({"frames": []})", context),
             "obs.json: frames: expected a non-empty list of frames, got []");
-  EXPECT_EQ(error_of(R"({"frame": []})", context), "obs.json: frame: unknown key; known: frames");
+  EXPECT_EQ(error_of(R"({"frame": []})", context),
+            "obs.json: frame: unknown key; known: frames, priors, bounds");
   EXPECT_EQ(error_of(frame(R"("markers": [])"), context),
             "obs.json: frames[0]: nothing observed; expected at least one marker or one point");
   EXPECT_EQ(error_of(frame(R"("markers": [{"node": 8, "position": [0, 0, 0]}])"), context),
@@ -115,7 +117,7 @@ TEST(Observations, BadFramesAreErrorsNamingTheField) {
       "obs.json: frames[0].points[1]: expected a point of length at most 1000 m, got [5000,0,0]");
   EXPECT_EQ(error_of(frame(marker + R"(, "colour": 1)"), context),
             "obs.json: frames[0].colour: unknown key; known: joints, markers, points, points_file, "
-            "sigma, time");
+            "sigma, time, loads, object_pose");
   EXPECT_EQ(error_of(frame(marker + R"(, "sigma": 0)"), context),
             "obs.json: frames[0].sigma: expected a positive number, got 0");
   EXPECT_EQ(error_of(frame(marker + R"(, "time": -1)"), context),
@@ -125,6 +127,61 @@ TEST(Observations, BadFramesAreErrorsNamingTheField) {
   EXPECT_EQ(error_of(frame(R"("points_file": "c.xyz")"), context),
             "obs.json: frames[0].points_file: point cloud files are read only from an observations "
             "file; expected \"points\"");
+}
+
+// Issue 35: a frame's own loads, read as the scene's (nodes or a box of rest positions, a force
+// in N shared by them), replace the scene's; their errors name the frame and the field.
+TEST(Observations, FramesCarryTheirOwnLoadsAndPoseCheckedAsTheScenesAre) {
+  const TetMesh mesh = make_box_mesh({0.2, 0.02, 0.02}, {4, 1, 1});  // 20 nodes, x in ±0.1
+  const ObservationContext context{.node_count = mesh.node_count(), .mesh = &mesh};
+  auto frame = [](const std::string& loads) {
+    return R"({"frames": [{"markers": [{"node": 1, "position": [0, 0, 0]}]},
+        {"markers": [{"node": 1, "position": [0, 0, 0]}], "loads": )" +
+           loads + "}]}";
+  };
+  const Observations obs = parse(frame(R"([{"box": {"min": [0.09, -1, -1], "max": [1, 1, 1]},
+      "force": [0, 0, -0.5]}, {"nodes": [0, 3], "force": [0.1, 0, 0]}])"),
+                                 context);
+  ASSERT_EQ(obs.frames.size(), 2u);
+  EXPECT_FALSE(obs.frames[0].loads.has_value());  // the scene's loads
+  ASSERT_TRUE(obs.frames[1].loads.has_value());
+  ASSERT_EQ(obs.frames[1].loads->size(), 2u);
+  EXPECT_EQ((*obs.frames[1].loads)[0].nodes.size(), 4u);  // the free end's face
+  EXPECT_EQ((*obs.frames[1].loads)[0].force, Vec3(0, 0, -0.5));
+  EXPECT_EQ((*obs.frames[1].loads)[1].nodes, (std::vector<int>{0, 3}));
+  EXPECT_TRUE(parse(frame("[]"), context).frames[1].loads->empty());  // none in this frame
+
+  EXPECT_EQ(error_of(frame(R"([{"nodes": [1], "force": [0, "a", 0]}])"), context),
+            "obs.json: frames[1].loads[0].force[1]: expected a number, got \"a\"");
+  EXPECT_EQ(error_of(frame(R"([{"nodes": [20], "force": [0, 0, -1]}])"), context),
+            "obs.json: frames[1].loads[0].nodes[0]: expected a whole number from 0 to 19, got 20");
+  EXPECT_EQ(error_of(frame(
+                         R"([{"box": {"min": [5, 5, 5], "max": [6, 6, 6]}, "force": [0, 0, 1]}])"),
+                     context),
+            "obs.json: frames[1].loads[0].box: expected a box around at least one node (rest "
+            "positions, object coordinates), got {\"max\":[6,6,6],\"min\":[5,5,5]}");
+  EXPECT_EQ(error_of(frame(R"([{"nodes": [1], "force": [0, 0, -1], "mass": 1}])"), context),
+            "obs.json: frames[1].loads[0].mass: unknown key; known: nodes, box, force");
+  EXPECT_EQ(error_of(frame(R"({"nodes": [1]})"), context),
+            "obs.json: frames[1].loads: expected a list of loads [{\"nodes\" or \"box\", "
+            "\"force\"}], got {\"nodes\":[1]}");
+  // A frame's pose of the object (its clamp), as the scene's object.pose.
+  const std::string posed = R"({"frames": [{"markers": [{"node": 1, "position": [0, 0, 0]}],
+      "object_pose": {"position": [0.1, 0, 0.2], "rpy": [1.5707963267948966, 0, 0]}}]})";
+  const Observations with_pose = parse(posed, context);
+  ASSERT_TRUE(with_pose.frames[0].object_pose.has_value());
+  EXPECT_TRUE(with_pose.frames[0].object_pose->translation().isApprox(Vec3(0.1, 0, 0.2)));
+  EXPECT_TRUE(
+      (with_pose.frames[0].object_pose->linear() * Vec3::UnitY()).isApprox(Vec3::UnitZ(), 1e-12));
+  EXPECT_NE(error_of(R"({"frames": [{"markers": [{"node": 1, "position": [0, 0, 0]}],
+      "object_pose": {"position": [0, 0], "rpy": [0, 0, 0]}}]})",
+                     context)
+                .find("obs.json: frames[0].object_pose.position"),
+            std::string::npos);
+  // Without the mesh (a frame from a network message) there is nothing to select nodes of.
+  EXPECT_EQ(error_of(frame("[]"), {.node_count = 20}),
+            "obs.json: frames[1].loads: per-frame conditions are read only from an observations "
+            "file (or Python), not from a live channel");
 }
 
 TEST(Observations, JointsMustNameEveryActiveJointAndNoOther) {

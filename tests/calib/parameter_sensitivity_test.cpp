@@ -128,6 +128,55 @@ TEST_P(ParameterSensitivity, MaterialAndPoseOfAClampedBarMatchCentralDifferences
   }
 }
 
+// Issue 35: a frame of its own loads (a weight hung from the free end, pulling sideways too),
+// the bar of two materials (its free half a region of its own): every material's columns, the
+// region's included, and the pose's, whose rotation turns the loads with gravity in the bar's
+// frame, match central differences of that frame's equilibria.
+TEST_P(ParameterSensitivity, MaterialsRegionsAndPoseOfALoadedFrameMatchCentralDifferences) {
+  Scene scene = with_solver(clamped_scene());
+  scene.regions.push_back({.box = AlignedBox{Vec3(0, -1, -1), Vec3(1, 1, 1)},
+                           .material = material_from_youngs(8e4, 0.35, 90)});
+  ObservationFrame loaded;
+  const NodeSelection free_end{.box = AlignedBox{Vec3(0.099, -1, -1), Vec3(1, 1, 1)}, .nodes = {}};
+  loaded.loads = std::vector<NodeLoad>{
+      {.nodes = free_end.resolve(*scene.object_mesh), .force = Vec3(0.005, 0.01, -0.04)}};
+  const Observations frames{.frames = {ObservationFrame{}, loaded, loaded}};
+  FitSelection all{.youngs_modulus = true,
+                   .poisson_ratio = true,
+                   .density = true,
+                   .object_pose = true};
+  for (const char* name : {"youngs_modulus", "poisson_ratio", "density"})
+    all.regions.push_back({0, name});
+  const ParameterSpace space(scene, all);
+  ASSERT_EQ(space.size(), 3 + 6 + 3);
+  EXPECT_EQ(space.coordinates()[3].name, "regions[0].youngs_modulus");
+  const PhysicalParameters p = PhysicalParameters::of(scene);
+  const Equilibria at =
+      frame_equilibria(scene, space, p, frames, nullptr, {.with_sensitivity = true});
+  ASSERT_EQ(at.frames.size(), 3u);
+  EXPECT_NE(at.frames[0], at.frames[1]);  // another load case
+  EXPECT_EQ(at.frames[1], at.frames[2]);  // the same one
+  Scene with_loads = scene;
+  with_loads.loads = *loaded.loads;
+  // The load moves the tip by centimetres: the frame's equilibrium is under it.
+  EXPECT_GT((at.frames[1]->positions - at.frames[0]->positions).cwiseAbs().maxCoeff(), 0.01);
+  EXPECT_TRUE(test::derivative_matches(at.frames[1]->positions, clamped_equilibrium(with_loads),
+                                       1e-9, "loaded equilibrium"));
+  const Eigen::MatrixXd& dx_dz = at.frames[1]->dx_dz;
+  for (int k = 0; k < space.size(); ++k) {
+    const ParameterCoordinate& c = space.coordinates()[k];
+    const auto moved = [&](const Eigen::VectorXd& u) -> Eigen::VectorXd {
+      Eigen::VectorXd dz = Eigen::VectorXd::Zero(space.size());
+      dz[k] = c.scale * u[0];
+      return clamped_equilibrium(space.advanced(p, dz).applied_to(with_loads));
+    };
+    const Eigen::MatrixXd numeric =
+        test::central_difference_jacobian(moved, Eigen::VectorXd::Zero(1), 1e-4);
+    EXPECT_TRUE(
+        test::derivative_matches(dx_dz.col(k) * c.scale, numeric, 1e-5, c.name, 1e-6 * c.scale));
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Each, ParameterSensitivity, testing::ValuesIn(test::kLinearSolvers),
                          test::linear_solver_name);
 
@@ -180,22 +229,30 @@ TEST(ParameterSpace, ObjectPoseIsRefusedForAnObjectTheRobotHolds) {
   EXPECT_EQ(refusal(clamped_scene(), {.object_pose = true}), "accepted");
 }
 
-// Calibration fits one material over the whole mesh and turns only the weight with the object.
-TEST(ParameterSpace, MaterialIsRefusedWithRegionsAndObjectPoseWithLoads) {
+// With regions, youngs_modulus etc. are the object's own material's, each region's its own; a
+// region the scene does not have is named. The pose turns the loads with the weight.
+TEST(ParameterSpace, RegionMaterialsAreFittedAndAMissingRegionIsNamed) {
   Scene two_materials = clamped_scene();
   two_materials.regions.push_back({.box = AlignedBox{Vec3(-1, -1, -1), Vec3(0, 1, 1)},
                                    .material = material_from_youngs(1e6, 0.3, 40)});
-  for (const FitSelection& fit :
-       {FitSelection{.youngs_modulus = true}, FitSelection{.poisson_ratio = true},
-        FitSelection{.density = true}})
-    EXPECT_NE(refusal(two_materials, fit).find("not fitted in a scene with \"regions\""),
-              std::string::npos);
-  EXPECT_EQ(refusal(two_materials, {.object_pose = true}), "accepted");
+  for (const char* fit : {"youngs_modulus", "poisson_ratio", "density", "regions[0].youngs_modulus",
+                          "regions[0].density,object_pose"})
+    EXPECT_EQ(refusal(two_materials, parse_fit_selection(fit)), "accepted") << fit;
+  EXPECT_EQ(refusal(two_materials, parse_fit_selection("regions[1].youngs_modulus")),
+            "regions[1].youngs_modulus: the scene has 1 region(s), regions[0] to regions[0]");
+  EXPECT_EQ(refusal(clamped_scene(), parse_fit_selection("regions[0].poisson_ratio")),
+            "regions[0].poisson_ratio: the scene has no \"regions\"");
+  const PhysicalParameters p = PhysicalParameters::of(two_materials);
+  ASSERT_EQ(p.regions.size(), 1u);
+  EXPECT_NEAR(p.regions[0].youngs_modulus, 1e6, 1e-3);
+  const ParameterSpace space(two_materials, parse_fit_selection("regions[0].youngs_modulus"));
+  const Scene moved =
+      space.advanced(p, Eigen::VectorXd::Constant(1, std::log(2.0))).applied_to(two_materials);
+  EXPECT_NEAR(youngs_modulus_of(moved.regions[0].material), 2e6, 1e-3);
+  EXPECT_NEAR(youngs_modulus_of(moved.material), youngs_modulus_of(two_materials.material), 1e-6);
   Scene loaded = clamped_scene();
   loaded.loads.push_back({.nodes = {3}, .force = Vec3(0, 0, -0.1)});
-  EXPECT_EQ(refusal(loaded, {.object_pose = true}),
-            "object_pose: not fitted in a scene with \"loads\"");
-  EXPECT_EQ(refusal(loaded, {.youngs_modulus = true}), "accepted");
+  EXPECT_EQ(refusal(loaded, {.object_pose = true}), "accepted");
 }
 
 TEST(ParameterSpace, UnknownNamesAreRefused) {
@@ -205,6 +262,13 @@ TEST(ParameterSpace, UnknownNamesAreRefused) {
   EXPECT_TRUE(s.density && s.grip_offsets && !s.youngs_modulus && !s.poisson_ratio &&
               !s.object_pose);
   EXPECT_TRUE(parse_fit_selection("object_pose").object_pose);
+  for (const char* bad : {"regions[].youngs_modulus", "regions[x].density", "regions[0].stiffness",
+                          "regions[0]youngs_modulus", "regions[-1].density"})
+    EXPECT_THROW(parse_fit_selection(bad), std::invalid_argument) << bad;
+  const FitSelection r = parse_fit_selection("regions[2].poisson_ratio,youngs_modulus");
+  ASSERT_EQ(r.regions.size(), 1u);
+  EXPECT_EQ(r.regions[0].region, 2);
+  EXPECT_EQ(r.regions[0].name, "poisson_ratio");
 }
 
 }  // namespace

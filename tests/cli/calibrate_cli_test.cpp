@@ -12,6 +12,7 @@
 #include <shapectl/calib/model_parameters.hpp>
 #include <shapectl/calib/simulated_camera.hpp>
 #include <shapectl/io/json_eigen.hpp>
+#include <shapectl/io/json_input.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
 #include <shapectl/scene_io/scene_writer.hpp>
 #include <shapectl/sim/object_statics.hpp>
@@ -392,6 +393,139 @@ TEST_F(CalibrateFixedCli, ParametersTheSceneDoesNotHaveExitOneNamingFit) {
   EXPECT_NE(pose.err.find("--fit: object_pose: the object is held by the robot's grips alone"),
             std::string::npos)
       << pose.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// Issue 35, load series: OBS.json frames of the clamped bar (truly 20 % softer and 25 % denser)
+// unloaded and with 7 g and 14 g hung from its free end, each frame's "loads" given: stiffness
+// and density both determined and written; the same frames without their loads leave density
+// not determined, and the report says to add loads.
+nlohmann::json load_series_observations(const Scene& truth, bool with_loads) {
+  SimulatedCamera camera;
+  for (int node = 3; node < truth.object_mesh->node_count(); node += 28)
+    camera.marker_nodes.push_back(node);
+  camera.sigma = 0.0005;
+  std::mt19937 rng(7);
+  nlohmann::json frames = nlohmann::json::array();
+  for (double grams : {0.0, 7.0, 14.0}) {
+    const nlohmann::json loads =
+        nlohmann::json::array({{{"box", {{"min", {0.159, -1, -1}}, {"max", {1, 1, 1}}}},
+                                {"force", {0, 0, -grams * 1e-3 * 9.81}}}});
+    Scene loaded = truth;
+    loaded.loads = read_loads(JsonInput(loads, "loads"), *truth.object_mesh);
+    Positions x = loaded.world_rest_positions();
+    const ObjectStatics statics(loaded);
+    EXPECT_TRUE(statics.solve(x).converged());
+    nlohmann::json frame =
+        frame_json(camera.observe(statics.mesh(), x, Eigen::VectorXd(), rng), {});
+    frame["sigma"] = camera.sigma;
+    if (with_loads) frame["loads"] = loads;
+    frames.push_back(frame);
+  }
+  return {{"frames", frames}};
+}
+
+TEST_F(CalibrateFixedCli, PerFrameLoadsSeparateStiffnessAndDensity) {
+  Scene real = model;
+  real.material =
+      material_from_youngs(0.8 * youngs_modulus_of(model.material),
+                           poisson_ratio_of(model.material), 1.25 * model.material.density);
+  const auto series = dir.write("series.json", load_series_observations(real, true).dump());
+  const auto run = run_cli({"calibrate", kClamped.string(), "--observations", series.string(),
+                            "--out", out, "--report", report, "--fit", "youngs_modulus,density"});
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json r = nlohmann::json::parse(test::read_text(report));
+  ASSERT_EQ(r["parameters"].size(), 2u);
+  for (const auto& p : r["parameters"]) EXPECT_EQ(p["verdict"], "determined") << p.dump();
+  const Scene calibrated = load_scene(out);
+  EXPECT_NEAR(youngs_modulus_of(calibrated.material) / youngs_modulus_of(real.material), 1, 0.03);
+  EXPECT_NEAR(calibrated.material.density / real.material.density, 1, 0.03);
+
+  const auto unloaded = dir.write("unloaded.json", load_series_observations(real, false).dump());
+  const auto blind = run_cli({"calibrate", kClamped.string(), "--observations", unloaded.string(),
+                              "--out", out, "--report", report, "--fit", "youngs_modulus,density"});
+  ASSERT_EQ(blind.exit_code, 0) << blind.err;
+  const nlohmann::json b = nlohmann::json::parse(test::read_text(report));
+  EXPECT_EQ(b["parameters"][1]["verdict"], "not determined");
+  EXPECT_NE(b["parameters"][1]["suggestion"].get<std::string>().find("\"loads\""),
+            std::string::npos);
+  EXPECT_NE(blind.err.find("hung from the free end"), std::string::npos) << blind.err;
+}
+
+TEST_F(CalibrateFixedCli, BadPerFrameLoadsAndRegionsExitOneNamingTheField) {
+  nlohmann::json bad = nlohmann::json::parse(test::read_text(observations));
+  bad["frames"][1]["loads"] = {{{"nodes", {3}}, {"force", {0, 0, "heavy"}}}};
+  const auto file = dir.write("bad.json", bad.dump());
+  const auto run =
+      run_cli({"calibrate", kClamped.string(), "--observations", file.string(), "--out", out});
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("bad.json: frames[1].loads[0].force[2]: expected a number"),
+            std::string::npos)
+      << run.err;
+  bad["frames"][1]["loads"] = {
+      {{"box", {{"min", {5, 5, 5}}, {"max", {6, 6, 6}}}}, {"force", {0, 0, -1}}}};
+  const auto nowhere = dir.write("nowhere.json", bad.dump());
+  const auto empty =
+      run_cli({"calibrate", kClamped.string(), "--observations", nowhere.string(), "--out", out});
+  EXPECT_EQ(empty.exit_code, 1) << empty.err;
+  EXPECT_NE(empty.err.find("nowhere.json: frames[1].loads[0].box: expected a box around at least "
+                           "one node"),
+            std::string::npos)
+      << empty.err;
+  const auto region =
+      run_cli({"calibrate", kClamped.string(), "--observations", observations.string(), "--out",
+               out, "--fit", "regions[1].youngs_modulus"});
+  EXPECT_EQ(region.exit_code, 1) << region.err;
+  EXPECT_NE(region.err.find("--fit: regions[1].youngs_modulus: the scene has no \"regions\""),
+            std::string::npos)
+      << region.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+// Issue 35: "priors" and "bounds" in the observations file, --prior's and --bounds' syntax;
+// the command line's entries win; bad ones name the file and the field.
+TEST_F(CalibrateFixedCli, PriorsAndBoundsInTheObservationsFileUnderTheCommandLine) {
+  nlohmann::json obs = nlohmann::json::parse(test::read_text(observations));
+  obs["priors"] = "youngs_modulus=10%,object_pose=5mm/1deg";
+  obs["bounds"] = "youngs_modulus=1e4:1e7";
+  const auto file = dir.write("with_priors.json", obs.dump());
+  const auto prior_of = [&](const std::vector<std::string>& extra, std::size_t k) {
+    std::vector<std::string> args = {"calibrate",      kClamped.string(),
+                                     "--observations", file.string(),
+                                     "--out",          out,
+                                     "--report",       report};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const auto run = run_cli(args);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return nlohmann::json::parse(test::read_text(report))["parameters"][k]["prior"].get<double>();
+  };
+  const double E = youngs_modulus_of(model.material);
+  EXPECT_NEAR(prior_of({}, 0), 0.1 * E, 1e-9 * E);
+  EXPECT_NEAR(prior_of({}, 1), 0.005, 1e-12);  // object_pose.x
+  EXPECT_NEAR(prior_of({"--prior", "youngs_modulus=20%"}, 0), 0.2 * E, 1e-9 * E);
+  EXPECT_NEAR(prior_of({"--prior", "youngs_modulus=20%"}, 1), 0.005, 1e-12);  // the file's
+
+  obs["bounds"] = "youngs_modulus=1e6:1e8";  // the scene's 200 kPa outside
+  const auto outside = dir.write("outside.json", obs.dump());
+  const auto run =
+      run_cli({"calibrate", kClamped.string(), "--observations", outside.string(), "--out", out});
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_NE(run.err.find("outside.json: bounds: youngs_modulus: the scene's value"),
+            std::string::npos)
+      << run.err;
+  const auto widened = run_cli({"calibrate", kClamped.string(), "--observations", outside.string(),
+                                "--out", out, "--bounds", "youngs_modulus=1e3:1e8"});
+  EXPECT_EQ(widened.exit_code, 0) << widened.err;
+  std::filesystem::remove(out);
+
+  obs.erase("bounds");
+  obs["priors"] = "stiffness=5%";
+  const auto unknown = dir.write("unknown.json", obs.dump());
+  const auto bad =
+      run_cli({"calibrate", kClamped.string(), "--observations", unknown.string(), "--out", out});
+  EXPECT_EQ(bad.exit_code, 1) << bad.err;
+  EXPECT_NE(bad.err.find("unknown.json: priors: \"stiffness=5%\": unknown name"), std::string::npos)
+      << bad.err;
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 

@@ -224,7 +224,8 @@ std::string suggestion(Kind kind, const std::vector<Kind>& partners) {
   const auto grip = [](Kind k) { return k == Kind::GripTranslation || k == Kind::GripRotation; };
   const auto pose = [](Kind k) { return k == Kind::PoseTranslation || k == Kind::PoseRotation; };
   if (has(is(Kind::LogYoungsModulus)) && has(is(Kind::LogDensity)))
-    return "add a frame with a different load (a hanging weight of known mass), or weigh the "
+    return "add a frame with a different load of known size (its \"loads\" in the observations "
+           "file: a hanging weight of known mass, e.g. hung from the free end), or weigh the "
            "object and give its density: under gravity alone the shape shows only E/density";
   if (is_material(kind) && any_partner(grip))
     return "a second robot pose that turns the object against gravity";
@@ -241,8 +242,15 @@ std::string suggestion(Kind kind, const std::vector<Kind>& partners) {
   return "markers not all on one line, or points on the object's end faces";
 }
 
-// Frames whose joints do not fit the scene (observations read for another scene).
-void check_frames(const Scene& scene, const Observations& observations) {
+// Frames whose joints do not fit the scene (observations read for another scene); a fitted pose
+// where frames give theirs.
+void check_frames(const Scene& scene, const Observations& observations, const FitSelection& fit) {
+  for (std::size_t k = 0; k < observations.frames.size() && fit.object_pose; ++k)
+    if (observations.frames[k].object_pose)
+      throw std::invalid_argument(
+          "object_pose: not fitted when frames give their own "
+          "(frames[" +
+          std::to_string(k) + "].object_pose: a known condition)");
   const Eigen::Index joints = scene.robot ? scene.robot->model->active_count() : 0;
   for (std::size_t k = 0; k < observations.frames.size(); ++k)
     if (observations.frames[k].joints.size() != joints)
@@ -263,9 +271,9 @@ Eigen::MatrixXd columns(const Eigen::MatrixXd& J, const std::vector<int>& active
 double reported_value(const ParameterCoordinate& c, const PhysicalParameters& p,
                       const PhysicalParameters& initial) {
   switch (c.kind) {
-    case Kind::LogYoungsModulus: return p.youngs_modulus;
-    case Kind::PoissonLogit: return p.poisson_ratio;
-    case Kind::LogDensity: return p.density;
+    case Kind::LogYoungsModulus: return p.material(c.region).youngs_modulus;
+    case Kind::PoissonLogit: return p.material(c.region).poisson_ratio;
+    case Kind::LogDensity: return p.material(c.region).density;
     case Kind::GripTranslation: return p.grip_offsets[c.grip].translation()[c.axis];
     case Kind::GripRotation: {
       const Eigen::AngleAxisd r(p.grip_offsets[c.grip].linear());
@@ -327,7 +335,7 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
                             const FitSelection& fit, const CalibrationOptions& options) {
   const auto started = std::chrono::steady_clock::now();
   if (observations.frames.empty()) throw std::invalid_argument("no observed frames");
-  check_frames(scene, observations);
+  check_frames(scene, observations, fit);
   const ParameterSpace space(scene, fit);
   const PhysicalParameters initial = PhysicalParameters::of(scene);
   if (const std::string name = outside_bounds(space, initial, options.bounds); !name.empty())

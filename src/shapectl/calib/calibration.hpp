@@ -113,7 +113,8 @@ struct CalibrationResult {
 };
 
 // Throws std::invalid_argument for a selection the scene does not allow (ParameterSpace) or
-// observations that do not match it (joints of another robot, or joints without one),
+// observations that do not match it (joints of another robot, or joints without one; a fitted
+// object_pose where frames give their own),
 // std::runtime_error when a frame's equilibrium cannot be found or the fit is stopped (time
 // budget, cancel) before the model was evaluated at the initial values. Throws
 // std::invalid_argument too for a scene value outside options.bounds.

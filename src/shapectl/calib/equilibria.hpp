@@ -5,8 +5,10 @@
 // - a robot holds the object: each frame has its own equilibrium at the frame's joints (Newton
 //   from a warm start, or walked from the reference joints, calib/joint_path.hpp), and
 //   dx̂/dz = H⁻¹ ∂F/∂z;
-// - fixed nodes alone hold it: every frame sees the one equilibrium, solved once, and dx̂/dz
-//   = H⁻¹ ∂F/∂z plus the rigid motion of the object's pose (ParameterSpace::pose_motion).
+// - fixed nodes alone hold it: the frames of one load case see one equilibrium, solved once,
+//   and dx̂/dz = H⁻¹ ∂F/∂z plus the rigid motion of the object's pose
+//   (ParameterSpace::pose_motion).
+// Each frame's equilibrium is under its own loads (ObservationFrame::loads) or the scene's.
 // Nothing else: an object held by neither cannot be loaded.
 #include <memory>
 #include <vector>

@@ -1,6 +1,7 @@
 #include <shapectl/calib/model_parameters.hpp>
 
 #include <cmath>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -31,12 +32,71 @@ void move(Eigen::Isometry3d& T, const Vec3& dt, const Vec3& dr) {
   T.translation() += dt;
 }
 
-// ∂E_elastic/∂x for a material with only μ = 1 (or only κ = 1): the energy is linear in both.
-Eigen::VectorXd unit_elastic_gradient(const TetMesh& mesh, const Positions& x, double mu,
-                                      double kappa) {
+// Materials for the elements of `region` alone (owner as Scene::element_regions), the others
+// none: the energy is linear in (μ, κ) and the weight in ρ, element by element.
+std::vector<Material> region_only(const std::vector<int>& owner, int region, const Material& m) {
+  std::vector<Material> out(owner.size());
+  for (std::size_t e = 0; e < owner.size(); ++e)
+    if (owner[e] == region) out[e] = m;
+  return out;
+}
+
+// ∂E_elastic/∂x of the elements of `region` with moduli (μ, κ).
+Eigen::VectorXd region_elastic_gradient(const TetMesh& mesh, const std::vector<int>& owner,
+                                        int region, const Positions& x, double mu, double kappa) {
   Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
-  NeoHookean(mesh, Material{.mu = mu, .kappa = kappa, .density = 0}).add_gradient(x, g);
+  NeoHookean(mesh, region_only(owner, region, Material{.mu = mu, .kappa = kappa, .density = 0}))
+      .add_gradient(x, g);
   return g;
+}
+
+// The weight of the elements of `region` (ρ of `m`), N per node, stacked.
+Eigen::VectorXd region_weight(const TetMesh& mesh, const std::vector<int>& owner, int region,
+                              const Positions& x, const Material& m, const Vec3& gravity) {
+  Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
+  Gravity(mesh, region_only(owner, region, m), gravity).add_gradient(x, g);
+  return -g;
+}
+
+const char* const kMaterialNames[] = {"youngs_modulus", "poisson_ratio", "density"};
+
+// "regions[1].youngs_modulus" → {1, "youngs_modulus"}; nullopt for anything else.
+std::optional<RegionParameter> parse_region_parameter(const std::string& item) {
+  const std::string prefix = "regions[";
+  if (item.rfind(prefix, 0) != 0) return std::nullopt;
+  const std::size_t close = item.find("].", prefix.size());
+  if (close == std::string::npos || close == prefix.size() || close - prefix.size() > 6)
+    return std::nullopt;
+  const std::string index = item.substr(prefix.size(), close - prefix.size());
+  if (index.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  const std::string name = item.substr(close + 2);
+  for (const char* known : kMaterialNames)
+    if (name == known) return RegionParameter{std::stoi(index), name};
+  return std::nullopt;
+}
+
+// ∂F/∂z of a material coordinate c (of region c.region) at x: elasticity is linear in (μ, κ)
+// and E scales both, so ∂F/∂ln E = −∂E_elastic/∂x of the region's elements; ν moves (μ, κ)
+// along (dμ/dν, dκ/dν); the weight is ∝ ρ.
+Eigen::VectorXd material_force_derivative(const TetMesh& mesh, const std::vector<int>& owner,
+                                          const ParameterCoordinate& c, const Positions& x,
+                                          const Scene& scene, const PhysicalParameters& p) {
+  const Material& m = c.region < 0 ? scene.material : scene.regions[c.region].material;
+  if (c.kind == Kind::LogYoungsModulus)
+    return -region_elastic_gradient(mesh, owner, c.region, x, m.mu, m.kappa);
+  if (c.kind == Kind::LogDensity) return region_weight(mesh, owner, c.region, x, m, scene.gravity);
+  // dμ/dν and dκ/dν of material_from_youngs, times dν/ds.
+  const double nu = p.material(c.region).poisson_ratio, E = p.material(c.region).youngs_modulus;
+  const double dmu_dnu = -E / (2 * (1 + nu) * (1 + nu));
+  const double dkappa_dnu = E * (1 + 2 * nu * nu) / std::pow((1 + nu) * (1 - 2 * nu), 2);
+  const double dnu_ds = nu * (1 - 2 * nu);
+  return -region_elastic_gradient(mesh, owner, c.region, x, dmu_dnu, dkappa_dnu) * dnu_ds;
+}
+
+Kind material_kind(const std::string& name) {
+  if (name == "youngs_modulus") return Kind::LogYoungsModulus;
+  if (name == "poisson_ratio") return Kind::PoissonLogit;
+  return Kind::LogDensity;
 }
 
 const char* axis_name(bool rotation, int axis) {
@@ -62,15 +122,14 @@ std::string object_pose_refusal(const Scene& scene) {
     return "object_pose: the object is held by the robot's grips alone, which tie it to the "
            "grippers: its pose follows the joints (fit grip_offsets for where they hold it)";
   if (!scene.fixed) return "object_pose: the scene has no fixed nodes to place";
-  // Its force derivatives turn the weight with the object, not the loads.
-  if (!scene.loads.empty()) return "object_pose: not fitted in a scene with \"loads\"";
   return "";
 }
 
 }  // namespace
 
 const char* fit_parameter_names() {
-  return "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose";
+  return "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose, "
+         "regions[K].youngs_modulus, regions[K].poisson_ratio, regions[K].density";
 }
 
 const char* default_fit(const Scene& scene) {
@@ -87,10 +146,10 @@ FitSelection parse_fit_selection(const std::string& list) {
     else if (item == "density") s.density = true;
     else if (item == "grip_offsets") s.grip_offsets = true;
     else if (item == "object_pose") s.object_pose = true;
+    else if (const auto region = parse_region_parameter(item)) s.regions.push_back(*region);
     else
-      throw std::invalid_argument(
-          "unknown parameter \"" + item +
-          "\" (expected youngs_modulus, poisson_ratio, density, grip_offsets or object_pose)");
+      throw std::invalid_argument("unknown parameter \"" + item + "\" (expected " +
+                                  fit_parameter_names() + ")");
   }
   if (s.empty())
     throw std::invalid_argument("no parameter to fit (expected a comma-separated list)");
@@ -104,29 +163,57 @@ PhysicalParameters PhysicalParameters::of(const Scene& scene) {
   p.density = scene.material.density;
   for (const Grip& g : scene.grips) p.grip_offsets.push_back(g.offset);
   p.object_pose = scene.T_world_object;
+  for (const MaterialRegion& r : scene.regions)
+    p.regions.push_back(
+        {youngs_modulus_of(r.material), poisson_ratio_of(r.material), r.material.density});
   return p;
+}
+
+MaterialValues PhysicalParameters::material(int region) const {
+  if (region >= 0) return regions[region];
+  return {youngs_modulus, poisson_ratio, density};
+}
+
+void PhysicalParameters::set_material(int region, const MaterialValues& values) {
+  if (region >= 0) {
+    regions[region] = values;
+    return;
+  }
+  youngs_modulus = values.youngs_modulus;
+  poisson_ratio = values.poisson_ratio;
+  density = values.density;
 }
 
 Scene PhysicalParameters::applied_to(const Scene& scene) const {
   Scene out = scene;
   out.material = material_from_youngs(youngs_modulus, poisson_ratio, density);
+  for (std::size_t k = 0; k < out.regions.size(); ++k)
+    out.regions[k].material = material_from_youngs(regions[k].youngs_modulus,
+                                                   regions[k].poisson_ratio, regions[k].density);
   for (std::size_t k = 0; k < out.grips.size(); ++k) out.grips[k].offset = grip_offsets[k];
   out.T_world_object = object_pose;
   return out;
 }
 
 ParameterSpace::ParameterSpace(const Scene& scene, const FitSelection& selection) {
-  // One material is fitted, its derivatives taken over the whole mesh.
-  if ((selection.youngs_modulus || selection.poisson_ratio || selection.density) &&
-      !scene.regions.empty())
-    throw std::invalid_argument(
-        "youngs_modulus, poisson_ratio, density: not fitted in a scene with \"regions\" "
-        "(calibration fits one material for the whole object)");
   if (selection.youngs_modulus)
     coordinates_.push_back({Kind::LogYoungsModulus, -1, -1, "youngs_modulus", 1});
   if (selection.poisson_ratio)
     coordinates_.push_back({Kind::PoissonLogit, -1, -1, "poisson_ratio", 1});
   if (selection.density) coordinates_.push_back({Kind::LogDensity, -1, -1, "density", 1});
+  for (const RegionParameter& r : selection.regions) {
+    const std::string name = "regions[" + std::to_string(r.region) + "]." + r.name;
+    if (r.region < 0 || r.region >= static_cast<int>(scene.regions.size()))
+      throw std::invalid_argument(name + ": " +
+                                  (scene.regions.empty()
+                                       ? std::string("the scene has no \"regions\"")
+                                       : "the scene has " + std::to_string(scene.regions.size()) +
+                                             " region(s), regions[0] to regions[" +
+                                             std::to_string(scene.regions.size() - 1) + "]"));
+    for (const ParameterCoordinate& c : coordinates_)
+      if (c.name == name) throw std::invalid_argument(name + ": named twice");
+    coordinates_.push_back({material_kind(r.name), -1, -1, name, 1, r.region});
+  }
   if (selection.grip_offsets) {
     if (scene.grips.empty()) throw std::invalid_argument("grip_offsets: the scene has no grips");
     for (std::size_t g = 0; g < scene.grips.size(); ++g) {
@@ -151,11 +238,16 @@ PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p,
   for (int k = 0; k < size(); ++k) {
     const ParameterCoordinate& c = coordinates_[k];
     switch (c.kind) {
-      case Kind::LogYoungsModulus: out.youngs_modulus *= std::exp(dz[k]); break;
-      case Kind::LogDensity: out.density *= std::exp(dz[k]); break;
+      case Kind::LogYoungsModulus:
+      case Kind::LogDensity:
       case Kind::PoissonLogit: {
-        const double s = std::log(2 * p.poisson_ratio / (1 - 2 * p.poisson_ratio)) + dz[k];
-        out.poisson_ratio = 0.5 / (1 + std::exp(-s));
+        MaterialValues m = out.material(c.region);
+        const double nu = p.material(c.region).poisson_ratio;
+        if (c.kind == Kind::LogYoungsModulus) m.youngs_modulus *= std::exp(dz[k]);
+        if (c.kind == Kind::LogDensity) m.density *= std::exp(dz[k]);
+        if (c.kind == Kind::PoissonLogit)
+          m.poisson_ratio = 0.5 / (1 + std::exp(-(std::log(2 * nu / (1 - 2 * nu)) + dz[k])));
+        out.set_material(c.region, m);
         break;
       }
       case Kind::GripTranslation: dt[c.grip][c.axis] = dz[k]; break;
@@ -171,10 +263,11 @@ PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p,
 
 double ParameterSpace::physical_per_coordinate(const ParameterCoordinate& c,
                                                const PhysicalParameters& p) const {
+  const MaterialValues m = p.material(c.region);
   switch (c.kind) {
-    case Kind::LogYoungsModulus: return p.youngs_modulus;
-    case Kind::LogDensity: return p.density;
-    case Kind::PoissonLogit: return p.poisson_ratio * (1 - 2 * p.poisson_ratio);
+    case Kind::LogYoungsModulus: return m.youngs_modulus;
+    case Kind::LogDensity: return m.density;
+    case Kind::PoissonLogit: return m.poisson_ratio * (1 - 2 * m.poisson_ratio);
     default: return 1;  // m and rad: the coordinates themselves
   }
 }
@@ -183,31 +276,24 @@ Eigen::MatrixXd ParameterSpace::force_derivatives(const ObjectStatics& statics, 
                                                   const Positions& x,
                                                   const PhysicalParameters& p) const {
   Eigen::MatrixXd dF = Eigen::MatrixXd::Zero(x.size(), size());
-  // Elasticity is linear in (μ, κ); E scales both, so ∂F/∂ln E = −∂E_elastic/∂x.
-  const double nu = p.poisson_ratio, E = p.youngs_modulus;
-  const Eigen::VectorXd g_mu = unit_elastic_gradient(statics.mesh(), x, 1, 0);
-  const Eigen::VectorXd g_kappa = unit_elastic_gradient(statics.mesh(), x, 0, 1);
-  const Material m = scene.material;
-  // dμ/dν and dκ/dν of material_from_youngs.
-  const double dmu_dnu = -E / (2 * (1 + nu) * (1 + nu));
-  const double dkappa_dnu = E * (1 + 2 * nu * nu) / std::pow((1 + nu) * (1 - 2 * nu), 2);
-  const double dnu_ds = nu * (1 - 2 * nu);
-  // Gravity's force mᵢ g: ∝ ρ, and turned by −δr when the scene turns by δr.
-  Eigen::VectorXd weight = Eigen::VectorXd::Zero(x.size());
-  Gravity(statics.mesh(), m.density, scene.gravity).add_gradient(x, weight);
-  weight = -weight;
+  const TetMesh& mesh = statics.mesh();
+  // Each element's region (all -1 without regions): a material's columns are its elements'.
+  const std::vector<int> owner =
+      scene.regions.empty() ? std::vector<int>(mesh.tets().size(), -1) : scene.element_regions();
+  // The external forces, world frame: turned by −δr in the object's frame when the scene turns
+  // by δr.
+  Eigen::VectorXd weight_gradient = Eigen::VectorXd::Zero(x.size());
+  Gravity(mesh, scene.element_materials(), scene.gravity).add_gradient(x, weight_gradient);
+  const Eigen::VectorXd external = scene.load_forces() - weight_gradient;
   for (int k = 0; k < size(); ++k) {
     const ParameterCoordinate& c = coordinates_[k];
-    switch (c.kind) {
-      case Kind::LogYoungsModulus: dF.col(k) = -(m.mu * g_mu + m.kappa * g_kappa); break;
-      case Kind::PoissonLogit: dF.col(k) = -(dmu_dnu * g_mu + dkappa_dnu * g_kappa) * dnu_ds; break;
-      case Kind::LogDensity: dF.col(k) = weight; break;
-      case Kind::PoseRotation:
-        for (Eigen::Index i = 0; i < x.size() / 3; ++i)
-          dF.col(k).segment<3>(3 * i) = Vec3(weight.segment<3>(3 * i)).cross(Vec3::Unit(c.axis));
-        break;
-      default: break;  // grip and pose translation columns: no force on the object itself
-    }
+    if (c.kind == Kind::PoseRotation) {
+      for (Eigen::Index i = 0; i < x.size() / 3; ++i)
+        dF.col(k).segment<3>(3 * i) = Vec3(external.segment<3>(3 * i)).cross(Vec3::Unit(c.axis));
+    } else if (c.kind == Kind::LogYoungsModulus || c.kind == Kind::PoissonLogit ||
+               c.kind == Kind::LogDensity) {
+      dF.col(k) = material_force_derivative(mesh, owner, c, x, scene, p);
+    }  // grip and pose translation columns: no force on the object itself
   }
   return dF;
 }

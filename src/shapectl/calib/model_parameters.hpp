@@ -4,13 +4,17 @@
 // (0, ½)), each grip's offset as 3 translations (m) and 3 rotations (rad) applied on the left,
 // O ← (exp([δr]) R, t + δt), about the TCP in the end effector's frame; the object's pose
 // T_world_object (scenes held by fixed nodes alone) the same way, in world axes about the
-// object frame's origin o: the whole scene, clamp included, moved by δ.
+// object frame's origin o: the whole scene, clamp included, moved by δ. A scene with "regions"
+// has one material per region besides its own (the elements in no region): each region's
+// Young's modulus, Poisson's ratio and density are coordinates of their own
+// ("regions[1].youngs_modulus"), their derivatives taken over that region's elements alone.
 //
 // For equilibria x̂ the forces' derivatives ∂F/∂z (F = −∂E/∂x) give the parameter sensitivity
 // dx̂/dz = H⁻¹ ∂F/∂z (GrippedObject::force_response), exactly as dx̂/dθ. The object's pose
 // adds a rigid part: moving the scene by δ moves its equilibrium by δ, under gravity turned
 // by R_δᵀ in the object's frame, so x̂(δ) = δ ∘ y(R_δᵀ g) and at δ = 0
-//   dx̂ᵢ/dδt = I,   dx̂ᵢ/dδr = −[x̂ᵢ − o]× + H⁻¹ ∂F/∂δr,   ∂Fᵢ/∂δr = mᵢ [g]× = [Fᵢ_gravity]×.
+//   dx̂ᵢ/dδt = I,   dx̂ᵢ/dδr = −[x̂ᵢ − o]× + H⁻¹ ∂F/∂δr,   ∂Fᵢ/∂δr = [Fᵢ_gravity + Fᵢ_loads]×
+// (the loads are world-frame forces too: they turn with gravity in the object's frame).
 #include <string>
 #include <vector>
 
@@ -19,25 +23,43 @@
 
 namespace shapectl {
 
-// What a calibration fits.
+// One material parameter of a region: "regions[1].youngs_modulus".
+struct RegionParameter {
+  int region = 0;    // index into Scene::regions
+  std::string name;  // "youngs_modulus", "poisson_ratio" or "density"
+};
+
+// What a calibration fits. With "regions", youngs_modulus etc. are the object's own material's
+// (the elements in no region).
 struct FitSelection {
   bool youngs_modulus = false;
   bool poisson_ratio = false;
   bool density = false;
   bool grip_offsets = false;
   bool object_pose = false;
+  std::vector<RegionParameter> regions = {};
   bool empty() const {
-    return !(youngs_modulus || poisson_ratio || density || grip_offsets || object_pose);
+    return !(youngs_modulus || poisson_ratio || density || grip_offsets || object_pose) &&
+           regions.empty();
   }
 };
-// Parsed from "youngs_modulus,poisson_ratio,density,grip_offsets,object_pose".
-// Throws std::invalid_argument naming the unknown entry and the known ones.
+// Parsed from "youngs_modulus,poisson_ratio,density,grip_offsets,object_pose,
+// regions[1].youngs_modulus". Throws std::invalid_argument naming the unknown entry and the
+// known ones.
 FitSelection parse_fit_selection(const std::string& list);
-// "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose": for messages.
+// "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose,
+// regions[K].youngs_modulus, ...": for messages.
 const char* fit_parameter_names();
 // What to fit when nobody says: a robot's grips are where the real object is held off; a
 // clamp is where the scene puts it.
 const char* default_fit(const Scene& scene);
+
+// One material's fittable values.
+struct MaterialValues {
+  double youngs_modulus = 0;  // Pa
+  double poisson_ratio = 0;
+  double density = 0;  // kg/m^3
+};
 
 struct PhysicalParameters {
   double youngs_modulus = 0;  // Pa
@@ -45,6 +67,11 @@ struct PhysicalParameters {
   double density = 0;                                             // kg/m^3
   std::vector<Eigen::Isometry3d> grip_offsets;                    // one per scene grip
   Eigen::Isometry3d object_pose = Eigen::Isometry3d::Identity();  // T_world_object
+  std::vector<MaterialValues> regions;                            // one per scene region
+
+  // Region r's material, or the object's own for r = -1.
+  MaterialValues material(int region) const;
+  void set_material(int region, const MaterialValues& values);
 
   static PhysicalParameters of(const Scene& scene);
   // The scene with these values (material, grip offsets, pose); everything else unchanged.
@@ -65,17 +92,19 @@ struct ParameterCoordinate {
   Kind kind;
   int grip = -1;  // for grip coordinates
   int axis = -1;  // 0..2 for grip and pose coordinates (the TCP frame's or the world's x, y, z)
-  // "youngs_modulus", "grip_offsets.left.x", "grip_offsets.left.rx", "object_pose.rz"
+  // "youngs_modulus", "grip_offsets.left.x", "grip_offsets.left.rx", "object_pose.rz",
+  // "regions[1].youngs_modulus"
   std::string name;
   // Typical size of a change worth noticing: 1 (a factor e) for the logarithms, 1 cm, 0.1 rad.
   double scale = 1;
+  int region = -1;  // material coordinates: the region's (-1: the object's own material)
 };
 
 class ParameterSpace {
  public:
   // Throws std::invalid_argument when the scene has nothing a selected parameter moves: no
   // grips for grip_offsets; for object_pose, an object the robot's grips hold (they tie it to
-  // the grippers, which are where the joints put them).
+  // the grippers, which are where the joints put them); a region the scene does not have.
   ParameterSpace(const Scene& scene, const FitSelection& selection);
   const std::vector<ParameterCoordinate>& coordinates() const { return coordinates_; }
   int size() const { return static_cast<int>(coordinates_.size()); }
@@ -85,8 +114,9 @@ class ParameterSpace {
   // ∂F/∂z at the equilibrium `state` of `object` (built from p.applied_to(scene)): 3n × size().
   Eigen::MatrixXd force_derivatives(const GrippedObject& object, const ObjectState& state,
                                     const PhysicalParameters& p) const;
-  // ∂F/∂z of the object's own forces (elasticity, gravity) at x, for `statics` built from
-  // `scene` = p.applied_to(original): 3n × size(), grip columns zero.
+  // ∂F/∂z of the object's own forces (elasticity, gravity, loads) at x, for `statics` built
+  // from `scene` = p.applied_to(original) (with a frame's loads): 3n × size(), grip columns
+  // zero.
   Eigen::MatrixXd force_derivatives(const ObjectStatics& statics, const Scene& scene,
                                     const Positions& x, const PhysicalParameters& p) const;
   // The rigid part of dx̂/dz at the equilibrium x: −[xᵢ − o]× for pose rotations, I for pose

@@ -7,6 +7,7 @@
 #include <shapectl/calib/point_cloud_file.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/robot/joints_file.hpp>
+#include <shapectl/scene_io/scene_file.hpp>  // read_loads, read_pose
 
 namespace shapectl {
 
@@ -100,10 +101,19 @@ std::vector<Vec3> read_points_file(const JsonInput& field, const ObservationCont
   return points;
 }
 
+// The frame's own loads, read and checked as the scene's (scene_io/scene_file.hpp).
+std::vector<NodeLoad> read_frame_loads(const JsonInput& list, const ObservationContext& context) {
+  if (!list.is_array()) list.fail("a list of loads [{\"nodes\" or \"box\", \"force\"}]");
+  std::vector<NodeLoad> loads = read_loads(list, *context.mesh);
+  refuse_empty_loads(list, loads);
+  return loads;
+}
+
 }  // namespace
 
 ObservationFrame read_observation_frame(const JsonInput& frame, const ObservationContext& context) {
-  frame.expect_only({"joints", "markers", "points", "points_file", "sigma", "time"});
+  frame.expect_only(
+      {"joints", "markers", "points", "points_file", "sigma", "time", "loads", "object_pose"});
   ObservationFrame out;
   out.joints = read_frame_joints(frame, context.robot);
   if (frame.has("markers")) out.markers = read_markers(frame.at("markers"), context.node_count);
@@ -115,17 +125,37 @@ ObservationFrame read_observation_frame(const JsonInput& frame, const Observatio
     frame.fail_problem("nothing observed; expected at least one marker or one point");
   if (frame.has("sigma")) out.sigma = frame.at("sigma").positive();
   if (frame.has("time")) out.time = frame.at("time").non_negative();
+  // Conditions change the model a frame is compared with: read where the scene is at hand (a
+  // file, Python), not from a live channel, whose frames the controller compares as they come.
+  for (const char* key : {"loads", "object_pose"})
+    if (frame.has(key) && !context.mesh)
+      frame.at(key).fail_problem(
+          "per-frame conditions are read only from an observations file (or Python), not from a "
+          "live channel");
+  if (frame.has("loads")) out.loads = read_frame_loads(frame.at("loads"), context);
+  if (frame.has("object_pose")) out.object_pose = read_pose(frame.at("object_pose"));
   return out;
 }
 
 Observations read_observations(const JsonInput& json, const ObservationContext& context) {
-  json.expect_only({"frames"});
+  json.expect_only({"frames", "priors", "bounds"});
   const JsonInput frames = json.at("frames");
   if (frames.size() == 0) frames.fail("a non-empty list of frames");
   if (frames.size() > max_observation_frames)
     frames.fail_problem(std::to_string(frames.size()) + " frames, more than the limit of " +
                         std::to_string(max_observation_frames));
   Observations out;
+  // --prior's and --bounds' grammar, their messages under the file's field.
+  try {
+    if (json.has("priors")) out.priors = parse_priors(json.at("priors").string());
+  } catch (const std::invalid_argument& e) {
+    json.at("priors").fail_problem(e.what());
+  }
+  try {
+    if (json.has("bounds")) out.bounds = parse_bounds(json.at("bounds").string());
+  } catch (const std::invalid_argument& e) {
+    json.at("bounds").fail_problem(e.what());
+  }
   std::size_t total_points = 0;
   for (std::size_t k = 0; k < frames.size(); ++k) {
     out.frames.push_back(read_observation_frame(frames.at(k), context));

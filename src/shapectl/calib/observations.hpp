@@ -4,20 +4,32 @@
 //   {"frames": [{"joints": {"yumi_joint_1_l": 0.1, ...},
 //                "markers": [{"node": 12, "position": [x, y, z]}, ...],
 //                "points": [[x, y, z], ...]   or   "points_file": "cloud.ply",
-//                "sigma": 0.0005, "time": 12.5}]}
+//                "sigma": 0.0005, "time": 12.5,
+//                "loads": [{"box": {...}, "force": [0, 0, -0.5]}]}],
+//    "priors": "youngs_modulus=50%", "bounds": "density=30:60"}
 // joints: every active joint of the robot (rad, m for prismatic), none other, each within its
 //   limits give or take observation_joint_margin; omitted for a scene without a robot. markers:
 //   distinct nodes. points_file: .xyz, .ply or .npy (calib/point_cloud_file.hpp), relative to the
 //   JSON file's directory. Each frame observes at least one marker or one point. sigma: the
 //   measurement noise (standard deviation, m, > 0, default default_observation_sigma). time:
-//   seconds (>= 0), optional.
+//   seconds (>= 0), optional. loads: the loads on the object in this frame (a weight hung from
+//   its free end), with the scene's "loads" schema and meaning (N, world frame, shared equally
+//   by the selected nodes); given, they replace the scene's loads for this frame ([] for none),
+//   omitted, the scene's apply. A series of known loads is what separates stiffness from
+//   density (docs/calibration.md, "Load series"). object_pose: where the object (with its clamp:
+//   its fixed nodes) was in this frame, {"position", "rpy"} as the scene's object.pose, which it
+//   replaces for this frame; a known condition (a clamp turned between frames), never fitted.
+//   priors, bounds (optional): what the one who measured knows, with --prior's and --bounds' syntax
+//   and meaning (calib/parameter_priors.hpp); the command line's entries win over the file's.
 #include <cstddef>
 #include <filesystem>
 #include <optional>
 #include <vector>
 
+#include <shapectl/calib/parameter_priors.hpp>
 #include <shapectl/io/json_input.hpp>
 #include <shapectl/robot/robot_model.hpp>
+#include <shapectl/sim/scene.hpp>
 #include <shapectl/types.hpp>
 
 namespace shapectl {
@@ -44,17 +56,25 @@ struct ObservationFrame {
   Eigen::VectorXd joints;               // θ, size robot.active_count(); size 0 without a robot
   std::vector<ObservedMarker> markers;  // distinct nodes
   std::vector<Vec3> points;             // unordered cloud, world frame, m
-  double sigma = default_observation_sigma;  // measurement noise (standard deviation), m
-  std::optional<double> time;                // s
+  double sigma = default_observation_sigma;      // measurement noise (standard deviation), m
+  std::optional<double> time;                    // s
+  std::optional<std::vector<NodeLoad>> loads;    // replaces the scene's loads; nullopt: the scene's
+  std::optional<Eigen::Isometry3d> object_pose;  // replaces T_world_object; nullopt: the scene's
 };
 
 struct Observations {
   std::vector<ObservationFrame> frames;  // at least one
+  // "priors" and "bounds": --prior's and --bounds' defaults changed by the file's entries.
+  std::optional<CalibrationPriors> priors = std::nullopt;
+  std::optional<MaterialBounds> bounds = std::nullopt;
 };
 
 struct ObservationContext {
   int node_count = 0;                 // of the object's mesh
   const RobotModel* robot = nullptr;  // null: a scene without a robot (frames have no joints)
+  // The object's rest mesh (object coordinates): a frame's "loads" select nodes of it; null (a
+  // live channel): a frame with loads or an object_pose is refused.
+  const TetMesh* mesh = nullptr;
   // Whether a frame may name a "points_file". load_observations allows it; JSON from a network
   // message leaves it off, so that a client cannot make the server read its files.
   bool allow_points_files = false;
@@ -64,9 +84,10 @@ struct ObservationContext {
 // a whole number from 0 to 424, got 500"): an empty or too long list of frames, a frame with
 // nothing observed, a node out of range or repeated, non-finite numbers, points beyond
 // max_observation_distance, a joint missing, not active or outside its limits (± the margin),
-// joints without a robot, both points and points_file, a points file that cannot be read (the
-// message names it and the problem), a points_file where they are not allowed, unknown keys, sizes
-// over the limits above.
+// joints without a robot, loads as the scene file refuses them (or on no node, or without
+// context.mesh), both points and points_file, a points file that cannot be read (the
+// message names it and the problem), a points_file where they are not allowed, priors or bounds
+// that --prior or --bounds would refuse, unknown keys, sizes over the limits above.
 Observations read_observations(const JsonInput& json, const ObservationContext& context);
 // One frame, e.g. from a WebSocket message: the object inside "frames" above.
 ObservationFrame read_observation_frame(const JsonInput& frame, const ObservationContext& context);

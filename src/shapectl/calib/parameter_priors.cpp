@@ -127,8 +127,8 @@ CalibrationPriors parse_priors(const std::string& text, CalibrationPriors base) 
   return p;
 }
 
-MaterialBounds parse_bounds(const std::string& text) {
-  MaterialBounds b;
+MaterialBounds parse_bounds(const std::string& text, MaterialBounds base) {
+  MaterialBounds b = base;
   for (const std::string& entry : split(text, ',')) {
     const std::size_t eq = entry.find('=');
     const std::string key = entry.substr(0, eq);
@@ -163,7 +163,8 @@ double prior_sigma(const CalibrationPriors& priors, const ParameterCoordinate& c
     case Kind::LogYoungsModulus: return priors.youngs_modulus;
     case Kind::LogDensity: return priors.density;
     // d ln ν / ds = 1 − 2ν: a relative σ of ν is σ / (1 − 2ν) in s.
-    case Kind::PoissonLogit: return priors.poisson_ratio / (1 - 2 * p.poisson_ratio);
+    case Kind::PoissonLogit:
+      return priors.poisson_ratio / (1 - 2 * p.material(c.region).poisson_ratio);
     case Kind::GripTranslation: return priors.grip_translation;
     case Kind::GripRotation: return priors.grip_rotation;
     case Kind::PoseTranslation: return priors.pose_translation;
@@ -196,10 +197,11 @@ std::string outside_bounds(const ParameterSpace& space, const PhysicalParameters
 }
 
 double material_coordinate(const ParameterCoordinate& c, const PhysicalParameters& p) {
+  const MaterialValues m = p.material(c.region);
   switch (c.kind) {
-    case Kind::LogYoungsModulus: return std::log(p.youngs_modulus);
-    case Kind::LogDensity: return std::log(p.density);
-    case Kind::PoissonLogit: return logit_of_poisson(p.poisson_ratio);
+    case Kind::LogYoungsModulus: return std::log(m.youngs_modulus);
+    case Kind::LogDensity: return std::log(m.density);
+    case Kind::PoissonLogit: return logit_of_poisson(m.poisson_ratio);
     default: return 0;
   }
 }

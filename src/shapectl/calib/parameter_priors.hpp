@@ -43,9 +43,9 @@ struct MaterialBounds {
 // off for no prior); "off" or "none" alone: no priors. Throws std::invalid_argument naming the
 // entry and what was expected.
 CalibrationPriors parse_priors(const std::string& text, CalibrationPriors base = {});
-// "youngs_modulus=1e3:1e8,density=:2000,poisson_ratio=0.3:0.45" (an empty side: unbounded).
-// Throws std::invalid_argument naming the entry.
-MaterialBounds parse_bounds(const std::string& text);
+// "youngs_modulus=1e3:1e8,density=:2000,poisson_ratio=0.3:0.45" (an empty side: unbounded):
+// entries change `base`. Throws std::invalid_argument naming the entry.
+MaterialBounds parse_bounds(const std::string& text, MaterialBounds base = {});
 
 // The prior's σ for coordinate c in its own units (0: none), the material's start values `p`.
 double prior_sigma(const CalibrationPriors& priors, const ParameterCoordinate& c,

@@ -253,30 +253,11 @@ std::vector<MaterialRegion> read_regions(const JsonInput& list, const Scene& sce
   return regions;
 }
 
-// "loads": [{"nodes" and/or "box", "force"}]: a force (N, world frame) shared equally by its
-// nodes (rest positions, object coordinates, as "fixed").
-std::vector<NodeLoad> read_loads(const JsonInput& list, const TetMesh& mesh) {
-  std::vector<NodeLoad> loads;
-  for (std::size_t k = 0; k < list.size(); ++k) {
-    const JsonInput l = list.at(k);
-    l.expect_only({"nodes", "box", "force"});
-    loads.push_back({.nodes = read_selection_keys(l, mesh.node_count()).resolve(mesh),
-                     .force = l.at("force").vec3_within(max_force, "a force", "N")});
-  }
-  return loads;
-}
-
 // A load on no node or a region of no element would silently change nothing. Checked after
 // check_scene, as the grips' regions are: a mesh drawn in mm misses every box, and the object's
 // size says why.
 void refuse_empty_selections(const JsonInput& root, const Scene& scene) {
-  for (std::size_t k = 0; k < scene.loads.size(); ++k) {
-    if (!scene.loads[k].nodes.empty()) continue;
-    const JsonInput l = root.at("loads").at(k);
-    if (l.has("box"))
-      l.at("box").fail("a box around at least one node (rest positions, object coordinates)");
-    l.at("nodes").fail("at least one node index");
-  }
+  if (root.has("loads")) refuse_empty_loads(root.at("loads"), scene.loads);
   const TetMesh& mesh = *scene.object_mesh;
   for (std::size_t k = 0; k < scene.regions.size(); ++k) {
     const MaterialRegion& region = scene.regions[k];
@@ -450,6 +431,29 @@ Scene load_scene(const std::filesystem::path& file) {
   scene.warnings = check_scene(scene);
   refuse_empty_selections(root, scene);
   return scene;
+}
+
+// "loads": [{"nodes" and/or "box", "force"}]: a force (N, world frame) shared equally by its
+// nodes (rest positions, object coordinates, as "fixed").
+std::vector<NodeLoad> read_loads(const JsonInput& list, const TetMesh& mesh) {
+  std::vector<NodeLoad> loads;
+  for (std::size_t k = 0; k < list.size(); ++k) {
+    const JsonInput l = list.at(k);
+    l.expect_only({"nodes", "box", "force"});
+    loads.push_back({.nodes = read_selection_keys(l, mesh.node_count()).resolve(mesh),
+                     .force = l.at("force").vec3_within(max_force, "a force", "N")});
+  }
+  return loads;
+}
+
+void refuse_empty_loads(const JsonInput& list, const std::vector<NodeLoad>& loads) {
+  for (std::size_t k = 0; k < loads.size(); ++k) {
+    if (!loads[k].nodes.empty()) continue;
+    const JsonInput l = list.at(k);
+    if (l.has("box"))
+      l.at("box").fail("a box around at least one node (rest positions, object coordinates)");
+    l.at("nodes").fail("at least one node index");
+  }
 }
 
 }  // namespace shapectl

@@ -26,6 +26,12 @@ Scene load_scene(const std::filesystem::path& file);
 // Parsers shared by scene-like files.
 AlignedBox read_box(const JsonInput& j);
 NodeSelection read_node_selection(const JsonInput& j, int node_count);
+// "loads": [{"nodes" and/or "box", "force"}], a force (N, world frame) shared equally by its
+// nodes (rest positions, object coordinates). A load on no node is left for the caller to
+// refuse (load_scene does after its checks; see refuse_empty_loads).
+std::vector<NodeLoad> read_loads(const JsonInput& list, const TetMesh& mesh);
+// Throws InputError naming "<list>[k].box" (or ".nodes") of the first load on no node.
+void refuse_empty_loads(const JsonInput& list, const std::vector<NodeLoad>& loads);
 // {"position": [x, y, z], "rpy": [roll, pitch, yaw]} (io/json_eigen.hpp: scene_pose_json).
 Eigen::Isometry3d read_pose(const JsonInput& j);
 // An "object.mesh" value (a file name, {"file", "units", ...} or {"box"}) as load_scene reads

@@ -37,20 +37,30 @@ Eigen::Isometry3d written_pose(const nlohmann::ordered_json& object,
 
 }  // namespace
 
+namespace {
+
+// The material's values in the form the file gives them (mu and kappa, or E and ν).
+void write_material(nlohmann::ordered_json& material, const Material& m) {
+  if (material.contains("mu")) {
+    material["mu"] = m.mu;
+    material["kappa"] = m.kappa;
+  } else {
+    material["youngs_modulus"] = youngs_modulus_of(m);
+    material["poisson_ratio"] = poisson_ratio_of(m);
+  }
+  material["density"] = m.density;
+}
+
+}  // namespace
+
 nlohmann::ordered_json scene_json_with_values(const std::filesystem::path& source,
                                               const Scene& scene,
                                               const std::filesystem::path& out) {
   nlohmann::ordered_json j =
       nlohmann::ordered_json::parse(read_input_file(source, max_json_file_bytes, "JSON"));
-  nlohmann::ordered_json& material = j["object"]["material"];
-  if (material.contains("mu")) {
-    material["mu"] = scene.material.mu;
-    material["kappa"] = scene.material.kappa;
-  } else {
-    material["youngs_modulus"] = youngs_modulus_of(scene.material);
-    material["poisson_ratio"] = poisson_ratio_of(scene.material);
-  }
-  material["density"] = scene.material.density;
+  write_material(j["object"]["material"], scene.material);
+  for (std::size_t k = 0; k < scene.regions.size(); ++k)
+    write_material(j["regions"][k]["material"], scene.regions[k].material);
   // A pose the file gives stays as written unless it changed (rpy would round it).
   if (scene.T_world_object.matrix() != written_pose(j["object"], source).matrix())
     j["object"]["pose"] = scene_pose_json(scene.T_world_object);

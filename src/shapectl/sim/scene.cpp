@@ -29,11 +29,19 @@ bool MaterialRegion::contains(const TetMesh& mesh, const TetRest& tet) const {
 
 std::vector<Material> Scene::element_materials() const {
   if (regions.empty()) return {material};
+  const std::vector<int> owner = element_regions();
+  std::vector<Material> out(owner.size(), material);
+  for (std::size_t e = 0; e < owner.size(); ++e)
+    if (owner[e] >= 0) out[e] = regions[owner[e]].material;
+  return out;
+}
+
+std::vector<int> Scene::element_regions() const {
   const auto& tets = object_mesh->tets();
-  std::vector<Material> out(tets.size(), material);
+  std::vector<int> out(tets.size(), -1);
   for (std::size_t e = 0; e < tets.size(); ++e)
-    for (const MaterialRegion& r : regions)
-      if (r.contains(*object_mesh, tets[e])) out[e] = r.material;
+    for (std::size_t r = 0; r < regions.size(); ++r)
+      if (regions[r].contains(*object_mesh, tets[e])) out[e] = static_cast<int>(r);
   return out;
 }
 

@@ -129,6 +129,9 @@ struct Scene {
   Positions world_rest_positions() const;
   // Each element's material (mesh.tets() order), or {material} alone when there are no regions.
   std::vector<Material> element_materials() const;
+  // Each element's region (mesh.tets() order): the index of the last region containing it, or
+  // -1 for the object's own material.
+  std::vector<int> element_regions() const;
   // The loads' nodal forces, stacked (3n), N, world frame.
   Eigen::VectorXd load_forces() const;
   // The sum of the loads' forces, N, world frame.
