@@ -293,3 +293,17 @@ export async function closeSession(session) {
   session?.ws?.close();
   await closeAll(session?.browser, session?.server);
 }
+
+// Page coordinates of the node nearest the object's centroid (a bent object's centroid may lie
+// off it): where a click adds a target at the middle of the object.
+export function centreNodeOnPage(page) {
+  return page.evaluate(() => {
+    const c = window.shapectl.objectCentroid(), x = window.shapectl.positions();
+    let nearest = 0, best = Infinity;
+    for (let i = 0; i < x.length; i += 3) {
+      const d = (x[i] - c[0]) ** 2 + (x[i + 1] - c[1]) ** 2 + (x[i + 2] - c[2]) ** 2;
+      if (d < best) { best = d; nearest = i / 3; }
+    }
+    return window.shapectl.nodeToPage(nearest);
+  });
+}

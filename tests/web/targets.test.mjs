@@ -7,7 +7,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { startServer, launchChromium, waitFor, openPage, colourNear, pixelsAt, RawWebSocket, sourceDir, closeAll } from './support.mjs';
+import { startServer, launchChromium, waitFor, openPage, colourNear, pixelsAt, RawWebSocket, sourceDir, closeAll, centreNodeOnPage } from './support.mjs';
 
 const cli = process.env.SHAPECTL_CLI ?? path.join(sourceDir, 'build/shapectl');
 const ORANGE = [0xff, 0x8c, 0x1a];      // targets and the followed centre-line
@@ -55,15 +55,7 @@ async function gripsDrawn(page) {
 // Clicks the node nearest the object's centroid (a bent object's centroid may lie off it).
 async function addTargetAtCentre(page) {
   await waitFor(() => hooks(page, () => window.shapectl.ready), 'the page to draw');
-  const centre = await hooks(page, () => {
-    const c = window.shapectl.objectCentroid(), x = window.shapectl.positions();
-    let nearest = 0, best = Infinity;
-    for (let i = 0; i < x.length; i += 3) {
-      const d = (x[i] - c[0]) ** 2 + (x[i + 1] - c[1]) ** 2 + (x[i + 2] - c[2]) ** 2;
-      if (d < best) { best = d; nearest = i / 3; }
-    }
-    return window.shapectl.nodeToPage(nearest);
-  });
+  const centre = await centreNodeOnPage(page);
   const before = (await state(page)).targets.length;
   await page.mouse.click(centre.x, centre.y);
   const s = await waitFor(async () => { const s = await state(page); return s.targets.length > before && s; }, 'a target from the click')

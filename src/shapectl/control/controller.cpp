@@ -426,6 +426,8 @@ void Controller::State::judge_stop() {
   } catch (const std::exception& e) {  // the probes' statics: the reasons stay unknown
     shortfall.detail = std::string("reasons unknown: ") + e.what();
   }
+  const std::string why = optimizer->why_stopped();
+  if (!why.empty()) shortfall.detail += "; the optimizer stopped: " + why;
   Eigen::Index j = 0;
   if (loop_start &&
       (current.joints() - *loop_start).cwiseAbs().maxCoeff(&j) >= options.trust_region - 1e-9) {

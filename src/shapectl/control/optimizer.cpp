@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <cstdio>
 
 #include <shapectl/enum_names.hpp>
 #include <shapectl/sim/rigid_motion.hpp>
@@ -77,6 +78,19 @@ StepOutcome GaussNewton::step(const ReducedObjective& objective, Evaluation& cur
   // Damping λ·max(diag JᵀJ)·I, not Marquardt's diag(JᵀJ): a 7-joint arm has self-motions
   // that barely move the object, and scaling by their tiny diagonal would let them run away.
   const double scale = std::max(A.diagonal().maxCoeff(), 1e-18);
+  // The trials this step refused, by why: for the words of a stop.
+  int no_equilibrium = 0, unsafe = 0, worse = 0;
+  const auto stop = [&](StepOutcome outcome, double step) {
+    char head[48] = "no step accepted", text[200];
+    if (step > 0) std::snprintf(head, sizeof head, "the last step was %.2g rad", step);
+    std::snprintf(text, sizeof text,
+                  "%s; longer trials refused: %d without a stable equilibrium within 25 Newton "
+                  "steps, %d into a collision or limit, %d worse",
+                  head, no_equilibrium, unsafe, worse);
+    stopped_ = text;
+    return outcome;
+  };
+  stopped_.clear();
   for (int attempt = 0; attempt < 12; ++attempt) {
     if (budget_spent()) return StepOutcome::OutOfTime;
     Eigen::MatrixXd damped = A;
@@ -110,11 +124,15 @@ StepOutcome GaussNewton::step(const ReducedObjective& objective, Evaluation& cur
       current = trial;
       if (gain > 0.75) damping_ = std::max(damping_ / 3, 1e-9);
       else if (gain < 0.25) damping_ *= 2;
-      return tiny ? StepOutcome::Converged : StepOutcome::Improved;
+      return tiny ? stop(StepOutcome::Converged, delta.cwiseAbs().maxCoeff())
+                  : StepOutcome::Improved;
     }
+    if (!trial.statics().converged()) ++no_equilibrium;
+    else if (current.safe() && !trial.safe()) ++unsafe;
+    else ++worse;
     damping_ = std::min(damping_ * 4, 1e6);
   }
-  return StepOutcome::Stuck;
+  return stop(StepOutcome::Stuck, 0);
 }
 
 void Lbfgs::reset() {

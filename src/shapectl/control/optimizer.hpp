@@ -32,6 +32,9 @@ class Optimizer {
   virtual StepOutcome step(const ReducedObjective& objective, Evaluation& current) = 0;
   // Forget accumulated curvature/damping, e.g. after the targets changed.
   virtual void reset() = 0;
+  // Why the last step that did not improve (converged or stuck) ended there, in words with
+  // numbers, for a best effort's reason; empty when the optimizer keeps no account.
+  virtual std::string why_stopped() const { return {}; }
   // A trust region: the joints no trial may leave, per joint (rad). Empty: none (the paper's
   // method). Trials are projected into it (the current joints must be inside); the controller
   // holds what the feedback may do with it (control/controller.hpp).
@@ -64,6 +67,7 @@ class GaussNewton : public Optimizer {
   std::string name() const override { return to_string(OptimizerKind::GaussNewton); }
   StepOutcome step(const ReducedObjective& objective, Evaluation& current) override;
   void reset() override { damping_ = kInitialDamping; }
+  std::string why_stopped() const override { return stopped_; }
   double max_step = 0.3;  // rad, largest joint change per trial
 
  private:
@@ -73,6 +77,7 @@ class GaussNewton : public Optimizer {
   // that the buckling case creeps along the bifurcation for seconds; 3e-3 is best for both.
   static constexpr double kInitialDamping = 3e-3;
   double damping_ = kInitialDamping;
+  std::string stopped_;
 };
 
 // L-BFGS with a backtracking (Armijo) line search, as in the paper.

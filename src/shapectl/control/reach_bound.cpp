@@ -79,14 +79,18 @@ std::string metres(double value) {
   return out.str();
 }
 
+// "joint 'j1'", or the gripping link when no joint moves it.
+std::string base_name(const RobotModel& robot, const ArmReach& arm) {
+  return arm.base_joint >= 0
+             ? "joint '" + robot.joints()[static_cast<std::size_t>(arm.base_joint)].name + "'"
+             : "link '" + robot.links()[static_cast<std::size_t>(arm.link)].name + "'";
+}
+
 // "target 529 m from joint 'j1' (at [..]), the base of the arm holding node 12; the robot
 // reaches at most 4.2 m with that node (...)"
 std::string beyond_reach(const char* what, double distance, const RobotModel& robot,
                          const ArmReach& arm, const std::string& with, double bound) {
-  const std::string base =
-      arm.base_joint >= 0
-          ? "joint '" + robot.joints()[static_cast<std::size_t>(arm.base_joint)].name + "'"
-          : "link '" + robot.links()[static_cast<std::size_t>(arm.link)].name + "'";
+  const std::string base = base_name(robot, arm);
   return std::string(what) + " " + metres(distance) + " from " + base + " (at " +
          point_text(arm.base) + "), where the arm gripping with link '" +
          robot.links()[static_cast<std::size_t>(arm.link)].name +
@@ -131,8 +135,9 @@ std::vector<ArmReach> reach_bounds(const GrippedObject& object) {
       gripped.push_back(h.node);
     }
     const double spring = object.statics().weight() / object.grips().stiffness();
-    arm.node_bound = path_lengths(object.mesh(), gripped);
+    arm.node_bound = arm.rest_bound = path_lengths(object.mesh(), gripped);
     for (double& d : arm.node_bound) d = length + anchor + spring + max_edge_stretch * d;
+    for (double& d : arm.rest_bound) d = length + anchor + spring + d;
     arms.push_back(std::move(arm));
   }
   return arms;
@@ -150,6 +155,30 @@ void check_targets_in_reach(const GrippedObject& object, const ShapeTargets& tar
                          beyond_reach("target", distance, object.robot(), arm,
                                       "node " + std::to_string(node), bound));
     }
+}
+
+std::string beyond_unstretched_reach(const GrippedObject& object, const ShapeTargets& targets) {
+  const ArmReach* worst_arm = nullptr;
+  int worst = -1;
+  double excess = 0, distance = 0;
+  const std::vector<ArmReach> arms = reach_bounds(object);
+  for (const ArmReach& arm : arms)
+    for (int k = 0; k < targets.size(); ++k) {
+      const int node = targets.nodes[static_cast<std::size_t>(k)];
+      const double d = (targets.positions[static_cast<std::size_t>(k)] - arm.base).norm();
+      if (d - arm.rest_bound[static_cast<std::size_t>(node)] <= excess) continue;
+      excess = d - arm.rest_bound[static_cast<std::size_t>(node)];
+      distance = d, worst = k, worst_arm = &arm;
+    }
+  if (!worst_arm) return {};
+  const RobotModel& robot = object.robot();
+  const auto node = static_cast<std::size_t>(targets.nodes[static_cast<std::size_t>(worst)]);
+  return "node " + std::to_string(node) + "'s target is " + metres(distance) + " from " +
+         base_name(robot, *worst_arm) + ", where the arm gripping with link '" +
+         robot.links()[static_cast<std::size_t>(worst_arm->link)].name +
+         "' starts: " + metres(excess) + " beyond the " + metres(worst_arm->rest_bound[node]) +
+         " it reaches with that node unstretched (" + metres(worst_arm->node_bound[node]) +
+         " stretched tenfold)";
 }
 
 void check_centerline_in_reach(const GrippedObject& object, const std::vector<Vec3>& centerline,

@@ -10,6 +10,8 @@
 //            plus the node's rest path length d along mesh edges from the link's gripped nodes,
 //            each edge stretched at most λ = 10 times (900 % strain, far past any equilibrium a
 //            neo-Hookean model of a real object reaches; the bound is meant to be loose).
+// The same sum with the object unstretched (λ = 1) is the reach a best effort names: a target
+// beyond it is reached, if at all, only by stretching the object (control/shortfall.hpp).
 #include <string>
 #include <vector>
 
@@ -26,6 +28,7 @@ struct ArmReach {
   int base_joint = -1;             // the first movable joint on its chain; -1: the link never moves
   Vec3 base = Vec3::Zero();        // that joint's origin (else the link's), world frame, m
   std::vector<double> node_bound;  // per node: |x − base| ≤ node_bound, m (+inf: no path)
+  std::vector<double> rest_bound;  // per node: the same with every edge at its rest length
 };
 
 // One per link gripping nodes. +inf bounds when a prismatic joint on the chain has no limits.
@@ -36,6 +39,11 @@ std::vector<ArmReach> reach_bounds(const GrippedObject& object);
 // is beyond a bound. Targets as check_targets accepts them.
 void check_targets_in_reach(const GrippedObject& object, const ShapeTargets& targets,
                             const std::string& source);
+// The target farthest beyond an arm's reach with the object unstretched (rest_bound), in words:
+// "node 212's target is 1.10 m from joint 'j1', where the arm gripping with link 'tool' starts:
+// 0.24 m beyond the 0.86 m it reaches with that node unstretched (2.4 m stretched tenfold)".
+// Empty when every target is within. Depends on the targets alone, never on a pose.
+std::string beyond_unstretched_reach(const GrippedObject& object, const ShapeTargets& targets);
 // The same for a centre-line's points, against the largest bound of any node (any node may be
 // sent to a point): "<source>: centerline[4]: point 529 m from ...".
 void check_centerline_in_reach(const GrippedObject& object, const std::vector<Vec3>& centerline,

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <set>
 
+#include <shapectl/control/reach_bound.hpp>
 #include <shapectl/enum_names.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
 #include <shapectl/robot/kinematics.hpp>
@@ -148,18 +149,25 @@ ShortfallReport find_shortfalls(const ReducedObjective& objective, Evaluation& a
   if (objective.targets().empty() || !at.statics().converged()) return report;
   const Eigen::VectorXd d = shape_descent(objective, at);
   const std::pair<Shortfall, std::string> found[] = {
+      {Shortfall::Reach, reach(objective, at)},
       {Shortfall::JointLimit, joint_limit(objective, at, d)},
       {Shortfall::Collision, collision(objective, at, d)},
-      {Shortfall::Reach, reach(objective, at)},
       {Shortfall::Buckling, buckling(objective, at, d, stop)}};
+  std::string seen;  // what the end state shows, binding first
   for (const auto& [reason, words] : found) {
     if (words.empty()) continue;
     report.reasons.push_back(reason);
-    report.detail +=
-        (report.detail.empty() ? "" : "; ") + std::string(to_string(reason)) + ": " + words;
+    seen += (seen.empty() ? "" : "; ") + std::string(to_string(reason)) + ": " + words;
   }
-  if (report.reasons.empty())
+  const std::string beyond = beyond_unstretched_reach(objective.object(), objective.targets());
+  if (!beyond.empty()) {
+    report.reasons = {Shortfall::Reach};
+    report.detail = "reach: " + beyond + (seen.empty() ? "" : "; where it stopped, " + seen);
+  } else if (report.reasons.empty()) {
     report.detail = "no joint limit, collision, reach or buckling in the way: a local minimum";
+  } else {
+    report.detail = seen;
+  }
   return report;
 }
 

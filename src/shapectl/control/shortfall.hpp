@@ -2,15 +2,20 @@
 // Why a stationary state stays farther from its targets than the user's tolerance: the reasons
 // behind a "best effort" status (GUI badge, state messages, `solve` and `run` output).
 //
-// All four are read from the state itself, along d = −J_sᵀ r_s, the joint direction in which
-// the targets alone (no barriers) would lower the shape error:
+// First, from the targets alone (so the same targets give it whatever pose the optimizer stopped
+// at): reach, when a target is farther from where an arm starts than that arm reaches with the
+// target's node and the object unstretched (control/reach_bound.hpp). That binds: it is then the
+// only reason, and what the end state shows is added to the words as "where it stopped".
+// Otherwise the reasons are read from the state itself, in this order (the one that binds
+// first), along d = −J_sᵀ r_s, the joint direction in which the targets alone (no barriers)
+// would lower the shape error:
+//   reach        a gripping arm stretched to its workspace boundary: its tool point at least
+//                95 % of the arm's length from its first movable joint (the length: the sum
+//                of the fixed distances joint origin → next joint origin → … → tool point);
 //   joint limit  a joint within the limit barrier's margin (+ 0.01 rad) of a hard limit while
 //                d pushes it further out;
 //   collision    a checked sphere pair within the collision margin (+ 1 mm) whose clearance
 //                shrinks along d (forward kinematics at θ + 1e-3·d/|d|);
-//   reach        a gripping arm stretched to its workspace boundary: its tool point at least
-//                95 % of the arm's length from its first movable joint (the length: the sum
-//                of the fixed distances joint origin → next joint origin → … → tool point);
 //   buckling     0.02 rad along d the equilibrium is unstable or lost, or snaps: the target
 //                nodes move more than 10× (and 1 mm beyond) what the sensitivity predicts.
 // None of them: a local minimum of the shape error, said as such.
@@ -30,7 +35,7 @@ bool parse(std::string_view name, Shortfall* shortfall);
 std::vector<std::string> shortfall_names(const std::vector<Shortfall>& shortfalls);
 
 struct ShortfallReport {
-  std::vector<Shortfall> reasons;  // those that hold, in enum order; empty: a local minimum
+  std::vector<Shortfall> reasons;  // those that hold, binding first; empty: a local minimum
   std::string detail;              // in words, with names and numbers
 };
 
