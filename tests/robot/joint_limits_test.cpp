@@ -38,10 +38,16 @@ TEST(JointLimits, ZeroInsideTheMarginAndGrowingOutside) {
   EXPECT_EQ(limits.value(Eigen::Vector3d(0.85, 0.25, 1e6)), 0.0);
   EXPECT_NEAR(limits.value(Eigen::Vector3d(0.95, 0.25, 0)), 10 * std::pow(0.05, 3), 1e-15);
   EXPECT_NEAR(limits.value(Eigen::Vector3d(-1.2, 0.25, 0)), 10 * std::pow(0.3, 3), 1e-14);
-  // A range narrower than twice the margin pushes from both sides.
+  // A range narrower than four margins (a 10 cm joint under a 0.1 margin) keeps a quarter of
+  // its range from each limit, not the margin: its middle half is free, not pinned.
   const JointLimits narrow(Eigen::VectorXd::Constant(1, 0.0), Eigen::VectorXd::Constant(1, 0.1),
                            0.1, 10.0);
-  EXPECT_NEAR(narrow.value(Eigen::VectorXd::Constant(1, 0.05)), 2 * 10 * std::pow(0.05, 3), 1e-15);
+  EXPECT_EQ(narrow.value(Eigen::VectorXd::Constant(1, 0.03)), 0.0);
+  EXPECT_EQ(narrow.value(Eigen::VectorXd::Constant(1, 0.07)), 0.0);
+  EXPECT_NEAR(narrow.value(Eigen::VectorXd::Constant(1, 0.0)), 10 * std::pow(0.025, 3), 1e-15);
+  EXPECT_DOUBLE_EQ(joint_margin(0, 0.025, 0.05), 0.025 / 4);  // a YuMi finger
+  EXPECT_DOUBLE_EQ(joint_margin(-2, 2, 0.05), 0.05);
+  EXPECT_DOUBLE_EQ(joint_margin(-INFINITY, INFINITY, 0.05), 0.05);
 }
 
 TEST(JointLimits, GradientAndResidualJacobianMatchCentralDifferences) {

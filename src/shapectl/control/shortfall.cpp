@@ -8,6 +8,7 @@
 #include <shapectl/control/reach_bound.hpp>
 #include <shapectl/enum_names.hpp>
 #include <shapectl/robot/collision_spheres.hpp>
+#include <shapectl/robot/joint_limits.hpp>
 #include <shapectl/robot/kinematics.hpp>
 
 namespace shapectl {
@@ -45,12 +46,13 @@ Eigen::VectorXd shape_descent(const ReducedObjective& objective, Evaluation& at)
 std::string joint_limit(const ReducedObjective& objective, const Evaluation& at,
                         const Eigen::VectorXd& d) {
   const RobotModel& robot = objective.object().robot();
-  const double near = objective.object().scene().robot->joint_limit_margin + kLimitSlack;
+  const double margin = objective.object().scene().robot->joint_limit_margin;
   const Eigen::VectorXd lower = robot.lower_limits(), upper = robot.upper_limits();
   const auto names = robot.active_joint_names();
   const double noise = 0.01 * d.cwiseAbs().maxCoeff();
   std::string out;
   for (int j = 0; j < d.size(); ++j) {
+    const double near = joint_margin(lower[j], upper[j], margin) + kLimitSlack;
     const bool low = at.joints()[j] - lower[j] <= near && d[j] < -noise;
     const bool high = upper[j] - at.joints()[j] <= near && d[j] > noise;
     if (!low && !high) continue;

@@ -1,5 +1,7 @@
 #include <shapectl/robot/inverse_kinematics.hpp>
 
+#include <shapectl/robot/joint_limits.hpp>
+
 #include <cmath>
 #include <limits>
 #include <random>
@@ -35,7 +37,8 @@ Bounds inner_bounds(const RobotModel& model, double margin) {
   Bounds b{model.lower_limits(), model.upper_limits()};
   for (int i = 0; i < b.lower.size(); ++i) {
     if (!std::isfinite(b.lower[i]) || !std::isfinite(b.upper[i])) continue;
-    const double lo = b.lower[i] + margin, hi = b.upper[i] - margin;
+    const double m = joint_margin(b.lower[i], b.upper[i], margin);
+    const double lo = b.lower[i] + m, hi = b.upper[i] - m;
     if (lo <= hi) {
       b.lower[i] = lo;
       b.upper[i] = hi;

@@ -1,5 +1,6 @@
 #include <shapectl/robot/joint_limits.hpp>
 
+#include <algorithm>
 #include <cassert>
 
 namespace shapectl {
@@ -7,13 +8,19 @@ namespace shapectl {
 JointLimits::JointLimits(const RobotModel& model, double margin, double stiffness)
     : JointLimits(model.lower_limits(), model.upper_limits(), margin, stiffness) {}
 
+double joint_margin(double lower, double upper, double margin) {
+  return std::min(margin, 0.25 * (upper - lower));  // infinite limits: margin
+}
+
 JointLimits::JointLimits(Eigen::VectorXd lower, Eigen::VectorXd upper, double margin,
                          double stiffness)
-    : lower_(lower.array() + margin),
-      upper_(upper.array() - margin),
-      margin_(margin),
-      barrier_{stiffness} {
+    : lower_(lower), upper_(upper), margin_(margin), barrier_{stiffness} {
   assert(lower_.size() == upper_.size() && margin >= 0 && stiffness >= 0);
+  for (int i = 0; i < lower_.size(); ++i) {
+    const double m = joint_margin(lower[i], upper[i], margin);
+    lower_[i] += m;
+    upper_[i] -= m;
+  }
 }
 
 double JointLimits::value(const Eigen::VectorXd& joints, Eigen::VectorXd* gradient) const {

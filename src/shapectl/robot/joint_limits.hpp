@@ -1,5 +1,6 @@
 #pragma once
-// Joint limits as two one-sided barriers per active joint, active inside a margin:
+// Joint limits as two one-sided barriers per active joint, active inside a margin (per joint:
+// joint_margin below):
 //   lower: v = (lower + margin) − θ,   upper: v = θ − (upper − margin),   each CubicBarrier.
 // Continuous joints (infinite limits) get none.
 #include <string>
@@ -9,6 +10,11 @@
 #include <shapectl/robot/robot_model.hpp>
 
 namespace shapectl {
+
+// The margin a joint keeps from each of its limits: `margin`, but at most a quarter of its
+// range, so a short joint (a 25 mm gripper finger under a 0.05 margin) keeps half its range
+// free instead of being pinned at its middle.
+double joint_margin(double lower, double upper, double margin);
 
 class JointLimits {
  public:

@@ -119,7 +119,7 @@ void check_joint_limits(const Scene& scene, std::vector<std::string>& warnings) 
   for (int k = 0; k < model.active_count(); ++k) {
     const double q = robot.reference_joints[k];
     const double gap = std::min(q - lower[k], upper[k] - q);
-    if (gap < robot.joint_limit_margin)
+    if (gap < joint_margin(lower[k], upper[k], robot.joint_limit_margin))
       warnings.push_back(scene.source.string() + ": robot.reference_joints." +
                          names[static_cast<std::size_t>(k)] + ": " + show(q, 4) +
                          " is within robot.joint_limit_margin (" + show(robot.joint_limit_margin) +
