@@ -69,8 +69,8 @@ std::string geometry(const Primitive& p) {
 
 // Two 3-joint arms on a base; the right hand's mesh is missing on purpose. With `finger`, the
 // left tool carries a part on a prismatic joint (±10 cm) that moves no tool, like a gripper's
-// finger or a camera slide. (A real 25 mm finger cannot be active at all: the joint-limit margin
-// of 0.05, m for prismatic joints, is wider than its stroke.)
+// finger or a camera slide. (A real 25 mm finger named active keeps a quarter of its stroke
+// from each limit, not the 0.05 margin: robot/joint_limits.hpp, joint_margin.)
 std::string urdf(bool finger = false) {
   std::map<std::string, std::string> links;
   for (const auto& p : primitives()) links[p.link] += geometry(p);
