@@ -346,6 +346,16 @@ TEST(AuthorCli, JointsThatMoveNoToolAreFixedAtTheFingerOpening) {
   EXPECT_EQ(robot["active_joints"].get<std::vector<std::string>>(), arms);
   EXPECT_EQ(robot["fixed_joints"], Json({{"l_finger_joint", 0.0}}));
 
+  // Named active, the finger is a joint of θ like the arms' (the IK leaves it where it starts).
+  args = author_args(a);
+  args.insert(args.end(), {"--active-joints", "l1,l2,l3,r1,r2,r3,l_finger_joint"});
+  const auto finger = run_cli(args);
+  ASSERT_EQ(finger.exit_code, 0) << finger.err;
+  robot = read_json(a.scene)["robot"];
+  EXPECT_EQ(robot["active_joints"].size(), 7u);
+  EXPECT_TRUE(robot["reference_joints"].contains("l_finger_joint"));
+  EXPECT_EQ(robot["fixed_joints"], Json::object());
+
   for (const auto& [option, value] :
        {std::pair<std::string, std::string>{"--finger-opening", "0.5"},
         {"--active-joints", "l1,l2,nothing"}}) {

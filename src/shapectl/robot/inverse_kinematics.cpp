@@ -222,10 +222,17 @@ IkResult solve_inverse_kinematics(const RobotModel& model, const std::vector<IkG
     if (a_free != b_free) return a_free;
     return a.position + a.orientation < b.position + b.orientation;
   };
+  // Joints that move no goal's link (a finger named active) keep their start in every restart:
+  // they cannot help, and drawing them would change the search for the joints that can.
+  std::vector<char> moves_a_goal(static_cast<std::size_t>(model.active_count()), 0);
+  for (const auto& g : goals)
+    for (const auto& entry : model.jacobian_entries(g.link))
+      moves_a_goal[static_cast<std::size_t>(entry.column)] = 1;
   for (int start = 0; start <= options.restarts; ++start) {
     Eigen::VectorXd q = clamp(joints0, bounds);
     if (start > 0)
       for (int i = 0; i < q.size(); ++i) {
+        if (!moves_a_goal[static_cast<std::size_t>(i)]) continue;
         const double lo = std::isfinite(bounds.lower[i]) ? bounds.lower[i] : -M_PI;
         const double hi = std::isfinite(bounds.upper[i]) ? bounds.upper[i] : M_PI;
         q[i] = std::uniform_real_distribution<double>(lo, hi)(rng);
