@@ -640,9 +640,7 @@ void run(const AuthorOptions& o) {
     const Eigen::Matrix3d R =
         reference.T_world_link[static_cast<std::size_t>(ees[e].link)].linear();
     const GraspAxes& axes = grasp_axes[e];
-    const Vec3 closing_link = axes.closing_link
-                                  ? *axes.closing_link
-                                  : finger_axis(model, ees[e].link).value_or(Vec3(Vec3::UnitY()));
+    const Vec3 closing_link = closing_axis_link(axes, model, ees[e].link);
     grip_report.push_back({{"end_effector", ees[e].name},
                            {"link", model.links()[static_cast<std::size_t>(ees[e].link)].name},
                            {"node_count", grips[e].nodes.size()},

@@ -42,12 +42,15 @@ std::optional<Vec3> finger_axis(const RobotModel& model, int tool_link) {
   return std::nullopt;
 }
 
+Vec3 closing_axis_link(const GraspAxes& axes, const RobotModel& model, int tool_link) {
+  return axes.closing_link ? *axes.closing_link
+                           : finger_axis(model, tool_link).value_or(Vec3(Vec3::UnitY()));
+}
+
 void orient_goal(const GraspAxes& axes, const RobotModel& model,
                  const Eigen::Matrix3d& R_world_link, const std::string& option, IkGoal& goal) {
   if (!axes.approach_world && !axes.closing_world) return;
-  const Vec3 closing_link = axes.closing_link
-                                ? *axes.closing_link
-                                : finger_axis(model, goal.link).value_or(Vec3(Vec3::UnitY()));
+  const Vec3 closing_link = closing_axis_link(axes, model, goal.link);
   if (!axes.closing_world) {
     goal.axis_link = axes.approach_link;
     goal.axis_world = *axes.approach_world;

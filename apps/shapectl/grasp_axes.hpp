@@ -23,6 +23,10 @@ struct GraspAxes {
 // the tool. None without one.
 std::optional<Vec3> finger_axis(const RobotModel& model, int tool_link);
 
+// The tool's closing axis in its link frame: the one --tool-axes named, else the fingers' axis,
+// else +y.
+Vec3 closing_axis_link(const GraspAxes& axes, const RobotModel& model, int tool_link);
+
 // Adds the orientation `axes` ask for to `goal` (a position goal for `goal.link`).
 // `R_world_link` (the link's orientation at the start pose) picks the closing axis's sign.
 // Throws InputError naming `option` when the approach and closing directions are within 10° of

@@ -47,12 +47,13 @@ bool negligible(double before, double after) {
 }
 }  // namespace
 
+// A trial whose statics need many Newton steps is far outside the linear model: better
+// rejected (and the step shortened) than solved at length.
+constexpr int kTrialNewtonLimit = 25;
+
 Evaluation evaluate_predicted(const ReducedObjective& objective, const Eigen::VectorXd& joints,
                               const Evaluation& from, const Positions& predicted,
                               const std::function<bool()>& out_of_time) {
-  // A trial whose statics need many Newton steps is far outside the linear model: better
-  // rejected (and the step shortened) than solved at length.
-  constexpr int kTrialNewtonLimit = 25;
   Evaluation e = objective.evaluate(joints, predicted, kTrialNewtonLimit, &from, out_of_time);
   if (e.statics().status == StaticsStatus::Inverted && e.statics().iterations == 0 &&
       !(out_of_time && out_of_time()))
@@ -84,9 +85,9 @@ StepOutcome GaussNewton::step(const ReducedObjective& objective, Evaluation& cur
     char head[48] = "no step accepted", text[200];
     if (step > 0) std::snprintf(head, sizeof head, "the last step was %.2g rad", step);
     std::snprintf(text, sizeof text,
-                  "%s; longer trials refused: %d without a stable equilibrium within 25 Newton "
+                  "%s; longer trials refused: %d without a stable equilibrium within %d Newton "
                   "steps, %d into a collision or limit, %d worse",
-                  head, no_equilibrium, unsafe, worse);
+                  head, no_equilibrium, kTrialNewtonLimit, unsafe, worse);
     stopped_ = text;
     return outcome;
   };
