@@ -129,7 +129,8 @@ export class CalibrationPanel {
       const decimals = decimalsFor(p.fitted * scale, p.held ? NaN : p.standard_deviation * scale);
       row.append(cell(parameterLabel(p.name)), cell(formatValue(p.initial, p.unit, decimals), 'number'));
       if (p.held) {
-        const held = cell('held (not determined)', 'muted');
+        // Kept at its start: that value, muted (the verdict column says "held").
+        const held = cell(formatValue(p.initial, p.unit, decimals), 'number muted');
         // That deviation is in units of the parameter's typical size (docs/calibration.md).
         if (unidentified.has(p.name)) held.title = heldExplanation(unidentified.get(p.name));
         row.append(held);
