@@ -213,9 +213,13 @@ ObjectMesh read_object_mesh(const AuthorOptions& o, const fs::path& scene_dir) {
   if (o.mesh.empty() == o.box.empty())
     throw InputError("command line", "--mesh", "either --mesh FILE or --box LX,LY,LZ",
                      o.mesh.empty() ? "neither" : "both");
+  const std::optional<double> unit = metres_per_unit(o.units.empty() ? "m" : o.units);
+  if (!unit) throw InputError("command line", "--units", "m, cm or mm", bounded_preview(o.units));
   if (!o.box.empty()) {
-    const auto s = numbers(o.box, "--box", "LX,LY,LZ: three edge lengths in metres", {3});
-    const Vec3 size(s[0], s[1], s[2]);
+    // In --units like a mesh (a box typed in cm with --units cm is what the user meant).
+    const auto s =
+        numbers(o.box, "--box", "LX,LY,LZ: three edge lengths (--units, default m)", {3});
+    const Vec3 size = *unit * Vec3(s[0], s[1], s[2]);
     if (!(size.minCoeff() >= 1e-4 && size.maxCoeff() <= 100))
       throw InputError("command line", "--box", "edge lengths from 1e-4 to 100 m",
                        bounded_preview(o.box));
@@ -245,8 +249,6 @@ ObjectMesh read_object_mesh(const AuthorOptions& o, const fs::path& scene_dir) {
     return {std::make_shared<const TetMesh>(load_mesh(file)), Json(relative.generic_string())};
   // Read as the scene will read it (scaled before TetGen meshes a surface), so the grips'
   // node numbers are the scene's.
-  if (!metres_per_unit(o.units))
-    throw InputError("command line", "--units", "m, cm or mm", bounded_preview(o.units));
   const JsonInput read({{"file", file.string()}, {"units", o.units}}, "command line", "--mesh");
   return {load_object_mesh(read), Json{{"file", relative.generic_string()}, {"units", o.units}}};
 }
@@ -791,7 +793,8 @@ void add_author_command(CLI::App& app) {
   add_package_path_option(*c, o->package_paths);
   c->add_flag("--allow-missing-meshes", o->allow_missing_meshes,
               "Author even when mesh files the URDF names are not found (links lose them)");
-  c->add_option("--units", o->units, "Units of --mesh's coordinates: m (default), cm or mm");
+  c->add_option("--units", o->units,
+                "Units of --mesh's coordinates and --box's sizes: m (default), cm or mm");
   c->add_option("--active-joints", o->active_joints,
                 "NAME,...: the joints to optimise (default: every joint that moves a tool)");
   c->add_option("--finger-opening", o->finger_opening,

@@ -385,6 +385,17 @@ TEST(AuthorCli, UnitsScaleTheMeshAsTheSceneReadsIt) {
   for (int g = 0; g < 2; ++g)
     EXPECT_EQ(in_millimetres["grips"][g]["node_count"], in_metres["grips"][g]["node_count"]);
 
+  // --box in the same units: 34 × 3 × 3 cm is the 0.34 × 0.03 × 0.03 m box.
+  args = author_args(a);
+  args[2] = "--box";
+  args[3] = "34,3,3";
+  args.insert(args.end(), {"--units", "cm"});
+  const auto box = run_cli(args);
+  ASSERT_EQ(box.exit_code, 0) << box.err;
+  const Json size = read_json(a.scene)["object"]["mesh"]["box"]["size"];
+  const std::array<double, 3> metres = {0.34, 0.03, 0.03};
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(size[k].get<double>(), metres[k], 1e-12);
+
   args = author_args(a);
   args.insert(args.end(), {"--units", "furlong"});
   const auto run = run_cli(args);
