@@ -359,8 +359,11 @@ TEST_F(CalibrateFixedCli, APoseBeyondItsPriorIsFlaggedImplausible) {
   ASSERT_FALSE(r["implausible"].empty()) << run.err;
   const std::string name = r["implausible"][0];
   EXPECT_NE(run.err.find("warning: " + name), std::string::npos) << run.err;
-  for (const auto& p : r["parameters"])
-    if (p["name"] == name) EXPECT_TRUE(p["implausible"].get<bool>());
+  for (const auto& p : r["parameters"]) {
+    if (p["name"] == name) {
+      EXPECT_TRUE(p["implausible"].get<bool>());
+    }
+  }
   // Without priors there is nothing to judge it by.
   const auto off = run_cli({"calibrate", kClamped.string(), "--observations", obs.string(), "--out",
                             out, "--report", report, "--fit", "object_pose", "--prior", "off"});

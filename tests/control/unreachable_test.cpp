@@ -67,7 +67,7 @@ TEST_F(YumiBarUnreachable, TheSameTargetGivesTheSameReasonsFromAnyStart) {
     runs.push_back(stop_at(controller, far));
   }
   // From another target's pose: 0.6 m above first, and the bar bent sideways.
-  for (const Vec3 before : {Vec3(0, 0, 0.6), Vec3(0, 0.1, -0.05)}) {
+  for (const Vec3& before : {Vec3(0, 0, 0.6), Vec3(0, 0.1, -0.05)}) {
     Controller controller(scene);
     ShapeTargets other = far;
     other.positions[0] = object.reference_positions().segment<3>(3 * middle()) + before;

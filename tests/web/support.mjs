@@ -8,7 +8,8 @@ import net from 'node:net';
 import crypto from 'node:crypto';
 import { fileURLToPath } from 'node:url';
 
-export const sourceDir = process.env.SHAPECTL_SOURCE_DIR ?? path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
+// Absolute: playwright-core is imported by a path under it (a relative one is a bare specifier).
+export const sourceDir = process.env.SHAPECTL_SOURCE_DIR ? path.resolve(process.env.SHAPECTL_SOURCE_DIR) : path.resolve(path.dirname(fileURLToPath(import.meta.url)), '../..');
 const cli = process.env.SHAPECTL_CLI ?? path.join(sourceDir, 'build/shapectl');
 export const buildDir = path.dirname(cli);  // where tests may write (screenshots), not the sources
 

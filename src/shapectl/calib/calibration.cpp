@@ -225,20 +225,25 @@ std::string suggestion(Kind kind, const std::vector<Kind>& partners) {
   const auto pose = [](Kind k) { return k == Kind::PoseTranslation || k == Kind::PoseRotation; };
   if (has(is(Kind::LogYoungsModulus)) && has(is(Kind::LogDensity)))
     return "add a frame with a different load of known size (its \"loads\" in the observations "
-           "file: a hanging weight of known mass, e.g. hung from the free end), or weigh the "
-           "object and give its density: under gravity alone the shape shows only E/density";
+           "file: a hanging weight of known mass, e.g. hung from the free end, or from the "
+           "middle of an object held at both ends), or weigh the object and give its density: "
+           "under gravity alone the shape shows only E/density";
   if (is_material(kind) && any_partner(grip))
     return "a second robot pose that turns the object against gravity";
   if (is_material(kind) && any_partner(pose))
-    return "markers where the object bends (on the free end and along it), or the clamp's pose "
-           "measured and given in the scene";
+    return "markers where the object bends (on the free end and along it; the middle of an "
+           "object held at both ends), or the clamp's pose measured and given in the scene";
   if (kind == Kind::PoissonLogit)
     return "observations of a twist or a squeeze (a bar that only bends barely shows Poisson's "
            "ratio)";
-  if (is_material(kind)) return "a marker on the free end: no observed point moves with it";
+  if (is_material(kind))
+    return "a marker where the object deflects most (a cantilever's free end, the middle of an "
+           "object held at both ends): no observed point moves with it";
   if (any_partner(is_material))
-    return grip(kind) ? "a second robot pose that turns the object against gravity"
-                      : "markers where the object bends (on the free end and along it)";
+    return grip(kind)
+               ? "a second robot pose that turns the object against gravity"
+               : "markers where the object bends (on the free end and along it; the middle of "
+                 "an object held at both ends)";
   return "markers not all on one line, or points on the object's end faces";
 }
 

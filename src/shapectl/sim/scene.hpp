@@ -28,8 +28,9 @@ struct AlignedBox {
 
 // A set of mesh nodes chosen by an object-space box and/or explicit indices.
 struct NodeSelection {
-  std::optional<AlignedBox> box;
-  std::vector<int> nodes;
+  // `{}`: a designated initializer may name one of the two without a warning.
+  std::optional<AlignedBox> box{};
+  std::vector<int> nodes{};
   // Indices of the selected nodes of `mesh` (rest positions in object coordinates).
   std::vector<int> resolve(const TetMesh& mesh) const;
 };
