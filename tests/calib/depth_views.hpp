@@ -1,12 +1,12 @@
 #pragma once
-// Depth cameras for tests: a camera placed by where it looks, and what it sees of an object
-// (calib/depth_render.hpp) with noise along each ray and flying pixels.
+// Depth cameras for tests: a camera placed by where it looks, what it sees of an object
+// (SimulatedCamera::depth_image) and its frame's "depth_image".
 #include <random>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
-#include <shapectl/calib/depth_render.hpp>
+#include <shapectl/calib/simulated_camera.hpp>
 #include <shapectl/io/json_eigen.hpp>
 
 namespace shapectl::test {
@@ -35,21 +35,16 @@ inline DepthCamera bar_camera() {
   return {{300, 300, 129.5, 59.5}, look_at(Vec3(0.02, -0.35, 0.25), Vec3(0, 0, -0.02)), 260, 120};
 }
 
-// What `camera` sees of the surface at `positions`: each depth with Gaussian noise σ along its
-// ray, and `outlier_fraction` of the pixels on the object flying anywhere from half to 1.5
-// times their depth (mixed edge pixels, multipath).
+// What `camera` sees of the surface at `positions`: SimulatedCamera::depth_image with noise σ
+// along each ray and `outlier_fraction` of the pixels on the object flying.
 inline DepthImage seen_depth(const DepthCamera& camera, const TetMesh& mesh,
                              const Positions& positions, double sigma, double outlier_fraction,
                              std::mt19937& rng) {
-  DepthImage image =
-      render_depth(mesh, positions, camera.intrinsics, camera.pose, camera.width, camera.height);
-  std::normal_distribution<double> noise(0, sigma);
-  std::uniform_real_distribution<double> unit(0, 1);
-  for (double& z : image.depth) {
-    if (std::isnan(z)) continue;
-    z = unit(rng) < outlier_fraction ? z * (0.5 + unit(rng)) : z + noise(rng);
-  }
-  return image;
+  SimulatedCamera simulated;
+  simulated.sigma = sigma;
+  simulated.outlier_fraction = outlier_fraction;
+  return simulated.depth_image(mesh, positions, camera.intrinsics, camera.pose, camera.width,
+                               camera.height, rng);
 }
 
 // A frame's "depth_image" for `camera`'s image in `file` (16-bit units of `scale` m).
