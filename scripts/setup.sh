@@ -15,6 +15,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libboost-dev chromium
   libprotobuf-dev protobuf-compiler
+  libpng-dev  # calib/'s depth images (16-bit PNG)
   clang-format
   qemu-user  # portable_install runs the installed tree on an emulated CPU without AVX
   pybind11-dev python3-dev python3-numpy python3-pytest

@@ -1,5 +1,6 @@
 // shapectl calibrate SCENE.json --observations OBS.json --out CALIBRATED.json
-//   [--fit youngs_modulus,poisson_ratio,density,grip_offsets,object_pose,regions[K].youngs_modulus]
+//   [--fit youngs_modulus,poisson_ratio,density,grip_offsets,object_pose,camera_poses,
+//          regions[K].youngs_modulus]
 //   [--report REPORT.json]
 //   [--prior LIST] [--bounds LIST] [--max-iterations N] [--max-seconds S]
 // Fits the scene's physical parameters to observed frames of the real object
@@ -35,6 +36,7 @@ struct CalibrateArgs {
 };
 
 // The parameters to fit; --fit names one the scene does not have → InputError naming --fit.
+// The depth cameras camera_poses needs are the observations': checked_against_cameras.
 FitSelection fit_selection(const CalibrateArgs& args, const Scene& scene) {
   const std::string list = args.fit.empty() ? default_fit(scene) : args.fit;
   FitSelection fit;
@@ -45,11 +47,23 @@ FitSelection fit_selection(const CalibrateArgs& args, const Scene& scene) {
                      list);
   }
   try {
-    const ParameterSpace space(scene, fit);  // refuses what the scene does not have
+    FitSelection of_the_scene = fit;
+    of_the_scene.camera_poses = false;
+    const ParameterSpace space(scene, of_the_scene);  // refuses what the scene does not have
   } catch (const std::invalid_argument& e) {
     throw InputError("--fit", "", std::string(e.what()) + " (" + args.scene + ")");
   }
   return fit;
+}
+
+// camera_poses without a depth image in the observations → InputError naming --fit.
+void checked_against_cameras(const CalibrateArgs& args, const Scene& scene, const FitSelection& fit,
+                             const Observations& observations) {
+  try {
+    const ParameterSpace space(scene, fit, camera_count(observations));
+  } catch (const std::invalid_argument& e) {
+    throw InputError("--fit", "", std::string(e.what()) + " (" + args.observations + ")");
+  }
 }
 
 // --prior and --bounds over the observations file's "priors" and "bounds" (the command line's
@@ -67,8 +81,8 @@ void priors_and_bounds(const CalibrateArgs& args, const Scene& scene, const FitS
   } catch (const std::invalid_argument& e) {
     throw InputError("--bounds", "", e.what());
   }
-  const std::string name =
-      outside_bounds(ParameterSpace(scene, fit), PhysicalParameters::of(scene), options.bounds);
+  const std::string name = outside_bounds(ParameterSpace(scene, fit, camera_count(observations)),
+                                          PhysicalParameters::of(scene), options.bounds);
   if (name.empty()) return;
   const std::string problem =
       name + ": the scene's value (" + args.scene + ") is outside these bounds";
@@ -170,6 +184,7 @@ void run_calibrate(const CalibrateArgs& args) {
                         {.node_count = scene.object_mesh->node_count(),
                          .robot = scene.robot ? scene.robot->model.get() : nullptr,
                          .mesh = scene.object_mesh.get()});
+  checked_against_cameras(args, scene, fit, observations);
   CalibrationOptions options{.max_iterations = args.max_iterations};
   priors_and_bounds(args, scene, fit, observations, options);
   CalibrationResult result;
@@ -211,15 +226,16 @@ void add_calibrate_command(CLI::App& app) {
   cmd->add_option(
       "--fit", args->fit,
       "parameters to fit, comma-separated: youngs_modulus, poisson_ratio, density, grip_offsets, "
-      "object_pose, regions[K].youngs_modulus (also .poisson_ratio, .density: region K's "
-      "material) (default youngs_modulus,grip_offsets with a robot, "
+      "object_pose, camera_poses (the depth images' cameras), regions[K].youngs_modulus (also "
+      ".poisson_ratio, .density: region K's material) (default youngs_modulus,grip_offsets with a "
+      "robot, "
       "youngs_modulus,object_pose for an object held by fixed nodes alone)");
   cmd->add_option("--prior", args->prior,
                   "priors on the fitted values' change from the scene's, comma-separated "
                   "NAME=SIGMA: object_pose.translation=10mm, object_pose.rotation=2deg, "
-                  "grip_offsets=5mm/3deg, youngs_modulus=50% (mm, m, deg, rad; % for material); "
-                  "none disables one, off alone all (defaults: object_pose 10mm/2deg, "
-                  "grip_offsets 5mm/3deg, none on material)");
+                  "grip_offsets=5mm/3deg, camera_poses=10mm/2deg, youngs_modulus=50% (mm, m, deg, "
+                  "rad; % for material); none disables one, off alone all (defaults: object_pose "
+                  "and camera_poses 10mm/2deg, grip_offsets 5mm/3deg, none on material)");
   cmd->add_option("--bounds", args->bounds,
                   "hard bounds on the material, comma-separated NAME=LOWER:UPPER (a side may be "
                   "empty): youngs_modulus=1e3:1e8, density=100:2000, poisson_ratio=0.2:0.49");

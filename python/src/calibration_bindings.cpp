@@ -75,8 +75,8 @@ void priors_and_bounds(const std::string& prior, const std::string& bounds, cons
   } catch (const std::invalid_argument& e) {
     throw InputError("bounds", "", e.what());
   }
-  const std::string outside =
-      outside_bounds(ParameterSpace(scene, fit), PhysicalParameters::of(scene), options.bounds);
+  const std::string outside = outside_bounds(ParameterSpace(scene, fit, camera_count(observations)),
+                                             PhysicalParameters::of(scene), options.bounds);
   if (!outside.empty())
     throw InputError("bounds", "", outside + ": the scene's value is outside these bounds");
 }

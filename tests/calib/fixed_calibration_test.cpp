@@ -8,8 +8,10 @@
 
 #include <shapectl/calib/simulated_camera.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
+#include <shapectl/sim/object_statics.hpp>
 
 #include "calib/calibration_checks.hpp"
+#include "calib/depth_views.hpp"
 #include "support/test_support.hpp"
 
 namespace shapectl {
@@ -140,6 +142,62 @@ TEST(FixedCalibration, ACameraOffsetIsTakenByTheObjectTranslationWithinItsPrior)
   const Eigen::Isometry3d free_moved =
       free.fitted.object_pose * study.model.T_world_object.inverse();
   EXPECT_LT((free_moved.translation() - offset).norm(), 0.001);
+}
+
+// The same 6 mm, as a depth camera's pose given 6 mm off (its points all shifted by it), 20 %
+// flying pixels. Fitted, the camera's pose and the object's translation share it within their
+// priors; without priors the translations trade off exactly, and the report says so.
+TEST(FixedCalibration, ADepthCameraOffsetIsTakenByTheCameraPoseWithinItsPrior) {
+  ClampedStudy study;
+  study.truth.T_world_object = study.model.T_world_object;  // only the camera is off
+  const Vec3 offset = 0.006 * Vec3(2, -1, 2).normalized();
+  Positions x = study.truth.world_rest_positions();
+  ASSERT_TRUE(ObjectStatics(study.truth).solve(x).converged());
+  const test::DepthCamera camera = test::bar_camera();
+  const Eigen::Isometry3d stated = Eigen::Translation3d(offset) * camera.pose;
+  std::mt19937 rng(26);
+  Observations observations;
+  for (int k = 0; k < 3; ++k) {
+    ObservationFrame frame;
+    const DepthImage image =
+        test::seen_depth(camera, *study.model.object_mesh, x, 0.0003, 0.2, rng);
+    frame.points = back_project(image, camera.intrinsics, stated, 2);
+    frame.sigma = 0.0003;
+    frame.camera = FrameCamera{0, stated.translation()};
+    observations.frames.push_back(frame);
+  }
+  ASSERT_GT(observations.frames[0].points.size(), 1000u);
+  const FitSelection fit = parse_fit_selection("youngs_modulus,object_pose,camera_poses");
+  const CalibrationResult r = calibrate(study.model, observations, fit);
+  ASSERT_TRUE(r.converged) << r.reason;
+  EXPECT_NEAR(r.fitted.youngs_modulus / youngs_modulus_of(study.truth.material), 1, 0.05);
+  const Eigen::Isometry3d moved = r.fitted.object_pose * study.model.T_world_object.inverse();
+  const CameraMotion motion =
+      ParameterSpace(study.model, fit, 1).camera_motion(0, stated.translation(), r.fitted);
+  // The bar's true points, seen through the stated pose and the fitted correction, are where the
+  // fitted model puts them.
+  for (const Vec3& q : {Vec3(-0.15, 0, 0), Vec3(0, 0, -0.01), Vec3(0.15, 0, -0.03)})
+    EXPECT_LT((moved.inverse() * (motion.motion * (q + offset)) - q).norm(), 0.001) << q;
+  EXPECT_LT(Eigen::AngleAxisd(moved.linear()).angle(), M_PI / 180);
+  EXPECT_LT(Eigen::AngleAxisd(r.fitted.camera_pose(0).linear()).angle(), M_PI / 180);
+  EXPECT_GT(r.fitted.camera_pose(0).translation().norm(), 0.001) << "the camera took its share";
+  for (const FittedParameter& p : r.parameters) EXPECT_FALSE(p.implausible) << p.name;
+
+  // Without priors the camera's and the object's translations move the points alike: not
+  // determined, each named as the other's trade-off.
+  CalibrationOptions no_priors;
+  no_priors.priors = CalibrationPriors::none();
+  const CalibrationResult free = calibrate(study.model, observations, fit, no_priors);
+  EXPECT_NEAR(free.fitted.youngs_modulus / youngs_modulus_of(study.truth.material), 1, 0.05);
+  int flagged = 0;
+  for (const FittedParameter& p : free.parameters) {
+    const bool camera = p.name.rfind("cameras[0].pose.", 0) == 0;
+    const bool pose = p.name.rfind("object_pose.", 0) == 0;
+    if (!(camera || pose) || p.verdict == Verdict::Determined) continue;
+    for (const std::string& other : p.trades_off_with)
+      if (other.rfind(camera ? "object_pose." : "cameras[0].pose.", 0) == 0) ++flagged;
+  }
+  EXPECT_GE(flagged, 3) << "the three translations at least";
 }
 
 // Held by a clamp, the bar's shape depends on stiffness and density through E/ρ alone.

@@ -117,13 +117,14 @@ TEST(Observations, BadFramesAreErrorsNamingTheField) {
       "obs.json: frames[0].points[1]: expected a point of length at most 1000 m, got [5000,0,0]");
   EXPECT_EQ(error_of(frame(marker + R"(, "colour": 1)"), context),
             "obs.json: frames[0].colour: unknown key; known: joints, markers, points, points_file, "
-            "sigma, time, loads, object_pose");
+            "depth_image, sigma, time, loads, object_pose");
   EXPECT_EQ(error_of(frame(marker + R"(, "sigma": 0)"), context),
             "obs.json: frames[0].sigma: expected a positive number, got 0");
   EXPECT_EQ(error_of(frame(marker + R"(, "time": -1)"), context),
             "obs.json: frames[0].time: expected a non-negative number, got -1");
   EXPECT_EQ(error_of(frame(R"("points": [[0, 0, 0]], "points_file": "c.xyz")"), context),
-            "obs.json: frames[0]: both \"points\" and \"points_file\"; expected one or the other");
+            "obs.json: frames[0]: more than one of \"points\", \"points_file\" and "
+            "\"depth_image\"; expected one");
   EXPECT_EQ(error_of(frame(R"("points_file": "c.xyz")"), context),
             "obs.json: frames[0].points_file: point cloud files are read only from an observations "
             "file; expected \"points\"");

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <shapectl/calib/equilibria.hpp>
+#include <shapectl/calib/observation_residuals.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
 
 #include "support/derivative_check.hpp"
@@ -269,6 +270,50 @@ TEST(ParameterSpace, UnknownNamesAreRefused) {
   ASSERT_EQ(r.regions.size(), 1u);
   EXPECT_EQ(r.regions[0].region, 2);
   EXPECT_EQ(r.regions[0].name, "poisson_ratio");
+}
+
+// A depth camera's pose correction moves its points, not the model: the residuals' camera
+// columns (calib/observation_residuals.hpp) against central differences of the residuals,
+// stepped through ParameterSpace::advanced from a correction already away from the identity.
+TEST(ParameterSpace, CameraPoseColumnsMatchCentralDifferences) {
+  const Scene scene = clamped_scene();
+  const Positions x = clamped_equilibrium(scene);
+  SurfaceDistance surface(scene.object_mesh->surface_triangles());
+  surface.update(x);
+  ObservationFrame frame;
+  frame.camera = FrameCamera{1, Vec3(0.05, -0.4, 0.3)};
+  std::mt19937 rng(7);
+  std::normal_distribution<double> off(0, 0.003);
+  for (std::size_t t = 0; t < surface.triangles().size(); t += 5) {
+    Vec3 centroid = Vec3::Zero();
+    for (int node : surface.triangles()[t]) centroid += x.segment<3>(3 * node) / 3;
+    frame.points.push_back(centroid + Vec3(off(rng), off(rng), off(rng)));
+  }
+  const ParameterSpace space(scene, {.youngs_modulus = true, .camera_poses = true}, 2);
+  ASSERT_EQ(space.size(), 1 + 12);
+  EXPECT_EQ(space.coordinates()[12].name, "cameras[1].pose.rz");
+  Eigen::VectorXd start = Eigen::VectorXd::Zero(space.size());
+  start.tail<6>() << 0.002, -0.001, 0.003, 0.02, -0.01, 0.03;
+  const PhysicalParameters p = space.advanced(PhysicalParameters::of(scene), start);
+  const auto residuals_at = [&](const PhysicalParameters& q, const Eigen::MatrixXd& dx_dz) {
+    // A cut-off of 1 m: every point an inlier on both sides of each step.
+    return frame_residuals(frame, x, surface, 1.0, dx_dz,
+                           space.camera_motion(1, frame.camera->position, q));
+  };
+  const Eigen::MatrixXd analytic =
+      residuals_at(p, Eigen::MatrixXd::Zero(x.size(), space.size())).jacobian;
+  EXPECT_TRUE(analytic.middleCols(1, 6).isZero()) << "camera 0 sees none of these points";
+  for (int k = 7; k < space.size(); ++k) {
+    const ParameterCoordinate& c = space.coordinates()[k];
+    const auto moved = [&](const Eigen::VectorXd& u) -> Eigen::VectorXd {
+      Eigen::VectorXd dz = Eigen::VectorXd::Zero(space.size());
+      dz[k] = c.scale * u[0];
+      return residuals_at(space.advanced(p, dz), Eigen::MatrixXd()).residuals;
+    };
+    const Eigen::MatrixXd numeric =
+        test::central_difference_jacobian(moved, Eigen::VectorXd::Zero(1), 1e-6);
+    EXPECT_TRUE(test::derivative_matches(analytic.col(k) * c.scale, numeric, 1e-6, c.name));
+  }
 }
 
 }  // namespace

@@ -161,3 +161,30 @@ def test_verdicts_priors_and_bad_priors(model):
         shapectl.calibrate(model, observations, prior="object_pose.rotation=2furlongs")
     with pytest.raises(ValueError, match="bounds: youngs_modulus: the scene.s value is outside"):
         shapectl.calibrate(model, observations, bounds="youngs_modulus=1e6:1e8")
+
+
+def test_depth_images_and_camera_poses(cli, write_json, tmp_path):
+    """A frame's "depth_image" goes through the CLI's reader: a float32 .npy of the clamped bar's
+    top face seen from 0.5 m straight above; camera_poses fits its camera; a bad dtype is named
+    as the CLI names it."""
+    clamped = SOURCE_DIR / "scenes" / "foam_bar_clamped.json"
+    depth = np.full((40, 320), np.nan, dtype=np.float32)
+    depth[5:35, :] = 0.485  # rows within ±15 px of cy = 19.5: the 3 cm wide top face
+    np.save(tmp_path / "d.npy", depth)
+    frame = {"depth_image": {"file": "d.npy",
+                             "intrinsics": {"fx": 500, "fy": 500, "cx": 159.5, "cy": 19.5},
+                             "camera_pose": {"position": [0, 0, 0.5], "rpy": [np.pi, 0, 0]}},
+             "sigma": 0.001}
+    path = write_json("obs.json", {"frames": [frame]})
+    result = shapectl.calibrate(shapectl.Scene.load(clamped), str(path),
+                                fit="object_pose,camera_poses", max_iterations=2)
+    names = [p.name for p in result.parameters]
+    assert names[6:] == [f"cameras[0].pose.{a}" for a in ("x", "y", "z", "rx", "ry", "rz")]
+    assert result.frames[0].points == 320 * 30
+    np.save(tmp_path / "d.npy", np.zeros(depth.shape, dtype=np.int16))
+    run = cli("calibrate", clamped, "--observations", path)
+    assert run.exit_code == 1
+    with pytest.raises(ValueError) as error:
+        shapectl.calibrate(shapectl.Scene.load(clamped), str(path))
+    assert str(error.value) == run.error_message()
+    assert "d.npy: header 'descr': expected '<f4' or '<f8'" in str(error.value)

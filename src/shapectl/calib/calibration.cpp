@@ -86,8 +86,11 @@ class CalibrationProblem {
       const ObservationFrame& frame = observations_.frames[k];
       const Equilibrium& e = *out.equilibria.frames[k];
       if (&e != surface_at) surface_.update(e.positions), surface_at = &e;
-      const double cutoff = cutoffs.empty() ? outlier_cutoff(frame, surface_) : cutoffs[k];
-      out.frames.push_back(frame_residuals(frame, e.positions, surface_, cutoff, e.dx_dz));
+      const CameraMotion camera =
+          frame.camera ? space_.camera_motion(frame.camera->index, frame.camera->position, p)
+                       : CameraMotion{};
+      const double cutoff = cutoffs.empty() ? outlier_cutoff(frame, surface_, camera) : cutoffs[k];
+      out.frames.push_back(frame_residuals(frame, e.positions, surface_, cutoff, e.dx_dz, camera));
       out.cutoffs.push_back(cutoff);
       out.cost += out.frames.back().cost();
     }
@@ -111,9 +114,11 @@ int hold_rank(Kind kind) {
     case Kind::PoissonLogit: return 1;
     case Kind::LogYoungsModulus: return 2;
     case Kind::GripRotation:
-    case Kind::PoseRotation: return 3;
+    case Kind::PoseRotation:
+    case Kind::CameraRotation: return 3;
     case Kind::GripTranslation:
-    case Kind::PoseTranslation: return 4;
+    case Kind::PoseTranslation:
+    case Kind::CameraTranslation: return 4;
   }
   return 5;
 }
@@ -144,6 +149,14 @@ Eigen::VectorXd displacement(const ParameterSpace& space, const PhysicalParamete
         break;
       case Kind::PoseRotation:
         d[k] = turned(p.object_pose.linear(), initial.object_pose.linear())[c.axis];
+        break;
+      case Kind::CameraTranslation:
+        d[k] = (p.camera_pose(c.camera).translation() -
+                initial.camera_pose(c.camera).translation())[c.axis];
+        break;
+      case Kind::CameraRotation:
+        d[k] = turned(p.camera_pose(c.camera).linear(),
+                      initial.camera_pose(c.camera).linear())[c.axis];
         break;
       default: d[k] = material_coordinate(c, p) - material_coordinate(c, initial);
     }
@@ -223,11 +236,17 @@ std::string suggestion(Kind kind, const std::vector<Kind>& partners) {
   const auto is = [](Kind want) { return [want](Kind k) { return k == want; }; };
   const auto grip = [](Kind k) { return k == Kind::GripTranslation || k == Kind::GripRotation; };
   const auto pose = [](Kind k) { return k == Kind::PoseTranslation || k == Kind::PoseRotation; };
+  const auto camera = [](Kind k) {
+    return k == Kind::CameraTranslation || k == Kind::CameraRotation;
+  };
   if (has(is(Kind::LogYoungsModulus)) && has(is(Kind::LogDensity)))
     return "add a frame with a different load of known size (its \"loads\" in the observations "
            "file: a hanging weight of known mass, e.g. hung from the free end, or from the "
            "middle of an object held at both ends), or weigh the object and give its density: "
            "under gravity alone the shape shows only E/density";
+  if (has(camera))
+    return "markers (a tracker sees the object in the world's frame), or a second camera's "
+           "points: one camera's offset moves all it sees as the object's pose does";
   if (is_material(kind) && any_partner(grip))
     return "a second robot pose that turns the object against gravity";
   if (is_material(kind) && any_partner(pose))
@@ -289,6 +308,11 @@ double reported_value(const ParameterCoordinate& c, const PhysicalParameters& p,
       const Eigen::AngleAxisd r(p.object_pose.linear() * initial.object_pose.linear().transpose());
       return (r.angle() * r.axis())[c.axis];
     }
+    case Kind::CameraTranslation: return p.camera_pose(c.camera).translation()[c.axis];
+    case Kind::CameraRotation: {
+      const Eigen::AngleAxisd r(p.camera_pose(c.camera).linear());
+      return (r.angle() * r.axis())[c.axis];
+    }
   }
   return 0;
 }
@@ -299,9 +323,11 @@ const char* unit_of(Kind kind) {
     case Kind::PoissonLogit: return "";
     case Kind::LogDensity: return "kg/m^3";
     case Kind::GripTranslation:
-    case Kind::PoseTranslation: return "m";
+    case Kind::PoseTranslation:
+    case Kind::CameraTranslation: return "m";
     case Kind::GripRotation:
-    case Kind::PoseRotation: return "rad";
+    case Kind::PoseRotation:
+    case Kind::CameraRotation: return "rad";
   }
   return "";
 }
@@ -341,7 +367,7 @@ CalibrationResult calibrate(const Scene& scene, const Observations& observations
   const auto started = std::chrono::steady_clock::now();
   if (observations.frames.empty()) throw std::invalid_argument("no observed frames");
   check_frames(scene, observations, fit);
-  const ParameterSpace space(scene, fit);
+  const ParameterSpace space(scene, fit, camera_count(observations));
   const PhysicalParameters initial = PhysicalParameters::of(scene);
   if (const std::string name = outside_bounds(space, initial, options.bounds); !name.empty())
     throw std::invalid_argument(name + ": the scene's value is outside its bounds");

@@ -128,7 +128,7 @@ std::string object_pose_refusal(const Scene& scene) {
 }  // namespace
 
 const char* fit_parameter_names() {
-  return "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose, "
+  return "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose, camera_poses, "
          "regions[K].youngs_modulus, regions[K].poisson_ratio, regions[K].density";
 }
 
@@ -146,6 +146,7 @@ FitSelection parse_fit_selection(const std::string& list) {
     else if (item == "density") s.density = true;
     else if (item == "grip_offsets") s.grip_offsets = true;
     else if (item == "object_pose") s.object_pose = true;
+    else if (item == "camera_poses") s.camera_poses = true;
     else if (const auto region = parse_region_parameter(item)) s.regions.push_back(*region);
     else
       throw std::invalid_argument("unknown parameter \"" + item + "\" (expected " +
@@ -167,6 +168,11 @@ PhysicalParameters PhysicalParameters::of(const Scene& scene) {
     p.regions.push_back(
         {youngs_modulus_of(r.material), poisson_ratio_of(r.material), r.material.density});
   return p;
+}
+
+Eigen::Isometry3d PhysicalParameters::camera_pose(int k) const {
+  return k < static_cast<int>(camera_poses.size()) ? camera_poses[k]
+                                                   : Eigen::Isometry3d::Identity();
 }
 
 MaterialValues PhysicalParameters::material(int region) const {
@@ -195,7 +201,7 @@ Scene PhysicalParameters::applied_to(const Scene& scene) const {
   return out;
 }
 
-ParameterSpace::ParameterSpace(const Scene& scene, const FitSelection& selection) {
+ParameterSpace::ParameterSpace(const Scene& scene, const FitSelection& selection, int cameras) {
   if (selection.youngs_modulus)
     coordinates_.push_back({Kind::LogYoungsModulus, -1, -1, "youngs_modulus", 1});
   if (selection.poisson_ratio)
@@ -228,6 +234,16 @@ ParameterSpace::ParameterSpace(const Scene& scene, const FitSelection& selection
     add_motion_coordinates(coordinates_, Kind::PoseTranslation, Kind::PoseRotation, -1,
                            "object_pose.");
   }
+  if (selection.camera_poses) {
+    if (cameras <= 0)
+      throw std::invalid_argument(
+          "camera_poses: no frame has a depth image (a camera's pose moves its image's points)");
+    for (int k = 0; k < cameras; ++k) {
+      add_motion_coordinates(coordinates_, Kind::CameraTranslation, Kind::CameraRotation, -1,
+                             "cameras[" + std::to_string(k) + "].pose.");
+      for (auto c = coordinates_.end() - 6; c != coordinates_.end(); ++c) c->camera = k;
+    }
+  }
 }
 
 PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p,
@@ -235,6 +251,7 @@ PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p,
   PhysicalParameters out = p;
   std::vector<Vec3> dt(p.grip_offsets.size(), Vec3::Zero()), dr = dt;
   Vec3 pose_dt = Vec3::Zero(), pose_dr = Vec3::Zero();
+  std::vector<Vec3> camera_dt, camera_dr;
   for (int k = 0; k < size(); ++k) {
     const ParameterCoordinate& c = coordinates_[k];
     switch (c.kind) {
@@ -254,7 +271,19 @@ PhysicalParameters ParameterSpace::advanced(const PhysicalParameters& p,
       case Kind::GripRotation: dr[c.grip][c.axis] = dz[k]; break;
       case Kind::PoseTranslation: pose_dt[c.axis] = dz[k]; break;
       case Kind::PoseRotation: pose_dr[c.axis] = dz[k]; break;
+      case Kind::CameraTranslation:
+      case Kind::CameraRotation: {
+        const std::size_t n = static_cast<std::size_t>(c.camera) + 1;
+        if (camera_dt.size() < n)
+          camera_dt.resize(n, Vec3::Zero()), camera_dr.resize(n, Vec3::Zero());
+        (c.kind == Kind::CameraTranslation ? camera_dt : camera_dr)[c.camera][c.axis] = dz[k];
+        break;
+      }
     }
+  }
+  for (std::size_t k = 0; k < camera_dt.size(); ++k) {
+    if (out.camera_poses.size() <= k) out.camera_poses.resize(k + 1, Eigen::Isometry3d::Identity());
+    move(out.camera_poses[k], camera_dt[k], camera_dr[k]);
   }
   for (std::size_t g = 0; g < out.grip_offsets.size(); ++g) move(out.grip_offsets[g], dt[g], dr[g]);
   move(out.object_pose, pose_dt, pose_dr);
@@ -270,6 +299,20 @@ double ParameterSpace::physical_per_coordinate(const ParameterCoordinate& c,
     case Kind::PoissonLogit: return m.poisson_ratio * (1 - 2 * m.poisson_ratio);
     default: return 1;  // m and rad: the coordinates themselves
   }
+}
+
+CameraMotion ParameterSpace::camera_motion(int camera, const Vec3& camera_position,
+                                           const PhysicalParameters& p) const {
+  // p' = o + t_C + R_C (p − o) for camera position o and correction C.
+  const Eigen::Isometry3d C = p.camera_pose(camera);
+  CameraMotion m;
+  m.motion.linear() = C.linear();
+  m.motion.translation() = camera_position + C.translation() - C.linear() * camera_position;
+  m.origin = camera_position + C.translation();
+  for (int k = 0; k < size() && m.column < 0; ++k)
+    if (coordinates_[k].kind == Kind::CameraTranslation && coordinates_[k].camera == camera)
+      m.column = k;
+  return m;
 }
 
 Eigen::MatrixXd ParameterSpace::force_derivatives(const ObjectStatics& statics, const Scene& scene,

@@ -8,6 +8,10 @@
 // has one material per region besides its own (the elements in no region): each region's
 // Young's modulus, Poisson's ratio and density are coordinates of their own
 // ("regions[1].youngs_modulus"), their derivatives taken over that region's elements alone.
+// A depth camera's pose (observations' "depth_image", "camera": K) is corrected the same way:
+// 3 translations and 3 rotations ("cameras[K].pose.x" ... ".rz"), applied on the left in world
+// axes about the camera's origin o, so its points move rigidly, p' = o + δt + R_δ (p − o); the
+// model's x̂ does not move, the residuals do (calib/observation_residuals.hpp).
 //
 // For equilibria x̂ the forces' derivatives ∂F/∂z (F = −∂E/∂x) give the parameter sensitivity
 // dx̂/dz = H⁻¹ ∂F/∂z (GrippedObject::force_response), exactly as dx̂/dθ. The object's pose
@@ -38,16 +42,18 @@ struct FitSelection {
   bool grip_offsets = false;
   bool object_pose = false;
   std::vector<RegionParameter> regions = {};
+  bool camera_poses = false;  // every depth camera's pose correction
   bool empty() const {
-    return !(youngs_modulus || poisson_ratio || density || grip_offsets || object_pose) &&
+    return !(youngs_modulus || poisson_ratio || density || grip_offsets || object_pose ||
+             camera_poses) &&
            regions.empty();
   }
 };
-// Parsed from "youngs_modulus,poisson_ratio,density,grip_offsets,object_pose,
+// Parsed from "youngs_modulus,poisson_ratio,density,grip_offsets,object_pose,camera_poses,
 // regions[1].youngs_modulus". Throws std::invalid_argument naming the unknown entry and the
 // known ones.
 FitSelection parse_fit_selection(const std::string& list);
-// "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose,
+// "youngs_modulus, poisson_ratio, density, grip_offsets, object_pose, camera_poses,
 // regions[K].youngs_modulus, ...": for messages.
 const char* fit_parameter_names();
 // What to fit when nobody says: a robot's grips are where the real object is held off; a
@@ -68,7 +74,11 @@ struct PhysicalParameters {
   std::vector<Eigen::Isometry3d> grip_offsets;                    // one per scene grip
   Eigen::Isometry3d object_pose = Eigen::Isometry3d::Identity();  // T_world_object
   std::vector<MaterialValues> regions;                            // one per scene region
+  // Depth camera K's pose correction C (T_world_camera ← (R_C R, t + t_C)); missing: identity.
+  std::vector<Eigen::Isometry3d> camera_poses;
 
+  // Camera k's correction (identity when not fitted).
+  Eigen::Isometry3d camera_pose(int k) const;
   // Region r's material, or the object's own for r = -1.
   MaterialValues material(int region) const;
   void set_material(int region, const MaterialValues& values);
@@ -87,25 +97,39 @@ struct ParameterCoordinate {
     GripTranslation,
     GripRotation,
     PoseTranslation,
-    PoseRotation
+    PoseRotation,
+    CameraTranslation,
+    CameraRotation
   };
   Kind kind;
   int grip = -1;  // for grip coordinates
-  int axis = -1;  // 0..2 for grip and pose coordinates (the TCP frame's or the world's x, y, z)
+  int axis =
+      -1;  // 0..2 for grip, pose and camera coordinates (the TCP frame's or the world's x, y, z)
   // "youngs_modulus", "grip_offsets.left.x", "grip_offsets.left.rx", "object_pose.rz",
   // "regions[1].youngs_modulus"
   std::string name;
   // Typical size of a change worth noticing: 1 (a factor e) for the logarithms, 1 cm, 0.1 rad.
   double scale = 1;
   int region = -1;  // material coordinates: the region's (-1: the object's own material)
+  int camera = -1;  // camera coordinates: the camera's index
+};
+
+// How a frame's points move with their camera's pose correction: p' = motion p, rotations
+// turning about `origin` (the corrected camera's), and where the camera's six coordinates are.
+struct CameraMotion {
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  Vec3 origin = Vec3::Zero();
+  int column = -1;  // index of its "x" coordinate (then y, z, rx, ry, rz); -1: not fitted
 };
 
 class ParameterSpace {
  public:
   // Throws std::invalid_argument when the scene has nothing a selected parameter moves: no
   // grips for grip_offsets; for object_pose, an object the robot's grips hold (they tie it to
-  // the grippers, which are where the joints put them); a region the scene does not have.
-  ParameterSpace(const Scene& scene, const FitSelection& selection);
+  // the grippers, which are where the joints put them); a region the scene does not have;
+  // camera_poses without cameras. cameras: how many depth cameras the observations have
+  // (camera_count).
+  ParameterSpace(const Scene& scene, const FitSelection& selection, int cameras = 0);
   const std::vector<ParameterCoordinate>& coordinates() const { return coordinates_; }
   int size() const { return static_cast<int>(coordinates_.size()); }
 
@@ -125,6 +149,9 @@ class ParameterSpace {
   // dν/ds etc.: the derivative of the physical value a coordinate moves (Pa, 1, kg/m^3, m,
   // rad) with respect to the coordinate, for reporting standard deviations in physical units.
   double physical_per_coordinate(const ParameterCoordinate& c, const PhysicalParameters& p) const;
+  // How the points of a depth camera at `camera_position` (world) with index `camera` move at p.
+  CameraMotion camera_motion(int camera, const Vec3& camera_position,
+                             const PhysicalParameters& p) const;
 
  private:
   std::vector<ParameterCoordinate> coordinates_;

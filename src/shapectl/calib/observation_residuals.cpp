@@ -4,11 +4,12 @@
 
 namespace shapectl {
 
-double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surface) {
+double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surface,
+                      const CameraMotion& camera) {
   if (frame.points.empty()) return 0;
   std::vector<double> d;
   d.reserve(frame.points.size());
-  for (const Vec3& p : frame.points) d.push_back(surface.closest(p).distance);
+  for (const Vec3& p : frame.points) d.push_back(surface.closest(camera.motion * p).distance);
   auto middle = d.begin() + d.size() / 2;
   std::nth_element(d.begin(), middle, d.end());
   return std::max(4 * frame.sigma, 3 * 1.4826 * *middle);
@@ -16,12 +17,13 @@ double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surf
 
 FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x,
                                const SurfaceDistance& surface, double cutoff,
-                               const Eigen::MatrixXd& dx_dz) {
+                               const Eigen::MatrixXd& dx_dz, const CameraMotion& camera) {
   const bool with_jacobian = dx_dz.size() > 0;
   const double w = 1 / frame.sigma;
   std::vector<std::pair<Vec3, SurfaceHit>> inliers;
   FrameResiduals out;
-  for (const Vec3& p : frame.points) {
+  for (const Vec3& observed : frame.points) {
+    const Vec3 p = camera.motion * observed;
     const SurfaceHit hit = surface.closest(p);
     if (hit.distance <= cutoff) inliers.emplace_back(p, hit);
     else out.outlier_cost += 0.5 * cutoff * cutoff * w * w;
@@ -47,6 +49,11 @@ FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x
         for (int k = 0; k < 3; ++k)
           out.jacobian.row(row) -=
               w * hit.barycentric[k] * u.transpose() * dx_dz.middleRows(3 * hit.nodes[k], 3);
+        if (camera.column >= 0) {
+          out.jacobian.row(row).segment<3>(camera.column) += w * u.transpose();
+          out.jacobian.row(row).segment<3>(camera.column + 3) +=
+              w * (p - camera.origin).cross(u).transpose();
+        }
       }
     }
     ++row;

@@ -6,10 +6,14 @@
 // d is the distance to the closest point c = Σₖ bₖ x̂ₖ on the deformed surface triangles and
 // u = (p − c)/d: the derivative of the distance through the closest point (its barycentrics
 // bₖ held fixed, which is exact at a distance minimum).
+// A depth camera's points move with its pose correction (calib/model_parameters.hpp): the
+// residual is d(p', surface) with p' = CameraMotion p, and its camera columns
+//   ∂r/∂δt = uᵀ / σ,   ∂r/∂δr = ((p' − o) × u)ᵀ / σ   (o the corrected camera's origin).
 // Cloud points farther than the frame's cut-off τ are outliers (background, noise): they add
 // the constant τ²/σ² to the cost and no row, a truncated quadratic that bounds their pull.
 #include <vector>
 
+#include <shapectl/calib/model_parameters.hpp>
 #include <shapectl/calib/observations.hpp>
 #include <shapectl/calib/surface_distance.hpp>
 
@@ -28,11 +32,13 @@ struct FrameResiduals {
 // A cut-off for the frame's cloud at the positions x: every point within 4σ, and otherwise
 // points within 3 robust standard deviations (1.4826 × the median distance) of the surface,
 // so a model still centimetres off keeps its inliers while background stays out.
-double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surface);
+double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surface,
+                      const CameraMotion& camera = {});
 
-// `surface` must have been updated to x. dx_dz may be empty (residuals only).
+// `surface` must have been updated to x. dx_dz may be empty (residuals only). `camera` moves
+// the frame's points (the identity for a frame without a depth image).
 FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x,
                                const SurfaceDistance& surface, double cutoff,
-                               const Eigen::MatrixXd& dx_dz);
+                               const Eigen::MatrixXd& dx_dz, const CameraMotion& camera = {});
 
 }  // namespace shapectl

@@ -1,9 +1,11 @@
 #include <shapectl/calib/observations.hpp>
 
+#include <algorithm>
 #include <set>
 #include <sstream>
 #include <string>
 
+#include <shapectl/calib/depth_image_file.hpp>
 #include <shapectl/calib/point_cloud_file.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/robot/joints_file.hpp>
@@ -112,15 +114,25 @@ std::vector<NodeLoad> read_frame_loads(const JsonInput& list, const ObservationC
 }  // namespace
 
 ObservationFrame read_observation_frame(const JsonInput& frame, const ObservationContext& context) {
-  frame.expect_only(
-      {"joints", "markers", "points", "points_file", "sigma", "time", "loads", "object_pose"});
+  frame.expect_only({"joints", "markers", "points", "points_file", "depth_image", "sigma", "time",
+                     "loads", "object_pose"});
   ObservationFrame out;
   out.joints = read_frame_joints(frame, context.robot);
   if (frame.has("markers")) out.markers = read_markers(frame.at("markers"), context.node_count);
-  if (frame.has("points") && frame.has("points_file"))
-    frame.fail_problem("both \"points\" and \"points_file\"; expected one or the other");
+  if (frame.has("points") + frame.has("points_file") + frame.has("depth_image") > 1)
+    frame.fail_problem(
+        "more than one of \"points\", \"points_file\" and \"depth_image\"; expected one");
   if (frame.has("points")) out.points = read_inline_points(frame.at("points"));
   if (frame.has("points_file")) out.points = read_points_file(frame.at("points_file"), context);
+  if (frame.has("depth_image")) {
+    if (!context.allow_points_files)
+      frame.at("depth_image")
+          .fail_problem(
+              "depth images are read only from an observations file; expected \"points\"");
+    DepthImageObservation depth = read_depth_image(frame.at("depth_image"));
+    out.points = std::move(depth.points);
+    out.camera = depth.camera;
+  }
   if (out.markers.empty() && out.points.empty())
     frame.fail_problem("nothing observed; expected at least one marker or one point");
   if (frame.has("sigma")) out.sigma = frame.at("sigma").positive();
@@ -165,6 +177,13 @@ Observations read_observations(const JsonInput& json, const ObservationContext& 
                                 " points in all frames together");
   }
   return out;
+}
+
+int camera_count(const Observations& observations) {
+  int count = 0;
+  for (const ObservationFrame& f : observations.frames)
+    if (f.camera) count = std::max(count, f.camera->index + 1);
+  return count;
 }
 
 Observations load_observations(const std::filesystem::path& file, ObservationContext context) {

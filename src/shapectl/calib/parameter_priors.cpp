@@ -112,6 +112,12 @@ CalibrationPriors parse_priors(const std::string& text, CalibrationPriors base) 
       p.grip_translation = prior_value(entry, value, Quantity::Length);
     else if (key == "grip_offsets.rotation")
       p.grip_rotation = prior_value(entry, value, Quantity::Angle);
+    else if (key == "camera_poses")
+      motion_prior(entry, value, &p.camera_translation, &p.camera_rotation);
+    else if (key == "camera_poses.translation")
+      p.camera_translation = prior_value(entry, value, Quantity::Length);
+    else if (key == "camera_poses.rotation")
+      p.camera_rotation = prior_value(entry, value, Quantity::Angle);
     else if (key == "youngs_modulus")
       p.youngs_modulus = prior_value(entry, value, Quantity::Fraction);
     else if (key == "density") p.density = prior_value(entry, value, Quantity::Fraction);
@@ -121,7 +127,8 @@ CalibrationPriors parse_priors(const std::string& text, CalibrationPriors base) 
       throw std::invalid_argument(
           "\"" + entry +
           "\": unknown name (expected object_pose, object_pose.translation, object_pose.rotation, "
-          "grip_offsets, grip_offsets.translation, grip_offsets.rotation, youngs_modulus, "
+          "grip_offsets, grip_offsets.translation, grip_offsets.rotation, camera_poses, "
+          "camera_poses.translation, camera_poses.rotation, youngs_modulus, "
           "density, poisson_ratio, or off alone)");
   }
   return p;
@@ -169,6 +176,8 @@ double prior_sigma(const CalibrationPriors& priors, const ParameterCoordinate& c
     case Kind::GripRotation: return priors.grip_rotation;
     case Kind::PoseTranslation: return priors.pose_translation;
     case Kind::PoseRotation: return priors.pose_rotation;
+    case Kind::CameraTranslation: return priors.camera_translation;
+    case Kind::CameraRotation: return priors.camera_rotation;
   }
   return 0;
 }

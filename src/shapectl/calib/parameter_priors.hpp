@@ -22,8 +22,11 @@ struct CalibrationPriors {
   double youngs_modulus = 0;
   double density = 0;
   double poisson_ratio = 0;
+  // A depth camera's pose correction: as the object's pose (a camera calibrated to ~1 cm, 2°).
+  double camera_translation = 0.010;
+  double camera_rotation = 2 * M_PI / 180;
 
-  static CalibrationPriors none() { return {0, 0, 0, 0, 0, 0, 0}; }
+  static CalibrationPriors none() { return {0, 0, 0, 0, 0, 0, 0, 0, 0}; }
 };
 
 struct ValueInterval {
@@ -39,9 +42,9 @@ struct MaterialBounds {
 };
 
 // "object_pose.rotation=2deg,object_pose.translation=10mm,grip_offsets=5mm/3deg,
-// youngs_modulus=50%": entries change `base` (units mm, m, deg, rad; % for material; none or
-// off for no prior); "off" or "none" alone: no priors. Throws std::invalid_argument naming the
-// entry and what was expected.
+// camera_poses=10mm/2deg,youngs_modulus=50%": entries change `base` (units mm, m, deg, rad; % for
+// material; none or off for no prior); "off" or "none" alone: no priors. Throws
+// std::invalid_argument naming the entry and what was expected.
 CalibrationPriors parse_priors(const std::string& text, CalibrationPriors base = {});
 // "youngs_modulus=1e3:1e8,density=:2000,poisson_ratio=0.3:0.45" (an empty side: unbounded):
 // entries change `base`. Throws std::invalid_argument naming the entry.

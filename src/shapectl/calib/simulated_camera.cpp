@@ -4,6 +4,8 @@
 
 #include <Eigen/Geometry>
 
+#include <shapectl/calib/depth_render.hpp>
+
 namespace shapectl {
 
 ObservationFrame SimulatedCamera::observe(const TetMesh& mesh, const Positions& positions,
@@ -45,6 +47,20 @@ ObservationFrame SimulatedCamera::observe(const TetMesh& mesh, const Positions& 
     frame.points.push_back(lo - margin + r.cwiseProduct(hi - lo + 2 * margin));
   }
   return frame;
+}
+
+DepthImage SimulatedCamera::depth_image(const TetMesh& mesh, const Positions& positions,
+                                        const PinholeIntrinsics& intrinsics,
+                                        const Eigen::Isometry3d& T_world_camera, int width,
+                                        int height, std::mt19937& rng) const {
+  DepthImage image = render_depth(mesh, positions, intrinsics, T_world_camera, width, height);
+  std::normal_distribution<double> noise(0, sigma);
+  std::uniform_real_distribution<double> unit(0, 1);
+  for (double& z : image.depth) {
+    if (std::isnan(z)) continue;
+    z = unit(rng) < outlier_fraction ? z * (0.5 + unit(rng)) : z + noise(rng);
+  }
+  return image;
 }
 
 }  // namespace shapectl
