@@ -11,6 +11,7 @@
 
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/sim/object_statics.hpp>
+#include <shapectl/sim/scene_checks.hpp>
 
 #include "support/self_intersection.hpp"
 
@@ -135,6 +136,41 @@ TEST(SelfContactStatics, RandomEndLoadsNeverPassTheBarThroughItself) {
             << touching << " of them touching themselves\n";
   EXPECT_GE(converged, 54);  // all 60 on the 2026-11-28 run
   EXPECT_GE(touching, 20);   // 34 then
+}
+
+// Two tetrahedra passing through each other at rest, fixed: with self-contact on, the scene
+// checks refuse the mesh naming two surface triangles that meet, and so does the solve.
+TEST(SelfContactStatics, ARestShapeThroughItselfIsRefused) {
+  Scene s;
+  s.source = "crossed";
+  s.object_mesh = std::make_shared<const TetMesh>(TetMesh({{0, 0, 0},
+                                                           {0.1, 0, 0},
+                                                           {0, 0.1, 0},
+                                                           {0, 0, 0.1},
+                                                           {0.02, 0.02, -0.02},
+                                                           {0.12, 0.02, -0.02},
+                                                           {0.02, 0.12, -0.02},
+                                                           {0.02, 0.02, 0.08}},
+                                                          {{0, 1, 2, 3}, {4, 5, 6, 7}}));
+  s.material = material_from_youngs(2e5, 0.3, 40);
+  s.fixed = NodeSelection{.nodes = {0, 1, 2, 4, 5, 6}};
+  EXPECT_NO_THROW(check_scene(s)) << "without self-contact the overlap is allowed";
+  s.contact.self = true;
+  std::string what;
+  try {
+    check_scene(s);
+  } catch (const std::exception& e) {
+    what = e.what();
+  }
+  EXPECT_NE(what.find("contact.self"), std::string::npos) << what;
+  EXPECT_NE(what.find("intersects itself"), std::string::npos) << what;
+  EXPECT_NE(what.find("surface triangle"), std::string::npos) << what;
+  EXPECT_NE(what.find(" meets surface triangle "), std::string::npos) << what;
+  Positions x = s.world_rest_positions();
+  const StaticsResult r = ObjectStatics(s).solve(x);
+  EXPECT_EQ(r.status, StaticsStatus::Inverted);
+  EXPECT_NE(r.reason.find("intersects itself (object surface triangles"), std::string::npos)
+      << r.reason;
 }
 
 }  // namespace
