@@ -51,7 +51,7 @@ void run(benchmark::State& state, int what) {
   Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size());
   const Eigen::VectorXd dx = Eigen::VectorXd::Constant(x.size(), -0.001);
   ElementNodes elements;
-  contact.hessian_elements(elements);
+  contact.hessian_elements(x, elements);
   DiscardingSink sink(elements.size());
   for (auto _ : state) {
     if (what == 0) benchmark::DoNotOptimize(contact.value(x));

@@ -140,7 +140,7 @@ class BlockSink : public ElementHessianSink {
 
 std::vector<Eigen::MatrixXd> blocks(const EnergyTerm& term, const Positions& x, bool project) {
   ElementNodes elements;
-  term.hessian_elements(elements);
+  term.hessian_elements(x, elements);
   BlockSink sink(elements);
   term.add_hessian(x, sink, project);
   EXPECT_EQ(sink.blocks.size(), elements.size());
@@ -372,14 +372,14 @@ TEST(ObstacleContact, HessianElementsAreTheSurfaceVerticesEdgesAndTriangles) {
   const TetMesh mesh = make_box_mesh({0.1, 0.1, 0.02}, {1, 1, 1});
   const ObstacleContact contact(mesh, every_kind(), kDhat, 1.0);
   ElementNodes elements;
-  contact.hessian_elements(elements);
+  contact.hessian_elements(mesh.rest_vector(), elements);
   // A box of one cell: 8 vertices, 12 triangles, 18 edges.
   ASSERT_EQ(elements.size(), 8u + 18u + 12u);
   for (std::size_t e = 0; e < 8; ++e) EXPECT_EQ(elements.node_count(e), 1);
   for (std::size_t e = 8; e < 26; ++e) EXPECT_EQ(elements.node_count(e), 2);
   for (std::size_t e = 26; e < 38; ++e) EXPECT_EQ(elements.node_count(e), 3);
   ElementNodes again;
-  contact.hessian_elements(again);
+  contact.hessian_elements(mesh.rest_vector(), again);
   EXPECT_EQ(elements, again);
 }
 

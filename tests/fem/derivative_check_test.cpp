@@ -121,7 +121,7 @@ class CubicTerm final : public EnergyTerm {
     return fault_ == Fault::FusedValue ? e * (1 + 1e-15) : e;
   }
   // One element per node of energy_point()'s two: a diagonal 3×3 block.
-  void hessian_elements(ElementNodes& elements) const override {
+  void hessian_elements(const Positions&, ElementNodes& elements) const override {
     elements.add({0});
     elements.add({1});
   }
@@ -150,7 +150,7 @@ class LinearTerm final : public EnergyTerm {
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override {
     gradient += Eigen::VectorXd::LinSpaced(x.size(), 1, static_cast<double>(x.size()));
   }
-  void hessian_elements(ElementNodes&) const override {}
+  void hessian_elements(const Positions&, ElementNodes&) const override {}
   void add_hessian(const Positions&, ElementHessianSink&, bool) const override {}
 };
 

@@ -88,7 +88,7 @@ def test_a_solve_reports_the_contacts_of_its_best_joints(bar_scene):
 
 @pytest.mark.parametrize("contact, field", [
     ({"friction": 0.3}, "contact.friction"),
-    ({"self": True}, "contact.self"),
+    ({"self": 1}, "contact.self"),
     ({"distance": -1}, "contact.distance"),
 ])
 def test_what_is_not_modelled_or_bad_is_refused_naming_the_field(contact, field):

@@ -130,7 +130,7 @@ TEST(HessianAssembler, AssemblesTheValuesOfTheLearnedPatternAndNothingBeforeIt) 
   const std::vector<const EnergyTerm*> terms{&p.elastic, &p.gravity, &grip};
   HessianAssembler assembler(x.size(), p.fixed_dof);
   EXPECT_THROW(assembler.assemble_values(terms, x, false), std::logic_error);
-  EXPECT_EQ(assembler.learn_pattern(terms), 1);
+  EXPECT_EQ(assembler.learn_pattern(terms, x), 1);
   expect_same_matrix(assembler.assemble_values(terms, x, false),
                      from_triplets(terms, x, p.fixed_dof, false));
   EXPECT_THROW(assembler.assemble_values({&p.elastic}, x, false), std::logic_error)

@@ -1,6 +1,7 @@
-// No equilibrium passes through an obstacle (issue 34): random obstacles near a sagging
-// cantilever and under a bar two arms move at random; every converged state is checked
-// against every obstacle with tests/support's own geometry, not contact/'s.
+// No equilibrium passes through an obstacle or through itself (issue 34): random obstacles near
+// a sagging cantilever and under a bar two arms move at random, with self-contact on; every
+// converged state is checked against every obstacle and against itself with tests/support's own
+// geometry, not contact/'s.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -10,6 +11,7 @@
 #include <shapectl/sim/object_statics.hpp>
 
 #include "support/obstacle_clearance.hpp"
+#include "support/self_intersection.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
@@ -84,6 +86,7 @@ TEST(NoIntersection, RandomObstaclesUnderASaggingCantilever) {
     scene.material = material_from_youngs(2e5, 0.3, 100);
     scene.fixed = NodeSelection{.box = AlignedBox{Vec3(-1, -1, -1), Vec3(-0.15 + 1e-6, 1, 1)}};
     scene.contact.distance = 1e-3;
+    scene.contact.self = true;
     std::vector<ObstacleShape> shapes;
     for (int k = 1 + static_cast<int>(rng() % 2); k > 0; --k)
       shapes.push_back(random_obstacle(rng));
@@ -102,6 +105,8 @@ TEST(NoIntersection, RandomObstaclesUnderASaggingCantilever) {
     touching += statics.contact()->summary(x).count > 0;
     ASSERT_EQ(first_intersection(statics.mesh(), x, shapes), "")
         << "placement " << placements << " (" << r.reason << ")";
+    ASSERT_EQ(test::self_intersection(x, statics.mesh().surface_triangles()), "")
+        << "placement " << placements;
   }
   std::cout << converged << " of 150 converged, " << touching << " of them touching\n";
   EXPECT_GE(converged, 120);  // the check means something only for accepted states
@@ -127,6 +132,7 @@ TEST(NoIntersection, ArmsPushAGrippedBarOntoATableAndABox) {
   shapes[1].pose.translation() = Vec3(centre.x(), centre.y(), bottom - 0.008 - 0.02);
   shapes[1].pose.linear() = Eigen::AngleAxisd(0.4, Vec3::UnitZ()).toRotationMatrix();
   scene.contact.distance = 1e-3;
+  scene.contact.self = true;
   for (std::size_t k = 0; k < shapes.size(); ++k)
     scene.obstacles.push_back(shapes[k].obstacle(k == 0 ? "table" : "box"));
   // Contact takes Newton many more iterations than free motion (20-200 here, 5-19 without the
@@ -159,6 +165,8 @@ TEST(NoIntersection, ArmsPushAGrippedBarOntoATableAndABox) {
     ++converged;
     touching += object.statics().contact()->summary(next.positions()).count > 0;
     ASSERT_EQ(first_intersection(object.mesh(), next.positions(), shapes), "") << "step " << step;
+    ASSERT_EQ(test::self_intersection(next.positions(), object.mesh().surface_triangles()), "")
+        << "step " << step;
     current = std::move(next);
   }
   std::cout << converged << " of 50 converged, " << touching << " touching\n";

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 namespace shapectl {
 
@@ -14,6 +16,13 @@ BarrierValue barrier(double d, double dhat) {
   const double e = d - dhat, log_ratio = std::log(d / dhat);
   return {-e * e * log_ratio, -2 * e * log_ratio - e * e / d,
           -2 * log_ratio - 4 * e / d + e * e / (d * d)};
+}
+
+void check_barrier_parameters(const char* term, double distance, double stiffness) {
+  if (!(distance > 0) || !std::isfinite(distance))
+    throw std::invalid_argument(std::string(term) + ": distance must be positive and finite");
+  if (!(stiffness >= 0) || !std::isfinite(stiffness))
+    throw std::invalid_argument(std::string(term) + ": stiffness must be non-negative and finite");
 }
 
 }  // namespace shapectl

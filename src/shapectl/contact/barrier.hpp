@@ -12,4 +12,7 @@ struct BarrierValue {
 // b and its first two derivatives at gap d for the distance d̂ > 0; all +inf for d ≤ 0.
 BarrierValue barrier(double d, double dhat);
 
+// Throws std::invalid_argument, naming `term`, unless d̂ > 0 and κ ≥ 0 are finite.
+void check_barrier_parameters(const char* term, double distance, double stiffness);
+
 }  // namespace shapectl

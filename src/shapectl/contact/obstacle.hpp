@@ -44,7 +44,7 @@ Obstacle make_mesh_obstacle(std::string name, std::vector<Vec3> vertices,
 // The scene's "contact" settings.
 struct ContactSettings {
   double distance = 1e-3;  // d̂, m: the barrier acts on gaps below it
-  bool self = false;       // object self-contact (not supported yet: load_scene refuses true)
+  bool self = false;       // object self-contact (self_contact.hpp)
   bool robot = false;      // robot collision spheres as obstacles (not supported yet: refused)
   double friction = 0;     // Coulomb coefficient (not supported yet: > 0 refused)
   // κ, J/m² (= N/m); none: from the object's mean nodal weight (obstacle_contact.hpp).

@@ -460,16 +460,11 @@ Aabb box_of(std::initializer_list<Vec3> points, double radius) {
 ObstacleContact::ObstacleContact(const TetMesh& mesh, std::vector<Obstacle> obstacles,
                                  double distance, double stiffness)
     : obstacles_(std::move(obstacles)), distance_(distance), stiffness_(stiffness) {
-  if (!(distance > 0) || !std::isfinite(distance))
-    throw std::invalid_argument("ObstacleContact: distance must be positive and finite");
-  if (!(stiffness >= 0) || !std::isfinite(stiffness))
-    throw std::invalid_argument("ObstacleContact: stiffness must be non-negative and finite");
+  check_barrier_parameters("ObstacleContact", distance, stiffness);
   auto m = std::make_shared<Impl>();
   m->triangles = mesh.surface_triangles();
   m->edges = triangle_edges(m->triangles);
-  for (const auto& t : m->triangles) m->vertices.insert(m->vertices.end(), t.begin(), t.end());
-  std::sort(m->vertices.begin(), m->vertices.end());
-  m->vertices.erase(std::unique(m->vertices.begin(), m->vertices.end()), m->vertices.end());
+  m->vertices = triangle_corners(m->triangles);
   // The surface's features by index: which vertices an edge joins, which a triangle's.
   std::vector<int> vertex_of_node(mesh.node_count(), -1);
   for (int v = 0; v < static_cast<int>(m->vertices.size()); ++v) vertex_of_node[m->vertices[v]] = v;
@@ -577,7 +572,7 @@ void ObstacleContact::add_gradient(const Positions& x, Eigen::VectorXd& gradient
   });
 }
 
-void ObstacleContact::hessian_elements(ElementNodes& elements) const {
+void ObstacleContact::hessian_elements(const Positions&, ElementNodes& elements) const {
   const Impl& m = *impl_;
   for (int v : m.vertices) elements.add({v});
   for (const auto& e : m.edges) elements.add({e[0], e[1]});

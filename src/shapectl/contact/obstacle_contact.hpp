@@ -54,7 +54,7 @@ class ObstacleContact : public EnergyTerm {
   std::string_view name() const override { return "contact"; }
   double value(const Positions& x) const override;
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
-  void hessian_elements(ElementNodes& elements) const override;
+  void hessian_elements(const Positions& x, ElementNodes& elements) const override;
   void add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const override;
   // Continuous collision detection: the largest α ∈ (0, 1] such that on the way from x to
   // x + α·dx no pair's gap falls below 10 % of where it started (so no surface passes through

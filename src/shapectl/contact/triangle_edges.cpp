@@ -17,4 +17,12 @@ std::vector<std::array<int, 2>> triangle_edges(const std::vector<std::array<int,
   return edges;
 }
 
+std::vector<int> triangle_corners(const std::vector<std::array<int, 3>>& triangles) {
+  std::vector<int> corners;
+  for (const auto& t : triangles) corners.insert(corners.end(), t.begin(), t.end());
+  std::sort(corners.begin(), corners.end());
+  corners.erase(std::unique(corners.begin(), corners.end()), corners.end());
+  return corners;
+}
+
 }  // namespace shapectl

@@ -16,7 +16,7 @@ class ConstantForce : public EnergyTerm {
     gradient += gradient_;
   }
   // Linear in x: no Hessian, no elements.
-  void hessian_elements(ElementNodes&) const override {}
+  void hessian_elements(const Positions&, ElementNodes&) const override {}
   void add_hessian(const Positions&, ElementHessianSink&, bool) const override {}
   // The forces f, stacked (3n), N.
   Eigen::VectorXd forces() const { return -gradient_; }

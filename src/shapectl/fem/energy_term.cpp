@@ -38,7 +38,7 @@ double EnergyTerm::value_and_add_gradient(const Positions& x, Eigen::VectorXd& g
 
 Triplets EnergyTerm::hessian_triplets(const Positions& x, bool project_psd) const {
   ElementNodes elements;
-  hessian_elements(elements);
+  hessian_elements(x, elements);
   Triplets out;
   TripletSink sink(elements, out);
   add_hessian(x, sink, project_psd);

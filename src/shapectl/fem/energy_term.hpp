@@ -19,10 +19,13 @@ class EnergyTerm {
   // overrides it where one pass over its elements can share the work (F, J, F⁻ᵀ per tet); the
   // default calls the two.
   virtual double value_and_add_gradient(const Positions& x, Eigen::VectorXd& gradient) const;
-  // Appends the nodes of each element whose Hessian block add_hessian gives: the same elements
-  // in the same order on every call, so an assembler can cache where each block lands.
-  virtual void hessian_elements(ElementNodes& elements) const = 0;
-  // ∂²E/∂x² as one block per element (hessian_elements order) through sink.add_blocks, called
+  // Appends the nodes of each element whose Hessian block add_hessian(x) gives at x. Most terms
+  // give the same elements in the same order at every x, so an assembler can cache where each
+  // block lands; a term whose elements follow x (self-contact: the pairs of its own surface
+  // within reach) gives them as a function of x alone, and the assembler builds a new pattern
+  // when they change.
+  virtual void hessian_elements(const Positions& x, ElementNodes& elements) const = 0;
+  // ∂²E/∂x² as one block per element (hessian_elements(x) order) through sink.add_blocks, called
   // once. `project_psd` makes each block positive semi-definite (the fallback when the true
   // Hessian cannot be factorized).
   virtual void add_hessian(const Positions& x, ElementHessianSink& sink,

@@ -233,7 +233,9 @@ double NeoHookean::value_and_add_gradient(const Positions& x, Eigen::VectorXd& g
   return energy;
 }
 
-void NeoHookean::hessian_elements(ElementNodes& elements) const { append_tets(mesh_, elements); }
+void NeoHookean::hessian_elements(const Positions&, ElementNodes& elements) const {
+  append_tets(mesh_, elements);
+}
 
 void NeoHookean::add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const {
   const auto& tets = mesh_.tets();

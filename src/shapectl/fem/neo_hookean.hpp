@@ -28,7 +28,7 @@ class NeoHookean : public EnergyTerm {
   double value(const Positions& x) const override;
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
   double value_and_add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
-  void hessian_elements(ElementNodes& elements) const override;
+  void hessian_elements(const Positions& x, ElementNodes& elements) const override;
   void add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const override;
   // One material for all elements, or one per element.
   const std::vector<Material>& materials() const { return materials_; }

@@ -121,8 +121,7 @@ ContactSettings read_contact(const JsonInput& j) {
     j.at("distance").positive();
     c.distance = j.at("distance").number_in(1e-9, max_contact_distance, "m");
   }
-  if (j.has("self") && j.at("self").boolean())
-    j.at("self").fail_problem("self-contact is not supported yet (give false or leave it out)");
+  if (j.has("self")) c.self = j.at("self").boolean();
   if (j.has("robot") && j.at("robot").boolean())
     j.at("robot").fail_problem(
         "contact with the robot is not supported yet (give false or leave it out)");

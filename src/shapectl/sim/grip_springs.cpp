@@ -63,7 +63,7 @@ void GripEnergy::add_gradient(const Positions& x, Eigen::VectorXd& gradient) con
   }
 }
 
-void GripEnergy::hessian_elements(ElementNodes& elements) const {
+void GripEnergy::hessian_elements(const Positions&, ElementNodes& elements) const {
   for (const auto& g : springs_->nodes()) elements.add({g.node});
 }
 

@@ -55,7 +55,7 @@ class GripEnergy : public EnergyTerm {
   double value(const Positions& x) const override;
   void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
   // One element per gripped node: K·I₃.
-  void hessian_elements(ElementNodes& elements) const override;
+  void hessian_elements(const Positions& x, ElementNodes& elements) const override;
   void add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const override;
   const std::vector<Vec3>& anchors() const { return anchors_; }
 

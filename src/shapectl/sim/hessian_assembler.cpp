@@ -27,11 +27,12 @@ class ScatterSink : public ElementHessianSink {
 HessianAssembler::HessianAssembler(int dof_count, std::vector<char> fixed_dof)
     : dof_count_(dof_count), fixed_dof_(std::move(fixed_dof)) {}
 
-int HessianAssembler::learn_pattern(const std::vector<const EnergyTerm*>& terms) {
+int HessianAssembler::learn_pattern(const std::vector<const EnergyTerm*>& terms,
+                                    const Positions& x) {
   asked_.resize(terms.size());
   for (std::size_t t = 0; t < terms.size(); ++t) {
     asked_[t].clear();
-    terms[t]->hessian_elements(asked_[t]);
+    terms[t]->hessian_elements(x, asked_[t]);
   }
   if (scatter_ && asked_ == elements_) return pattern_version_;
   std::swap(elements_, asked_);
@@ -41,7 +42,7 @@ int HessianAssembler::learn_pattern(const std::vector<const EnergyTerm*>& terms)
 
 const SparseMatrix& HessianAssembler::assemble(const std::vector<const EnergyTerm*>& terms,
                                                const Positions& x, bool project_psd) {
-  learn_pattern(terms);
+  learn_pattern(terms, x);
   return assemble_values(terms, x, project_psd);
 }
 

@@ -22,11 +22,12 @@ class HessianAssembler {
   // How many patterns were built: a Cholesky analysed at another count must analyse again (a
   // flag for the last call alone would be lost to a later call with the same elements).
   int pattern_version() const { return pattern_version_; }
-  // Builds the pattern and scatter map of the terms' elements, if they are new (assemble()
-  // does); the matrix's values are then to be assembled. Returns pattern_version().
-  int learn_pattern(const std::vector<const EnergyTerm*>& terms);
+  // Builds the pattern and scatter map of the terms' elements at x, if they are new (assemble()
+  // does); the matrix's values at x are then to be assembled. Returns pattern_version().
+  int learn_pattern(const std::vector<const EnergyTerm*>& terms, const Positions& x);
   // assemble() without asking the terms for their elements again: for a caller that has just
-  // called learn_pattern(terms) (asking is a pass over every element, compared with the last).
+  // called learn_pattern(terms, x) at the same x (asking is a pass over every element, compared
+  // with the last).
   const SparseMatrix& assemble_values(const std::vector<const EnergyTerm*>& terms,
                                       const Positions& x, bool project_psd);
   // The node pattern of the matrix (HessianScatter::node_pattern), for fill-reducing orders.

@@ -99,13 +99,24 @@ std::optional<ConstantForce> load_term(const Scene& scene) {
 
 // The barrier on the scene's obstacles: κ as the scene gives it, else scaled to the mean nodal
 // load (default_contact_stiffness) so a resting node sits about d̂/2 off a flat obstacle.
+double contact_stiffness(const Scene& scene, const TetMesh& placed, double load) {
+  return scene.contact.stiffness.value_or(
+      default_contact_stiffness(object_load(placed, scene.material, load), placed.node_count(),
+                                scene.contact.distance));
+}
+
 std::optional<ObstacleContact> contact_term(const Scene& scene, const TetMesh& placed,
                                             double load) {
   if (scene.obstacles.empty()) return std::nullopt;
-  const double d = scene.contact.distance;
-  const double kappa = scene.contact.stiffness.value_or(
-      default_contact_stiffness(object_load(placed, scene.material, load), placed.node_count(), d));
-  return ObstacleContact(placed, scene.obstacles, d, kappa);
+  return ObstacleContact(placed, scene.obstacles, scene.contact.distance,
+                         contact_stiffness(scene, placed, load));
+}
+
+// The same barrier, κ and d̂ between the object's own surface primitives.
+std::optional<SelfContact> self_contact_term(const Scene& scene, const TetMesh& placed,
+                                             double load) {
+  if (!scene.contact.self) return std::nullopt;
+  return SelfContact(placed, scene.contact.distance, contact_stiffness(scene, placed, load));
 }
 
 std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
@@ -161,6 +172,7 @@ ObjectStatics::ObjectStatics(const Scene& scene, const std::vector<int>& held_no
       gravity_(*mesh_, elasticity_.materials(), scene.gravity),
       loads_(load_term(scene)),
       contact_(contact_term(scene, *mesh_, applied_load(scene, gravity_.weight()))),
+      self_contact_(self_contact_term(scene, *mesh_, applied_load(scene, gravity_.weight()))),
       fixed_node_(fixed_nodes(scene, *mesh_)),
       solver_(mesh_->node_count(), fixed_node_,
               statics_options(scene, *mesh_, applied_load(scene, gravity_.weight()))) {
@@ -173,6 +185,7 @@ EnergyTerms ObjectStatics::terms(const EnergyTerm* extra) const {
   EnergyTerms t = {&elasticity_, &gravity_};
   if (loads_) t.push_back(&*loads_);
   if (contact_) t.push_back(&*contact_);
+  if (self_contact_) t.push_back(&*self_contact_);
   if (extra) t.push_back(extra);
   return t;
 }
@@ -184,24 +197,30 @@ Eigen::VectorXd ObjectStatics::load_forces() const {
 StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra,
                                    int max_iterations, const StaticsWorkspace* chord,
                                    const StopRequest& stop) const {
-  if (!unheld_reason_.empty()) {
+  const auto refused = [](StaticsStatus status, std::string reason) {
     StaticsResult r;
-    r.status = StaticsStatus::Singular;
-    r.reason = unheld_reason_;
+    r.status = status;
+    r.reason = std::move(reason);
     return r;
-  }
+  };
+  if (!unheld_reason_.empty()) return refused(StaticsStatus::Singular, unheld_reason_);
+  // The barrier is infinite there: say where instead of "a non-finite energy".
   if (contact_) {
-    // The barrier is infinite there: say where instead of "a non-finite energy".
     const auto [obstacle, triangle] = contact_->first_intersection(x);
-    if (obstacle >= 0) {
-      StaticsResult r;
-      r.status = StaticsStatus::Inverted;
-      r.reason = "the starting state touches or intersects obstacle '" +
-                 contact_->obstacles()[static_cast<std::size_t>(obstacle)].name +
-                 "' (object surface triangle " + std::to_string(triangle) +
-                 "): no equilibrium sought from there";
-      return r;
-    }
+    if (obstacle >= 0)
+      return refused(StaticsStatus::Inverted,
+                     "the starting state touches or intersects obstacle '" +
+                         contact_->obstacles()[static_cast<std::size_t>(obstacle)].name +
+                         "' (object surface triangle " + std::to_string(triangle) +
+                         "): no equilibrium sought from there");
+  }
+  if (self_contact_) {
+    const auto [a, b] = self_contact_->first_intersection(x);
+    if (a >= 0)
+      return refused(StaticsStatus::Inverted,
+                     "the starting state touches or intersects itself (object surface triangles " +
+                         std::to_string(a) + " and " + std::to_string(b) +
+                         "): no equilibrium sought from there");
   }
   return solver_.solve(terms(extra), ws, x, max_iterations, chord, stop);
 }

@@ -1,12 +1,14 @@
 #pragma once
 // A scene's object as an energy and a statics solver: neo-Hookean elasticity (each element of
-// its region's material), gravity, applied loads, contact with the scene's obstacles, fixed
-// nodes, plus extra terms the caller owns (the robot's grip springs).
+// its region's material), gravity, applied loads, contact with the scene's obstacles and (with
+// contact.self) with itself, fixed nodes, plus extra terms the caller owns (the robot's grip
+// springs).
 #include <memory>
 #include <optional>
 #include <vector>
 
 #include <shapectl/contact/obstacle_contact.hpp>
+#include <shapectl/contact/self_contact.hpp>
 #include <shapectl/fem/gravity.hpp>
 #include <shapectl/fem/neo_hookean.hpp>
 #include <shapectl/sim/scene.hpp>
@@ -23,14 +25,14 @@ class ObjectStatics {
   // them, so that check is left to Newton (a part nothing holds ends Singular or not converged).
   explicit ObjectStatics(const Scene& scene, const std::vector<int>& held_nodes = {});
 
-  // The object's energy terms (elasticity, gravity, the loads and the obstacle contact if any),
-  // plus `extra` if given.
+  // The object's energy terms (elasticity, gravity, the loads, the obstacle contact and the
+  // self-contact if any), plus `extra` if given.
   EnergyTerms terms(const EnergyTerm* extra = nullptr) const;
   StaticsWorkspace make_workspace() const { return solver_.make_workspace(); }
   // Equilibrium from the warm start x (fixed nodes must be at their prescribed positions) with
   // the energy plus `extra`, in `ws` (see StaticsSolver::solve for `chord`). An object that
   // nothing holds is reported as Singular without iterating; a start that touches or intersects
-  // an obstacle as Inverted without iterating, naming the obstacle.
+  // an obstacle or itself as Inverted without iterating, naming the obstacle or the triangles.
   StaticsResult solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra = nullptr,
                       int max_iterations = 0, const StaticsWorkspace* chord = nullptr,
                       const StopRequest& stop = {}) const;
@@ -45,6 +47,8 @@ class ObjectStatics {
   double weight() const { return gravity_.weight(); }
   // The contact with the scene's obstacles; null without obstacles (no contact term at all).
   const ObstacleContact* contact() const { return contact_ ? &*contact_ : nullptr; }
+  // The contact of the object with itself; null unless the scene's contact.self.
+  const SelfContact* self_contact() const { return self_contact_ ? &*self_contact_ : nullptr; }
   // The applied loads' nodal forces (3n, N); zero without loads.
   Eigen::VectorXd load_forces() const;
   // The force Newton stops at: the scene's tolerance, or the round-off floor if larger.
@@ -54,8 +58,9 @@ class ObjectStatics {
   std::shared_ptr<const TetMesh> mesh_;
   NeoHookean elasticity_;
   Gravity gravity_;
-  std::optional<ConstantForce> loads_;      // none without loads: the default terms stay two
-  std::optional<ObstacleContact> contact_;  // none without obstacles
+  std::optional<ConstantForce> loads_;       // none without loads: the default terms stay two
+  std::optional<ObstacleContact> contact_;   // none without obstacles
+  std::optional<SelfContact> self_contact_;  // none without contact.self
   std::vector<char> fixed_node_;
   std::string unheld_reason_;
   StaticsSolver solver_;

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include <shapectl/contact/obstacle_contact.hpp>
+#include <shapectl/contact/self_contact.hpp>
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/robot/joint_limits.hpp>
 #include <shapectl/robot/kinematics.hpp>
@@ -305,6 +306,26 @@ void check_obstacle_gaps(const Scene& scene) {
                            "obstacle so that they are apart");
 }
 
+// With self-contact on, the rest shape must not meet itself: the barrier keeps the surface from
+// passing through itself, so one that starts through itself would stay so.
+void check_self_intersection(const Scene& scene) {
+  if (!scene.contact.self) return;
+  const SelfContact self(*scene.object_mesh, scene.contact.distance, 1.0);
+  const auto [a, b] = self.first_intersection(scene.world_rest_positions());
+  if (a < 0) return;
+  const auto surface = scene.object_mesh->surface_triangles();
+  const auto show_triangle = [&](int t) {
+    const auto& n = surface[static_cast<std::size_t>(t)];
+    return "surface triangle " + std::to_string(t) + " (nodes " + std::to_string(n[0]) + ", " +
+           std::to_string(n[1]) + ", " + std::to_string(n[2]) + ")";
+  };
+  throw InputError(scene.source.string(), "contact.self",
+                   "the object's rest shape intersects itself: " + show_triangle(a) + " meets " +
+                       show_triangle(b) +
+                       "; self-contact needs a mesh whose surface does not meet itself (give "
+                       "false, or mend the mesh)");
+}
+
 }  // namespace
 
 // A mesh far larger than anything the robot could hold (or than any object, without one) is
@@ -389,6 +410,7 @@ std::vector<std::string> check_scene(const Scene& scene) {
   if (const std::string w = tet_count_warning(scene); !w.empty()) warnings.push_back(w);
   check_contact_distance(scene);
   check_obstacle_gaps(scene);
+  check_self_intersection(scene);
   warn_distant_obstacles(scene, warnings);
   if (scene.robot) {
     check_joint_limits(scene, warnings);

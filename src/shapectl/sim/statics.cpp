@@ -134,7 +134,7 @@ bool StaticsSolver::factor_at(const EnergyTerms& terms, StaticsWorkspace& ws, co
     auto assemble = [&] { ws.assembler.assemble_values(terms, x, projected); };
     // A new pattern: its symbolic analysis, which reads the pattern alone, beside the assembly
     // of the values; the two share the cores.
-    if (ws.assembler.learn_pattern(terms) != ws.analyzed_pattern) {
+    if (ws.assembler.learn_pattern(terms, x) != ws.analyzed_pattern) {
       HandOff hand_off;
       tbb::parallel_invoke(hand_off(analyze), hand_off(assemble));
       hand_off.joined();

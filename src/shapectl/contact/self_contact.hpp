@@ -1,0 +1,66 @@
+#pragma once
+// The object's contact with itself (IPC, Li et al. 2020): for every pair of primitives of its
+// own surface closer than d̂ — a surface vertex and a surface triangle, or two surface edges —
+//   E = κ Σ b(d),  b(d) = −(d − d̂)² ln(d / d̂) for 0 < d < d̂, 0 beyond, +inf for d ≤ 0,
+// d the unsigned point–triangle or segment–segment distance (the same b, κ and d̂ as the
+// obstacle contact). Pairs left out: those sharing a node (their distance is 0 for ever), and
+// those closer than d̂ at rest (neighbours across a thin part of the mesh), so the rest shape is
+// never in contact with itself. Every pair is a primitive pair: a vertex near an edge is counted
+// by each triangle at that edge (IPC's own formulation, no merging of duplicates).
+//
+// Each pair couples 4 nodes anywhere on the surface, so the Hessian's elements are the pairs
+// within d̂ at x (hessian_elements(x)), in a fixed order for a given x: energy, gradient and
+// Hessian are functions of x alone, and the assembler builds a new pattern (statics a new
+// symbolic analysis) whenever that set of pairs changes.
+//
+// Smoothness: each pair's distance is one of IPC's smooth pieces (point–point, point–line,
+// point–plane, line–line) chosen by where the closest points lie: C¹ across the pieces' borders,
+// not C² there. Edge–edge pairs use the exact segment–segment distance, no mollifier: near-parallel
+// edges whose closest points lie inside both use the line–line piece, whose derivatives grow as
+// 1/sin of the edges' angle (exact, but badly conditioned); parallel ones (to rounding) take an
+// end (point–line), where the energy is C⁰ in the angle only.
+//
+// It does not depend on θ: nothing in ∂F/∂θ.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <shapectl/fem/energy_term.hpp>
+#include <shapectl/mesh/tet_mesh.hpp>
+
+namespace shapectl {
+
+class SelfContact : public EnergyTerm {
+ public:
+  // The surface of `mesh` (its surface_triangles()); its rest positions decide which pairs are
+  // neighbours (closer than `distance` at rest). κ = stiffness, J/m².
+  SelfContact(const TetMesh& mesh, double distance, double stiffness);
+
+  std::string_view name() const override { return "self-contact"; }
+  double value(const Positions& x) const override;
+  void add_gradient(const Positions& x, Eigen::VectorXd& gradient) const override;
+  // The pairs within d̂ at x, 4 nodes each (vertex, triangle / edge, edge).
+  void hessian_elements(const Positions& x, ElementNodes& elements) const override;
+  void add_hessian(const Positions& x, ElementHessianSink& sink, bool project_psd) const override;
+  // Continuous collision detection, as the obstacle term's: the largest α ∈ (0, 1] such that on
+  // the way from x to x + α·dx no pair's gap falls below 10 % of where it started.
+  double max_step(const Positions& x, const Eigen::VectorXd& dx) const override;
+
+  // The smallest gap over the pairs within d̂ at x; +inf if none is.
+  double min_distance(const Positions& x) const;
+  // Two surface triangles (indices into the mesh's surface_triangles()) sharing no node that
+  // intersect or touch at x; {-1, -1} if none. Every such pair, neighbours at rest included.
+  std::array<int, 2> first_intersection(const Positions& x) const;
+
+  double distance() const { return distance_; }
+  double stiffness() const { return stiffness_; }
+
+ private:
+  struct Impl;
+  std::shared_ptr<const Impl> impl_;  // the surface and the pairs left out
+  double distance_;
+  double stiffness_;
+};
+
+}  // namespace shapectl

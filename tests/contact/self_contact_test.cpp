@@ -1,0 +1,169 @@
+// The object's contact with itself: derivatives against central differences for vertex–triangle
+// and edge–edge pairs, PSD projection, the pairs left out (sharing a node, neighbours at rest),
+// CCD and the intersection query. The object: two tetrahedra, far apart at rest, brought close.
+#include <shapectl/contact/self_contact.hpp>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <random>
+
+#include <shapectl/mesh/box_mesh.hpp>
+
+#include "support/derivative_check.hpp"
+
+namespace shapectl {
+namespace {
+
+constexpr double kDhat = 0.01;  // large enough that central differences (h = 1e-6) resolve b
+
+// Tet A: the corner (0,0,0), (0.1,0,0), (0,0.1,0), (0,0,0.1); tet B: `b` (any orientation),
+// placed 1 m away at rest so that no pair is a neighbour there.
+TetMesh two_tets(std::array<Vec3, 4> b) {
+  std::vector<Vec3> p{{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}, {0, 0, 0.1}};
+  if ((b[1] - b[0]).cross(b[2] - b[0]).dot(b[3] - b[0]) < 0) std::swap(b[2], b[3]);
+  for (const Vec3& q : b) p.push_back(q + Vec3(1, 0, 0));
+  return TetMesh(p, {{0, 1, 2, 3}, {4, 5, 6, 7}});
+}
+
+// B where it is meant to be (its rest shifted back by 1 m), every node moved by up to 1e-3 m
+// (a generic configuration: no symmetry hides an error).
+Positions brought_close(const TetMesh& mesh, unsigned seed) {
+  Positions x = mesh.rest_vector();
+  for (int i = 4; i < 8; ++i) x[3 * i] -= 1;
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+  for (int i = 0; i < x.size(); ++i) x[i] += u(rng);
+  return x;
+}
+
+// B's apex 5 mm below the middle of A's bottom face: vertex–triangle pairs only.
+TetMesh vertex_triangle() {
+  return two_tets({Vec3(0.02, 0.02, -0.005), Vec3(0.0, 0.0, -0.1), Vec3(0.08, 0.0, -0.1),
+                   Vec3(0.0, 0.08, -0.1)});
+}
+
+// B's top edge 5 mm below A's bottom face, across its edges on y = 0 and x + y = 0.1, its ends
+// far outside: edge–edge pairs only.
+TetMesh edge_edge() {
+  return two_tets({Vec3(0.05, -0.1, -0.005), Vec3(0.05, 0.2, -0.005), Vec3(0.0, 0.05, -0.1),
+                   Vec3(0.1, 0.05, -0.08)});
+}
+
+Eigen::MatrixXd dense_hessian(const EnergyTerm& term, const Positions& x, bool project) {
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(x.size(), x.size());
+  for (const auto& t : term.hessian_triplets(x, project)) H(t.row(), t.col()) += t.value();
+  return H;
+}
+
+// How many of the active pairs are vertex–triangle (one node of B, three of A, or the other
+// way) and edge–edge (two of each).
+std::array<int, 2> pair_kinds(const SelfContact& term, const Positions& x) {
+  ElementNodes elements;
+  term.hessian_elements(x, elements);
+  std::array<int, 2> kinds{0, 0};
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    EXPECT_EQ(elements.node_count(e), 4);
+    int of_b = 0;
+    for (int k = 0; k < 4; ++k) of_b += elements.begin(e)[k] >= 4;
+    ++kinds[of_b == 2 ? 1 : 0];
+  }
+  return kinds;
+}
+
+void expect_derivatives_match(const TetMesh& mesh, unsigned seed) {
+  const SelfContact term(mesh, kDhat, 3.0);
+  const Positions x = brought_close(mesh, seed);
+  ASSERT_TRUE(std::isfinite(term.value(x)));
+  ASSERT_GT(term.value(x), 0);
+  const auto gradient_at = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(y.size());
+    term.add_gradient(y, g);
+    return g;
+  };
+  const Eigen::VectorXd g = gradient_at(x);
+  EXPECT_TRUE(test::derivative_matches(
+      g,
+      test::central_difference_gradient([&](const Eigen::VectorXd& y) { return term.value(y); }, x,
+                                        1e-6),
+      1e-5, "gradient"));
+  EXPECT_TRUE(test::derivative_matches(dense_hessian(term, x, false),
+                                       test::central_difference_jacobian(gradient_at, x, 1e-6),
+                                       1e-5, "Hessian"));
+  // Projected: each block PSD, so the sum is.
+  const Eigen::MatrixXd P = dense_hessian(term, x, true);
+  EXPECT_GE(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(P).eigenvalues().minCoeff(),
+            -1e-9 * P.norm());
+}
+
+TEST(SelfContact, VertexTriangleDerivativesMatchCentralDifferences) {
+  const TetMesh mesh = vertex_triangle();
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const auto kinds = pair_kinds(SelfContact(mesh, kDhat, 3.0), brought_close(mesh, seed));
+    EXPECT_GE(kinds[0], 1);
+    EXPECT_EQ(kinds[1], 0);
+    expect_derivatives_match(mesh, seed);
+  }
+}
+
+TEST(SelfContact, EdgeEdgeDerivativesMatchCentralDifferences) {
+  const TetMesh mesh = edge_edge();
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const auto kinds = pair_kinds(SelfContact(mesh, kDhat, 3.0), brought_close(mesh, seed));
+    EXPECT_EQ(kinds[0], 0);
+    EXPECT_GE(kinds[1], 2) << "B's edge crosses two of A's";
+    expect_derivatives_match(mesh, seed);
+  }
+}
+
+TEST(SelfContact, IsZeroAndHasNoPairsAtRestEvenOnAMeshThinnerThanDhat) {
+  // 5 mm thick, d̂ = 10 mm: its top and bottom faces are neighbours at rest, left out.
+  const TetMesh thin = make_box_mesh({0.1, 0.1, 0.005}, {4, 4, 1});
+  const SelfContact term(thin, kDhat, 3.0);
+  const Positions x = thin.rest_vector();
+  EXPECT_EQ(term.value(x), 0.0);
+  ElementNodes elements;
+  term.hessian_elements(x, elements);
+  EXPECT_EQ(elements.size(), 0u);
+  EXPECT_EQ(term.first_intersection(x)[0], -1);
+  // The two far tets at rest: nothing either.
+  const TetMesh two = vertex_triangle();
+  EXPECT_EQ(SelfContact(two, kDhat, 3.0).value(two.rest_vector()), 0.0);
+}
+
+TEST(SelfContact, ElementsFollowTheState) {
+  const TetMesh mesh = vertex_triangle();
+  const SelfContact term(mesh, kDhat, 3.0);
+  ElementNodes at_rest, close, again;
+  term.hessian_elements(mesh.rest_vector(), at_rest);
+  const Positions x = brought_close(mesh, 1);
+  term.hessian_elements(x, close);
+  term.hessian_elements(x, again);
+  EXPECT_EQ(at_rest.size(), 0u);
+  EXPECT_GT(close.size(), 0u);
+  EXPECT_EQ(close, again) << "one state, one list of elements in one order";
+}
+
+TEST(SelfContact, MaxStepStopsBeforeTheSurfacesPassThroughEachOther) {
+  const TetMesh mesh = vertex_triangle();
+  const SelfContact term(mesh, kDhat, 3.0);
+  const Positions x = brought_close(mesh, 2);
+  ASSERT_EQ(term.first_intersection(x)[0], -1);
+  // B moved 5 cm up: its apex would go through A's bottom face.
+  Eigen::VectorXd dx = Eigen::VectorXd::Zero(x.size());
+  for (int i = 4; i < 8; ++i) dx[3 * i + 2] = 0.05;
+  const Positions through = x + dx;
+  EXPECT_GE(term.first_intersection(through)[0], 0) << "the full step intersects";
+  const double alpha = term.max_step(x, dx);
+  EXPECT_GT(alpha, 0);
+  EXPECT_LT(alpha, 0.1);  // the apex is ~5 mm below: 10 % of 5 cm
+  for (double s : {0.25, 0.5, 0.75, 1.0}) {
+    const Positions y = x + s * alpha * dx;
+    EXPECT_EQ(term.first_intersection(y)[0], -1);
+    EXPECT_TRUE(std::isfinite(term.value(y)));
+  }
+  EXPECT_GT(term.min_distance(x + alpha * dx), 0);
+}
+
+}  // namespace
+}  // namespace shapectl
