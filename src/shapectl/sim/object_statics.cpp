@@ -5,6 +5,9 @@
 #include <limits>
 #include <numeric>
 
+#include <shapectl/robot/kinematics.hpp>
+#include <shapectl/sim/contact_obstacles.hpp>
+
 namespace shapectl {
 
 std::string find_unheld_part(const TetMesh& mesh, const std::vector<char>& held) {
@@ -99,13 +102,19 @@ std::optional<ConstantForce> load_term(const Scene& scene) {
 
 // The barrier on the scene's obstacles: κ as the scene gives it, else scaled to the mean nodal
 // load (default_contact_stiffness) so a resting node sits about d̂/2 off a flat obstacle.
+// Obstacles on links are placed at the reference joints θ⁰ (GrippedObject poses them at each θ).
 std::optional<ObstacleContact> contact_term(const Scene& scene, const TetMesh& placed,
                                             double load) {
-  if (scene.obstacles.empty()) return std::nullopt;
+  std::vector<Obstacle> obstacles = contact_obstacles(scene);
+  if (obstacles.empty()) return std::nullopt;
   const double d = scene.contact.distance;
   const double kappa = scene.contact.stiffness.value_or(
       default_contact_stiffness(object_load(placed, scene.material, load), placed.node_count(), d));
-  return ObstacleContact(placed, scene.obstacles, d, kappa);
+  std::vector<Eigen::Isometry3d> T_world_link;
+  if (scene.robot)
+    T_world_link =
+        forward_kinematics(*scene.robot->model, scene.robot->reference_joints).T_world_link;
+  return ObstacleContact(placed, std::move(obstacles), d, kappa, T_world_link);
 }
 
 std::vector<char> fixed_nodes(const Scene& scene, const TetMesh& placed) {
@@ -169,10 +178,10 @@ ObjectStatics::ObjectStatics(const Scene& scene, const std::vector<int>& held_no
   if (!contact_) unheld_reason_ = find_unheld_part(*mesh_, held);
 }
 
-EnergyTerms ObjectStatics::terms(const EnergyTerm* extra) const {
+EnergyTerms ObjectStatics::terms(const EnergyTerm* extra, const ObstacleContact* contact) const {
   EnergyTerms t = {&elasticity_, &gravity_};
   if (loads_) t.push_back(&*loads_);
-  if (contact_) t.push_back(&*contact_);
+  if (contact_) t.push_back(contact ? contact : &*contact_);
   if (extra) t.push_back(extra);
   return t;
 }
@@ -183,7 +192,7 @@ Eigen::VectorXd ObjectStatics::load_forces() const {
 
 StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra,
                                    int max_iterations, const StaticsWorkspace* chord,
-                                   const StopRequest& stop) const {
+                                   const StopRequest& stop, const ObstacleContact* posed) const {
   if (!unheld_reason_.empty()) {
     StaticsResult r;
     r.status = StaticsStatus::Singular;
@@ -191,19 +200,21 @@ StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const Ene
     return r;
   }
   if (contact_) {
-    // The barrier is infinite there: say where instead of "a non-finite energy".
-    const auto [obstacle, triangle] = contact_->first_intersection(x);
+    // The barrier is infinite there: say where instead of "a non-finite energy". With obstacles
+    // on links this refuses a warm start a moved obstacle has reached.
+    const ObstacleContact& contact = posed ? *posed : *contact_;
+    const auto [obstacle, triangle] = contact.first_intersection(x);
     if (obstacle >= 0) {
       StaticsResult r;
       r.status = StaticsStatus::Inverted;
       r.reason = "the starting state touches or intersects obstacle '" +
-                 contact_->obstacles()[static_cast<std::size_t>(obstacle)].name +
+                 contact.obstacles()[static_cast<std::size_t>(obstacle)].name +
                  "' (object surface triangle " + std::to_string(triangle) +
                  "): no equilibrium sought from there";
       return r;
     }
   }
-  return solver_.solve(terms(extra), ws, x, max_iterations, chord, stop);
+  return solver_.solve(terms(extra, posed), ws, x, max_iterations, chord, stop);
 }
 
 StaticsResult ObjectStatics::solve(Positions& x, int max_iterations) const {
