@@ -115,8 +115,8 @@ struct ContactsResult {
   ContactSummary summary;
   std::vector<std::string> obstacle_names;
 };
-// Those at x of the statics' contact term; none without obstacles.
-std::optional<ContactsResult> contacts_at(const ObjectStatics& statics, const Positions& x);
+// The contacts at x; none without a contact term (null).
+std::optional<ContactsResult> contacts_at(const ObstacleContact* contact, const Positions& x);
 // {"count", "min_distance" (m; None without a pair within the contact distance), "force_total"
 // ((3,) N, the obstacles' force on the object), "by_obstacle": {name: {"count", "force"}}}, the
 // fields of RESULT.json's "contacts"; None without obstacles.

@@ -5,8 +5,7 @@
 
 namespace shapectl::python {
 
-std::optional<ContactsResult> contacts_at(const ObjectStatics& statics, const Positions& x) {
-  const ObstacleContact* contact = statics.contact();
+std::optional<ContactsResult> contacts_at(const ObstacleContact* contact, const Positions& x) {
   if (!contact) return std::nullopt;
   ContactsResult out{contact->summary(x), {}};
   for (const Obstacle& o : contact->obstacles()) out.obstacle_names.push_back(o.name);

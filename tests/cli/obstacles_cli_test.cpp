@@ -115,7 +115,7 @@ TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
                       R"("rpy": [0, 0, "x"]}}})"),
             "obstacles[0].box.pose.rpy[2]", "expected a number"},
            {obstacles(R"({"link": "gripper_l", "sphere": {"center": [0, 0, -1], "radius": 0.1}})"),
-            "obstacles[0].link", "not supported yet"},
+            "obstacles[0].link", "an obstacle on a link needs a \"robot\""},
            {obstacles(R"({"cylinder": {"radius": 0.1}})"), "obstacles[0].cylinder", "unknown key"},
            {obstacles(R"({"name": "table"})"), "obstacles[0]", "exactly one of"},
            {obstacles(R"({"name": "a", "plane": {"point": [0, 0, -1], "normal": [0, 0, 1]}}, )"
@@ -135,7 +135,7 @@ TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
             "friction is not supported yet"},
            {obstacles(plane) + R"(, "contact": {"self": 1})", "contact.self", "true or false"},
            {obstacles(plane) + R"(, "contact": {"robot": true})", "contact.robot",
-            "not supported yet"},
+            "contact with the robot needs a \"robot\""},
            {obstacles(plane) + R"(, "contact": {"stiffness": 0})", "contact.stiffness",
             "expected a positive number"},
            {obstacles(plane) + R"(, "contact": {"gap": 0.1})", "contact.gap", "unknown key"},

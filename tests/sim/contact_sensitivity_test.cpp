@@ -12,7 +12,7 @@
 
 #include <shapectl/contact/obstacle_contact.hpp>
 
-#include "support/derivative_check.hpp"
+#include "support/sensitivity_check.hpp"
 #include "support/two_arm_scene.hpp"
 
 namespace shapectl {
@@ -38,20 +38,7 @@ TEST(ContactSensitivity, MatchesCentralDifferencesWithTwentyActiveContacts) {
   ASSERT_GE(contacts.count, 20);
   ASSERT_GT(contacts.force_total.z(), 0);
 
-  const Positions x = state.positions();
-  const Eigen::MatrixXd dx = object.sensitivity(state);
-  const auto equilibrium = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
-    const ObjectState moved = object.solve_from(t, x);
-    EXPECT_TRUE(moved.statics().converged()) << moved.statics().reason;
-    return moved.positions();
-  };
-  EXPECT_TRUE(test::derivative_matches(dx,
-                                       test::central_difference_jacobian(equilibrium, theta, 1e-5),
-                                       1e-4, "dx/dθ in contact"));
-  std::mt19937 rng(5);
-  const Eigen::VectorXd v = test::perturbed(Eigen::VectorXd::Zero(x.size()), 1.0, rng);
-  EXPECT_TRUE(test::derivative_matches(object.adjoint(state, v), dx.transpose() * v, 1e-9,
-                                       "adjoint (dx/dθ)ᵀv in contact"));
+  test::expect_sensitivity_matches(object, state, 1e-4, "in contact");
 }
 
 // A 0.32 × 0.03 × 0.03 m foam bar (the YuMi scene's) held by its middle cross-section in the

@@ -133,4 +133,11 @@ Obstacle make_mesh_obstacle(std::string name, std::vector<Vec3> vertices,
   return o;
 }
 
+Obstacle moved(const Obstacle& o, const Eigen::Isometry3d& T) {
+  Obstacle out = o;
+  for (Vec3& p : out.points) p = T * p;
+  if (out.plane) out.plane = HalfSpace{T * o.plane->point, T.linear() * o.plane->normal};
+  return out;
+}
+
 }  // namespace shapectl

@@ -4,8 +4,8 @@
 //   - a half-space (a plane and the side its normal points away from), or
 //   - points, segments and triangles inflated by a radius: a sphere is one point, a capsule one
 //     segment with radius r; a box or a mesh is its corners, edges and triangles with r = 0.
-// Geometry is in the world frame. Obstacles attached to robot links ("link" in the scene) are
-// not supported yet: load_scene refuses them.
+// Geometry is in the world frame, or in a robot link's frame for an obstacle attached to that
+// link (it then moves with the joint angles θ: docs/contact.md, "Obstacles on robot links").
 #include <Eigen/Geometry>
 #include <array>
 #include <optional>
@@ -29,7 +29,15 @@ struct Obstacle {
   std::vector<std::array<int, 2>> edges;
   std::vector<std::array<int, 3>> triangles;  // outward by the right-hand rule (box, mesh)
   double radius = 0;                          // m; > 0 for spheres and capsules
+  // The robot link it is attached to (its geometry then in that link's frame); -1: the world.
+  int link = -1;
+  // Object nodes it never touches, sorted: those its own end effector grips (their grip springs
+  // hold them; a barrier there would fight the grip).
+  std::vector<int> ignored_nodes;
 };
+
+// `o` moved rigidly by T (its points and plane; name, link and ignored nodes kept).
+Obstacle moved(const Obstacle& o, const Eigen::Isometry3d& T);
 
 Obstacle make_plane(std::string name, const Vec3& point, const Vec3& normal);
 Obstacle make_sphere(std::string name, const Vec3& center, double radius);
@@ -45,7 +53,7 @@ Obstacle make_mesh_obstacle(std::string name, std::vector<Vec3> vertices,
 struct ContactSettings {
   double distance = 1e-3;  // d̂, m: the barrier acts on gaps below it
   bool self = false;       // object self-contact (self_contact.hpp)
-  bool robot = false;      // robot collision spheres as obstacles (not supported yet: refused)
+  bool robot = false;      // the robot's collision spheres as obstacles on their links
   double friction = 0;     // Coulomb coefficient (not supported yet: > 0 refused)
   // κ, J/m² (= N/m); none: from the object's mean nodal weight (obstacle_contact.hpp).
   std::optional<double> stiffness;

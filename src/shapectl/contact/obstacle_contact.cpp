@@ -121,6 +121,28 @@ struct ObstacleContact::Impl {
   std::vector<Point> points;                        // every point: against object triangles
   std::vector<int> vertex_segments, vertex_points;  // those an object vertex meets directly
   Bvh triangle_bvh, segment_bvh, point_bvh, vertex_segment_bvh, vertex_point_bvh;
+  int node_count = 0;
+  // Per obstacle: ignores[o][node] if o never touches that node (empty: it touches every node).
+  std::vector<std::vector<char>> ignores;
+
+  // The obstacles' primitives in the world: those on links placed by T_world_link (per link).
+  void set_obstacles(const std::vector<Obstacle>& obstacles,
+                     const std::vector<Eigen::Isometry3d>& T_world_link);
+
+  // Whether the obstacle ignores one of the nodes.
+  template <std::size_t K>
+  bool ignores_any(int obstacle, const std::array<int, K>& nodes) const {
+    const std::vector<char>& ignore = ignores[static_cast<std::size_t>(obstacle)];
+    if (ignore.empty()) return false;
+    for (int n : nodes)
+      if (ignore[static_cast<std::size_t>(n)]) return true;
+    return false;
+  }
+  // Whether the pair's obstacle ignores one of its object nodes (they are then no pair at all).
+  template <int K>
+  bool ignored(const Pair& p) const {
+    return ignores_any(obstacle(p), nodes<K>(p));
+  }
 
   template <int K>
   std::array<int, K> nodes(const Pair& p) const {
@@ -272,6 +294,53 @@ struct ObstacleContact::Impl {
     return kNaN;  // no such pair of features
   }
 
+  // The obstacle feature's points, world: a point, a segment's ends or a triangle's corners.
+  static int feature_point_count(Feature f) {
+    return f == Feature::Point ? 1 : f == Feature::Segment ? 2 : f == Feature::Triangle ? 3 : 0;
+  }
+  template <int P>
+  std::array<Vec3, P> feature_points(const Contact& c) const {
+    if constexpr (P == 1) return {points[c.index].p};
+    if constexpr (P == 2) return {segments[c.index].a, segments[c.index].b};
+    if constexpr (P == 3)
+      return {obstacle_triangles[c.index].a, obstacle_triangles[c.index].b,
+              obstacle_triangles[c.index].c};
+  }
+  double feature_radius(const Contact& c) const {
+    switch (c.feature) {
+      case Feature::Point: return points[c.index].radius;
+      case Feature::Segment: return segments[c.index].radius;
+      case Feature::Triangle: return obstacle_triangles[c.index].radius;
+      default: return 0;
+    }
+  }
+
+  // The pairs of features a contact can be: K element nodes against P obstacle points.
+  template <int K, int P>
+  static constexpr bool coupled = K == 1 || P == 1 || (K == 2 && P == 2);
+
+  // contact_gap with the obstacle's P points `q` as variables too: its gradient and Hessian
+  // with respect to the element's node coordinates, then the points'.
+  template <int K, int P>
+  double coupled_gap(const Contact& c, const std::array<Vec3, K>& at, const std::array<Vec3, P>& q,
+                     VecN<3 * (K + P)>& g, MatN<3 * (K + P)>& h) const {
+    using namespace contact;
+    std::array<Vec3, K + P> all;
+    std::array<bool, K + P> varies;
+    for (int k = 0; k < K; ++k) all[k] = at[k];
+    for (int j = 0; j < P; ++j) all[K + j] = q[j];
+    varies.fill(true);
+    const auto piece = [](const auto& X) {
+      if constexpr (K == 1 && P == 1) return point_point_piece(X[0], X[1]);
+      else if constexpr (K == 1 && P == 2) return point_line_piece(X[0], X[1], X[2]);
+      else if constexpr (K == 1 && P == 3) return point_plane_piece(X[0], X[1], X[2], X[3]);
+      else if constexpr (K == 2 && P == 1) return point_line_piece(X[2], X[0], X[1]);
+      else if constexpr (K == 2 && P == 2) return line_line_piece(X[0], X[1], X[2], X[3]);
+      else return point_plane_piece(X[3], X[0], X[1], X[2]);  // K == 3, P == 1
+    };
+    return evaluate_piece<3 * (K + P)>(piece, all, varies, &g, &h) - feature_radius(c);
+  }
+
   // Where on the object contact c's closest point lies.
   template <int K>
   Vec3 closest_on_object(const Contact& c, const std::array<Vec3, K>& at) const {
@@ -371,7 +440,12 @@ struct ObstacleContact::Impl {
   // radius. Half-spaces: every vertex whose gap is below `inflate` at x or x + dx.
   template <class Visit>
   void for_each_candidate(const Positions& x, const Eigen::VectorXd* dx, double inflate,
-                          Visit&& visit) const {
+                          Visit&& visit_any) const {
+    const auto visit = [&](const Pair& p) {
+      const bool skip =
+          with_element_size(arity(p.kind), [&](auto k) { return ignored<decltype(k)::value>(p); });
+      if (!skip) visit_any(p);
+    };
     const auto box_of = [&](std::initializer_list<int> ns) {
       Aabb box;
       for (int n : ns) {
@@ -457,9 +531,84 @@ Aabb box_of(std::initializer_list<Vec3> points, double radius) {
 
 }  // namespace
 
+void ObstacleContact::Impl::set_obstacles(const std::vector<Obstacle>& given,
+                                          const std::vector<Eigen::Isometry3d>& T_world_link) {
+  planes.clear();
+  obstacle_triangles.clear();
+  segments.clear();
+  points.clear();
+  vertex_segments.clear();
+  vertex_points.clear();
+  ignores.assign(given.size(), {});
+  std::vector<Aabb> triangle_boxes, segment_boxes, point_boxes, vertex_segment_boxes,
+      vertex_point_boxes;
+  for (int o = 0; o < static_cast<int>(given.size()); ++o) {
+    if (given[o].link >= 0 && given[o].link >= static_cast<int>(T_world_link.size()))
+      throw std::invalid_argument("obstacle '" + given[o].name +
+                                  "' is on a robot link: its pose is needed");
+    const Obstacle ob =
+        given[o].link >= 0 ? moved(given[o], T_world_link[given[o].link]) : given[o];
+    if (!ob.ignored_nodes.empty()) {
+      ignores[o].assign(static_cast<std::size_t>(node_count), 0);
+      for (int n : ob.ignored_nodes) ignores[o][static_cast<std::size_t>(n)] = 1;
+    }
+    const double r = ob.radius;
+    if (ob.plane) planes.push_back({o, *ob.plane});
+    const int first_point = static_cast<int>(points.size());
+    for (const Vec3& p : ob.points) {
+      if (ob.triangles.empty() && ob.edges.empty()) {
+        vertex_points.push_back(static_cast<int>(points.size()));
+        vertex_point_boxes.push_back(box_of({p}, r));
+      }
+      points.push_back({o, p, r});
+      point_boxes.push_back(box_of({p}, r));
+    }
+    // An object vertex meets a triangle's edges and corners through the point–triangle
+    // distance, a segment's ends through the point–segment distance.
+    std::map<std::array<int, 2>, int> segment_index;
+    for (const auto& e : ob.edges) {
+      if (ob.triangles.empty()) {
+        vertex_segments.push_back(static_cast<int>(segments.size()));
+        vertex_segment_boxes.push_back(box_of({ob.points[e[0]], ob.points[e[1]]}, r));
+      }
+      segment_index[{std::min(e[0], e[1]), std::max(e[0], e[1])}] =
+          static_cast<int>(segments.size());
+      segments.push_back(
+          {o, ob.points[e[0]], ob.points[e[1]], r, {first_point + e[0], first_point + e[1]}});
+      segment_boxes.push_back(box_of({ob.points[e[0]], ob.points[e[1]]}, r));
+    }
+    for (const auto& t : ob.triangles) {
+      std::array<int, 3> corners, sides;
+      for (int k = 0; k < 3; ++k) {
+        const int i = t[k], j = t[(k + 1) % 3];
+        const auto side = segment_index.find({std::min(i, j), std::max(i, j)});
+        if (side == segment_index.end())
+          throw std::invalid_argument("obstacle '" + ob.name + "': the edge " + std::to_string(i) +
+                                      "-" + std::to_string(j) +
+                                      " of a triangle is not among its edges");
+        corners[k] = first_point + i;
+        sides[k] = side->second;
+      }
+      const Vec3 n = (ob.points[t[1]] - ob.points[t[0]]).cross(ob.points[t[2]] - ob.points[t[0]]);
+      obstacle_triangles.push_back({o, ob.points[t[0]], ob.points[t[1]], ob.points[t[2]], r,
+                                    n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero(), corners,
+                                    sides});
+      triangle_boxes.push_back(box_of({ob.points[t[0]], ob.points[t[1]], ob.points[t[2]]}, r));
+    }
+  }
+  triangle_bvh = Bvh(triangle_boxes);
+  segment_bvh = Bvh(segment_boxes);
+  point_bvh = Bvh(point_boxes);
+  vertex_segment_bvh = Bvh(vertex_segment_boxes);
+  vertex_point_bvh = Bvh(vertex_point_boxes);
+}
+
 ObstacleContact::ObstacleContact(const TetMesh& mesh, std::vector<Obstacle> obstacles,
-                                 double distance, double stiffness)
-    : obstacles_(std::move(obstacles)), distance_(distance), stiffness_(stiffness) {
+                                 double distance, double stiffness,
+                                 const std::vector<Eigen::Isometry3d>& T_world_link)
+    : obstacles_(std::make_shared<const std::vector<Obstacle>>(std::move(obstacles))),
+      distance_(distance),
+      stiffness_(stiffness) {
   check_barrier_parameters("ObstacleContact", distance, stiffness);
   auto m = std::make_shared<Impl>();
   m->triangles = mesh.surface_triangles();
@@ -483,61 +632,23 @@ ObstacleContact::ObstacleContact(const TetMesh& mesh, std::vector<Obstacle> obst
     m->triangle_vertices.push_back(vs);
     m->triangle_edges.push_back(es);
   }
-
-  std::vector<Aabb> triangle_boxes, segment_boxes, point_boxes, vertex_segment_boxes,
-      vertex_point_boxes;
-  for (int o = 0; o < static_cast<int>(obstacles_.size()); ++o) {
-    const Obstacle& ob = obstacles_[o];
-    const double r = ob.radius;
-    if (ob.plane) m->planes.push_back({o, *ob.plane});
-    const int first_point = static_cast<int>(m->points.size());
-    for (const Vec3& p : ob.points) {
-      if (ob.triangles.empty() && ob.edges.empty()) {
-        m->vertex_points.push_back(static_cast<int>(m->points.size()));
-        vertex_point_boxes.push_back(box_of({p}, r));
-      }
-      m->points.push_back({o, p, r});
-      point_boxes.push_back(box_of({p}, r));
-    }
-    // An object vertex meets a triangle's edges and corners through the point–triangle
-    // distance, a segment's ends through the point–segment distance.
-    std::map<std::array<int, 2>, int> segment_index;
-    for (const auto& e : ob.edges) {
-      if (ob.triangles.empty()) {
-        m->vertex_segments.push_back(static_cast<int>(m->segments.size()));
-        vertex_segment_boxes.push_back(box_of({ob.points[e[0]], ob.points[e[1]]}, r));
-      }
-      segment_index[{std::min(e[0], e[1]), std::max(e[0], e[1])}] =
-          static_cast<int>(m->segments.size());
-      m->segments.push_back(
-          {o, ob.points[e[0]], ob.points[e[1]], r, {first_point + e[0], first_point + e[1]}});
-      segment_boxes.push_back(box_of({ob.points[e[0]], ob.points[e[1]]}, r));
-    }
-    for (const auto& t : ob.triangles) {
-      std::array<int, 3> corners, sides;
-      for (int k = 0; k < 3; ++k) {
-        const int i = t[k], j = t[(k + 1) % 3];
-        const auto side = segment_index.find({std::min(i, j), std::max(i, j)});
-        if (side == segment_index.end())
-          throw std::invalid_argument("obstacle '" + ob.name + "': the edge " + std::to_string(i) +
-                                      "-" + std::to_string(j) +
-                                      " of a triangle is not among its edges");
-        corners[k] = first_point + i;
-        sides[k] = side->second;
-      }
-      const Vec3 n = (ob.points[t[1]] - ob.points[t[0]]).cross(ob.points[t[2]] - ob.points[t[0]]);
-      m->obstacle_triangles.push_back({o, ob.points[t[0]], ob.points[t[1]], ob.points[t[2]], r,
-                                       n.norm() > 0 ? Vec3(n.normalized()) : Vec3::Zero(), corners,
-                                       sides});
-      triangle_boxes.push_back(box_of({ob.points[t[0]], ob.points[t[1]], ob.points[t[2]]}, r));
-    }
-  }
-  m->triangle_bvh = Bvh(triangle_boxes);
-  m->segment_bvh = Bvh(segment_boxes);
-  m->point_bvh = Bvh(point_boxes);
-  m->vertex_segment_bvh = Bvh(vertex_segment_boxes);
-  m->vertex_point_bvh = Bvh(vertex_point_boxes);
+  m->node_count = mesh.node_count();
+  m->set_obstacles(*obstacles_, T_world_link);
   impl_ = std::move(m);
+}
+
+bool ObstacleContact::moves() const {
+  return std::any_of(obstacles_->begin(), obstacles_->end(),
+                     [](const Obstacle& o) { return o.link >= 0; });
+}
+
+ObstacleContact ObstacleContact::posed(const std::vector<Eigen::Isometry3d>& T_world_link) const {
+  ObstacleContact out = *this;
+  if (!moves()) return out;
+  auto m = std::make_shared<Impl>(*impl_);  // the surface kept, the obstacles placed anew
+  m->set_obstacles(*obstacles_, T_world_link);
+  out.impl_ = std::move(m);
+  return out;
 }
 
 double ObstacleContact::value(const Positions& x) const {
@@ -649,11 +760,40 @@ double ObstacleContact::max_step(const Positions& x, const Eigen::VectorXd& dx) 
   return alpha;
 }
 
+void ObstacleContact::for_each_coupling(const Positions& x, const CouplingVisit& visit) const {
+  const Impl& m = *impl_;
+  m.for_each_contact(x, distance_, [&](const Contact& c) {
+    const int o = m.obstacle(c);
+    if ((*obstacles_)[static_cast<std::size_t>(o)].link < 0) return;  // fixed: no coupling
+    const int P = Impl::feature_point_count(c.feature);
+    if (P == 0) return;
+    with_element_size(m.element_size(c), [&](auto k) {
+      with_element_size(P, [&](auto q) {
+        constexpr int K = decltype(k)::value, Q = decltype(q)::value, N = 3 * (K + Q);
+        if constexpr (Impl::coupled<K, Q>) {
+          const std::array<Vec3, Q> points = m.feature_points<Q>(c);
+          VecN<N> g;
+          MatN<N> h;
+          const double d =
+              m.coupled_gap<K, Q>(c, m.element_positions<K>(c.element, x), points, g, h);
+          if (!(d > 0 && d < distance_)) return;
+          const BarrierValue b = barrier(d, distance_);
+          const MatN<N> H = stiffness_ * (b.second * g * g.transpose() + b.first * h);
+          const std::array<int, K> nodes = m.element_nodes<K>(c.element);
+          for (int a = 0; a < K; ++a)
+            for (int j = 0; j < Q; ++j)
+              visit(nodes[a], o, points[j], H.template block<3, 3>(3 * a, 3 * (K + j)));
+        }
+      });
+    });
+  });
+}
+
 ContactSummary ObstacleContact::summary(const Positions& x) const {
   const Impl& m = *impl_;
   ContactSummary s;
   s.min_distance = kInf;
-  s.by_obstacle.resize(obstacles_.size());
+  s.by_obstacle.resize(obstacles_->size());
   m.for_each_contact(x, distance_, [&](const Contact& contact) {
     with_element_size(m.element_size(contact), [&](auto k) {
       constexpr int K = decltype(k)::value;
@@ -685,14 +825,18 @@ std::array<int, 2> ObstacleContact::first_intersection(const Positions& x) const
   for (int t = 0; t < static_cast<int>(m.triangles.size()); ++t) {
     const auto& tri = m.triangles[t];
     const Vec3 a = node(x, tri[0]), b = node(x, tri[1]), c = node(x, tri[2]);
+    // Obstacles that ignore one of its nodes (gripped by their end effector) may hold it.
+    const auto ignores = [&](int obstacle) { return m.ignores_any(obstacle, tri); };
     for (const Plane& plane : m.planes)
       for (const Vec3& p : {a, b, c})
-        if (!((p - plane.h.point).dot(plane.h.normal) > 0)) return {plane.obstacle, t};
+        if (!ignores(plane.obstacle) && !((p - plane.h.point).dot(plane.h.normal) > 0))
+          return {plane.obstacle, t};
     const Aabb box = box_of({a, b, c}, 0);
     int found = -1;
     m.triangle_bvh.query(box, [&](int i) {
       if (found >= 0) return;
       const Triangle& o = m.obstacle_triangles[i];
+      if (ignores(o.obstacle)) return;
       // Two triangles meet where an edge of one meets the other.
       const std::array<Vec3, 3> A{a, b, c}, B{o.a, o.b, o.c};
       for (int k = 0; k < 3 && found < 0; ++k)
@@ -702,11 +846,13 @@ std::array<int, 2> ObstacleContact::first_intersection(const Positions& x) const
     });
     m.segment_bvh.query(box, [&](int i) {
       const Segment& s = m.segments[i];
-      if (found < 0 && segment_triangle_distance(s.a, s.b, a, b, c) <= s.radius) found = s.obstacle;
+      if (found < 0 && !ignores(s.obstacle) &&
+          segment_triangle_distance(s.a, s.b, a, b, c) <= s.radius)
+        found = s.obstacle;
     });
     m.point_bvh.query(box, [&](int i) {
       const Point& q = m.points[i];
-      if (found < 0 &&
+      if (found < 0 && !ignores(q.obstacle) &&
           point_triangle_distance<0>(q.p, a, b, c, {false, false, false, false}) <= q.radius)
         found = q.obstacle;
     });

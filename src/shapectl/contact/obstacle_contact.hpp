@@ -8,11 +8,14 @@
 // surface edge. b is C² at d̂, so Newton and the sensitivities stay exact; each pair's Hessian
 // block is exact and, with project_psd, projected on its own.
 //
-// Obstacles do not move with θ here, so the term adds nothing to ∂F/∂θ.
+// Obstacles on robot links (Obstacle::link) are placed by the links' poses (posed()); they
+// couple x and θ: for_each_coupling gives ∂²E/∂x∂p, p their points, for ∂F/∂θ.
+// An obstacle never touches its ignored nodes: pairs with one are no pairs at all.
 //
 // Every pair couples nodes of one surface triangle (or one edge, one vertex): the Hessian's
 // elements are the surface's vertices, edges and triangles, fixed, so the assembler's pattern
 // and the symbolic factorization stay valid while contacts come and go.
+#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -48,8 +51,20 @@ class ObstacleContact : public EnergyTerm {
  public:
   // The object's surface from `mesh` (its surface_triangles()), `obstacles` in the world.
   // stiffness κ in J/m² (see default_contact_stiffness).
+  // Obstacles on links are placed by T_world_link (per robot link; needed if there are any).
   ObstacleContact(const TetMesh& mesh, std::vector<Obstacle> obstacles, double distance,
-                  double stiffness);
+                  double stiffness, const std::vector<Eigen::Isometry3d>& T_world_link = {});
+
+  // Whether an obstacle is on a robot link (the term then depends on θ).
+  bool moves() const;
+  // The same term with the obstacles on links placed by T_world_link (the surface, hence the
+  // Hessian's elements, unchanged); a copy sharing everything if none moves.
+  ObstacleContact posed(const std::vector<Eigen::Isometry3d>& T_world_link) const;
+  // ∂²E/∂x∂p at x for the obstacles on links: visit(node, obstacle, p, B) for each object node
+  // and obstacle point p (world, where it is now) of every contact within d̂, B = ∂²E/∂xₙ∂p
+  // (3 × 3). p moves rigidly with its link, so ∂F/∂θ = −Σ B ∂p/∂θ.
+  using CouplingVisit = std::function<void(int node, int obstacle, const Vec3& p, const Mat3& B)>;
+  void for_each_coupling(const Positions& x, const CouplingVisit& visit) const;
 
   std::string_view name() const override { return "contact"; }
   double value(const Positions& x) const override;
@@ -66,14 +81,15 @@ class ObstacleContact : public EnergyTerm {
   // {obstacle, triangle index into the mesh's surface_triangles()}; {-1, -1} if none.
   std::array<int, 2> first_intersection(const Positions& x) const;
 
-  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  // As given: those on links in their link's frame.
+  const std::vector<Obstacle>& obstacles() const { return *obstacles_; }
   double distance() const { return distance_; }
   double stiffness() const { return stiffness_; }
 
  private:
   struct Impl;
-  std::shared_ptr<const Impl> impl_;  // surface, candidate search structures
-  std::vector<Obstacle> obstacles_;
+  std::shared_ptr<const Impl> impl_;                        // surface, candidate search structures
+  std::shared_ptr<const std::vector<Obstacle>> obstacles_;  // shared by posed copies
   double distance_;
   double stiffness_;
 };

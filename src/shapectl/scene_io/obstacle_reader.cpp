@@ -1,11 +1,13 @@
 #include <shapectl/scene_io/obstacle_reader.hpp>
 
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 
 #include <shapectl/io/json_input.hpp>
 #include <shapectl/mesh/surface_reader.hpp>
 #include <shapectl/scene_io/scene_file.hpp>
+#include <shapectl/sim/scene.hpp>
 
 namespace shapectl {
 
@@ -78,12 +80,20 @@ Obstacle read_mesh_obstacle(const std::string& name, const JsonInput& j) {
   }
 }
 
-Obstacle read_obstacle(const JsonInput& j, std::size_t index) {
-  j.expect_only({"name", "plane", "box", "sphere", "capsule", "mesh", "link"});
-  if (j.has("link"))
-    j.at("link").fail_problem(
-        "obstacles attached to robot links are not supported yet (leave out \"link\": the "
-        "obstacle is then fixed in the world frame)");
+// "link": the index of the robot link it names.
+int read_link(const JsonInput& j, const RobotSetup* robot) {
+  if (!robot) j.fail_problem("an obstacle on a link needs a \"robot\"");
+  const RobotModel& model = *robot->model;
+  const std::string name = j.string();
+  if (const auto link = model.find_link(name)) return *link;
+  std::string links;
+  for (const Link& l : model.links()) links += (links.empty() ? "" : ", ") + l.name;
+  j.fail("a link of the robot " + std::filesystem::path(model.source()).filename().string() + " (" +
+         links + ")");
+}
+
+// The obstacle's name and shape; in its link's frame if it has a "link".
+Obstacle read_shape(const JsonInput& j, std::size_t index) {
   const std::string name =
       j.has("name") ? j.at("name").string() : "obstacle " + std::to_string(index + 1);
   if (name.empty()) j.at("name").fail("a non-empty name");
@@ -99,12 +109,23 @@ Obstacle read_obstacle(const JsonInput& j, std::size_t index) {
   return read_mesh_obstacle(name, j.at("mesh"));
 }
 
+Obstacle read_obstacle(const JsonInput& j, std::size_t index, const RobotSetup* robot) {
+  j.expect_only({"name", "plane", "box", "sphere", "capsule", "mesh", "link"});
+  const int link = j.has("link") ? read_link(j.at("link"), robot) : -1;
+  if (link >= 0 && j.has("plane"))
+    j.at("plane").fail_problem(
+        "a plane cannot move with a link (it is a whole half-space): give a box on the link");
+  Obstacle o = read_shape(j, index);
+  o.link = link;
+  return o;
+}
+
 }  // namespace
 
-std::vector<Obstacle> read_obstacles(const JsonInput& list) {
+std::vector<Obstacle> read_obstacles(const JsonInput& list, const RobotSetup* robot) {
   std::vector<Obstacle> obstacles;
   for (std::size_t k = 0; k < list.size(); ++k) {
-    Obstacle o = read_obstacle(list.at(k), k);
+    Obstacle o = read_obstacle(list.at(k), k, robot);
     for (const Obstacle& other : obstacles)
       if (other.name == o.name)
         (list.at(k).has("name") ? list.at(k).at("name") : list.at(k))
@@ -114,7 +135,7 @@ std::vector<Obstacle> read_obstacles(const JsonInput& list) {
   return obstacles;
 }
 
-ContactSettings read_contact(const JsonInput& j) {
+ContactSettings read_contact(const JsonInput& j, const RobotSetup* robot) {
   j.expect_only({"distance", "self", "robot", "friction", "stiffness"});
   ContactSettings c;
   if (j.has("distance")) {
@@ -122,9 +143,13 @@ ContactSettings read_contact(const JsonInput& j) {
     c.distance = j.at("distance").number_in(1e-9, max_contact_distance, "m");
   }
   if (j.has("self")) c.self = j.at("self").boolean();
-  if (j.has("robot") && j.at("robot").boolean())
-    j.at("robot").fail_problem(
-        "contact with the robot is not supported yet (give false or leave it out)");
+  if (j.has("robot") && j.at("robot").boolean()) {
+    if (!robot) j.at("robot").fail_problem("contact with the robot needs a \"robot\" in the scene");
+    if (!robot->collisions || robot->collisions->spheres().empty())
+      j.at("robot").fail_problem(
+          "contact with the robot uses its collision spheres: give robot.collision_spheres");
+    c.robot = true;
+  }
   if (j.has("friction")) {
     const double mu = j.at("friction").non_negative();
     if (mu > 0)

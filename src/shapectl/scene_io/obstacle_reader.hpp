@@ -1,6 +1,6 @@
 #pragma once
-// The scene's "obstacles" and "contact" (issue 34): static obstacles in the world frame and how
-// contact with them acts. Part of load_scene; errors name the file and field.
+// The scene's "obstacles" and "contact" (issue 34): obstacles in the world or on robot links and
+// how contact with them acts. Part of load_scene; errors name the file and field.
 #include <vector>
 
 #include <shapectl/contact/obstacle.hpp>
@@ -8,15 +8,17 @@
 namespace shapectl {
 
 class JsonInput;
+struct RobotSetup;
 
-// "obstacles": [{"name"?, one of "plane" {point, normal}, "box" {size, pose}, "sphere" {center,
-// radius}, "capsule" {a, b, radius}, "mesh" {file, units | scale, pose}}]. Names default to
-// "obstacle N" (1-based) and must differ; "link" (an obstacle moving with a robot link) is
-// refused as not supported yet.
-std::vector<Obstacle> read_obstacles(const JsonInput& list);
+// "obstacles": [{"name"?, "link"?, one of "plane" {point, normal}, "box" {size, pose}, "sphere"
+// {center, radius}, "capsule" {a, b, radius}, "mesh" {file, units | scale, pose}}]. Names
+// default to "obstacle N" (1-based) and must differ. With "link" (a link of `robot`, refused
+// without one) the obstacle moves with that link, its geometry in the link's frame; a plane
+// cannot.
+std::vector<Obstacle> read_obstacles(const JsonInput& list, const RobotSetup* robot);
 
-// "contact": {"distance", "self", "robot", "friction", "stiffness"}; self or robot contact and
-// friction are refused as not supported yet.
-ContactSettings read_contact(const JsonInput& j);
+// "contact": {"distance", "self", "robot", "friction", "stiffness"}; self contact and friction
+// are refused as not supported yet; robot: true needs `robot` with collision spheres.
+ContactSettings read_contact(const JsonInput& j, const RobotSetup* robot);
 
 }  // namespace shapectl

@@ -426,8 +426,9 @@ Scene load_scene(const std::filesystem::path& file) {
   if (root.has("grip_stiffness"))
     scene.grip_stiffness = positive_in(root.at("grip_stiffness"), 1e-12, max_stiffness, "N/m");
   if (root.has("objective")) scene.weights = read_objective(root.at("objective"));
-  if (root.has("obstacles")) scene.obstacles = read_obstacles(root.at("obstacles"));
-  if (root.has("contact")) scene.contact = read_contact(root.at("contact"));
+  const RobotSetup* robot = scene.robot ? &*scene.robot : nullptr;
+  if (root.has("obstacles")) scene.obstacles = read_obstacles(root.at("obstacles"), robot);
+  if (root.has("contact")) scene.contact = read_contact(root.at("contact"), robot);
   scene.warnings = check_scene(scene);
   refuse_empty_selections(root, scene);
   return scene;

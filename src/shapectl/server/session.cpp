@@ -373,7 +373,9 @@ void Session::load(const SceneEntry& entry) {
   // Only an armed link has something to say about it (at start-up it is disarmed already).
   if (link_ && link_->status().armed) link_->disarm("scene changed to " + entry.name);
   robot_meshes_ = find_visual_meshes(*scene.robot->model, package_paths_);
-  statics_ = scene.obstacles.empty() ? nullptr : std::make_unique<ObjectStatics>(scene);
+  statics_ = scene.obstacles.empty() && !scene.contact.robot
+                 ? nullptr
+                 : std::make_unique<ObjectStatics>(scene);
   contacts_ = nullptr;
   update_contacts();
   scene_description_ = describe_scene();
@@ -557,6 +559,14 @@ void Session::update_contacts() {
   if (!contact || (!contacts_.is_null() && snapshot_->sequence == contacts_sequence_)) return;
   if (snapshot_->positions.size() != 3 * controller_->mesh().node_count()) return;  // none yet
   contacts_sequence_ = snapshot_->sequence;
+  if (contact->moves() &&
+      snapshot_->joints.size() == controller_->scene().robot->reference_joints.size()) {
+    // Obstacles on links where the snapshot's joints put them.
+    const ObstacleContact posed = contact->posed(
+        forward_kinematics(*controller_->scene().robot->model, snapshot_->joints).T_world_link);
+    contacts_ = contacts_json(posed.summary(snapshot_->positions), posed.obstacles());
+    return;
+  }
   contacts_ = contacts_json(contact->summary(snapshot_->positions), contact->obstacles());
 }
 

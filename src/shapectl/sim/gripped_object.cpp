@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include <shapectl/sim/contact_force_jacobian.hpp>
+
 namespace shapectl {
 
 namespace {
@@ -65,8 +67,9 @@ const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::Vecto
   state.kinematics_ = forward_kinematics(robot(), joints);
   const GripEnergy grip(*grips_, state.kinematics_);
   const StaticsWorkspace* chord_ws = chord ? chord->workspace_.get() : nullptr;
-  state.statics_ =
-      statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations, chord_ws, stop);
+  const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
+  state.statics_ = statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations,
+                                   chord_ws, stop, contact ? &*contact : nullptr);
   return state.statics_;
 }
 
@@ -89,10 +92,14 @@ void GrippedObject::carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen
     for (int i : g.nodes) x.segment<3>(3 * i) = motion * at_from.segment<3>(3 * i);
   }
   // The prediction moves every node straight from at_from: cut short where a surface would
-  // pass through an obstacle on the way (the CCD bound), so the solve starts clear of them.
+  // pass through an obstacle on the way (the CCD bound, obstacles on links where they were at
+  // `from`), so the solve starts clear of them. An obstacle on a link that has moved onto the
+  // warm start is not chased: the solve at `to` refuses that start (Inverted).
   if (const ObstacleContact* contact = statics_->contact()) {
+    const std::optional<ObstacleContact> posed = moving_contact(a);
     const Eigen::VectorXd dx = x - at_from;
-    if (const double alpha = contact->max_step(at_from, dx); alpha < 1) x = at_from + alpha * dx;
+    if (const double alpha = (posed ? *posed : *contact).max_step(at_from, dx); alpha < 1)
+      x = at_from + alpha * dx;
   }
 }
 
@@ -101,7 +108,27 @@ bool GrippedObject::factored(ObjectState& state, double stale_step) const {
   StaticsWorkspace& ws = *state.workspace_;
   if (solver.factor_distance(ws, state.positions_) <= stale_step) return true;
   const GripEnergy grip(*grips_, state.kinematics_);
-  return solver.factor(statics_->terms(&grip), ws, state.positions_);
+  const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
+  return solver.factor(statics_->terms(&grip, contact ? &*contact : nullptr), ws, state.positions_);
+}
+
+std::optional<ObstacleContact> GrippedObject::moving_contact(const KinematicsState& state) const {
+  const ObstacleContact* contact = statics_->contact();
+  if (!contact || !contact->moves()) return std::nullopt;
+  return contact->posed(state.T_world_link);
+}
+
+std::optional<ObstacleContact> GrippedObject::contact_at(const KinematicsState& state) const {
+  if (std::optional<ObstacleContact> posed = moving_contact(state)) return posed;
+  if (const ObstacleContact* contact = statics_->contact()) return *contact;
+  return std::nullopt;
+}
+
+Eigen::MatrixXd GrippedObject::force_jacobian(const ObjectState& state) const {
+  Eigen::MatrixXd dF = grips_->force_jacobian(state.kinematics_, node_count());
+  if (const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_))
+    dF += contact_force_jacobian(*contact, robot(), state.kinematics_, state.positions_);
+  return dF;
 }
 
 bool GrippedObject::stable(ObjectState& state, double stale_step) const {
@@ -117,7 +144,7 @@ bool GrippedObject::confirm_stable(ObjectState& state, double stale_step) const 
 }
 
 Eigen::MatrixXd GrippedObject::sensitivity(ObjectState& state, double stale_step) const {
-  return force_response(state, grips_->force_jacobian(state.kinematics_, node_count()), stale_step);
+  return force_response(state, force_jacobian(state), stale_step);
 }
 
 Eigen::MatrixXd GrippedObject::force_response(ObjectState& state,
@@ -131,7 +158,11 @@ Eigen::VectorXd GrippedObject::adjoint(ObjectState& state, const Eigen::VectorXd
                                        double stale_step) const {
   factored(state, stale_step);
   const Eigen::VectorXd lambda = statics_->solver().solve_with_factor(*state.workspace_, v);
-  return grips_->force_jacobian_transpose_times(state.kinematics_, lambda);
+  Eigen::VectorXd out = grips_->force_jacobian_transpose_times(state.kinematics_, lambda);
+  if (const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_))
+    add_contact_force_jacobian_transpose_times(*contact, robot(), state.kinematics_,
+                                               state.positions_, lambda, out);
+  return out;
 }
 
 }  // namespace shapectl

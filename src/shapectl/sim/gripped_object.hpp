@@ -9,6 +9,7 @@
 // Every algorithm is a const member taking the state: two threads may work on one
 // GrippedObject with states of their own.
 #include <memory>
+#include <optional>
 
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/sim/grip_springs.hpp>
@@ -80,6 +81,14 @@ class GrippedObject {
   // std::runtime_error at an unstable state.
   Eigen::MatrixXd force_response(ObjectState& state, const Eigen::MatrixXd& force_change,
                                  double stale_step = 0) const;
+  // ∂F/∂θ at the state's positions and joints (3n × m): the grip springs', plus the contact's
+  // with obstacles on links (contact_force_jacobian.hpp).
+  Eigen::MatrixXd force_jacobian(const ObjectState& state) const;
+  // The contact term with its obstacles on links placed at `state`; none if no obstacle is on
+  // a link (then statics().contact() is the term at every θ).
+  std::optional<ObstacleContact> moving_contact(const KinematicsState& state) const;
+  // The contact term with the robot at `state` (for its contacts); none without obstacles.
+  std::optional<ObstacleContact> contact_at(const KinematicsState& state) const;
   // (dx̂/dθ)ᵀ v by the adjoint method, one solve: λ = H⁻¹ v, result = (∂F/∂θ)ᵀ λ.
   Eigen::VectorXd adjoint(ObjectState& state, const Eigen::VectorXd& v,
                           double stale_step = 0) const;

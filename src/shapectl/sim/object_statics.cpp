@@ -5,6 +5,9 @@
 #include <limits>
 #include <numeric>
 
+#include <shapectl/robot/kinematics.hpp>
+#include <shapectl/sim/contact_obstacles.hpp>
+
 namespace shapectl {
 
 std::string find_unheld_part(const TetMesh& mesh, const std::vector<char>& held) {
@@ -105,11 +108,17 @@ double contact_stiffness(const Scene& scene, const TetMesh& placed, double load)
                                 scene.contact.distance));
 }
 
+// Obstacles on links are placed at the reference joints θ⁰ (GrippedObject poses them at each θ).
 std::optional<ObstacleContact> contact_term(const Scene& scene, const TetMesh& placed,
                                             double load) {
-  if (scene.obstacles.empty()) return std::nullopt;
-  return ObstacleContact(placed, scene.obstacles, scene.contact.distance,
-                         contact_stiffness(scene, placed, load));
+  std::vector<Obstacle> obstacles = contact_obstacles(scene);
+  if (obstacles.empty()) return std::nullopt;
+  std::vector<Eigen::Isometry3d> T_world_link;
+  if (scene.robot)
+    T_world_link =
+        forward_kinematics(*scene.robot->model, scene.robot->reference_joints).T_world_link;
+  return ObstacleContact(placed, std::move(obstacles), scene.contact.distance,
+                         contact_stiffness(scene, placed, load), T_world_link);
 }
 
 // The same barrier, κ and d̂ between the object's own surface primitives.
@@ -181,10 +190,10 @@ ObjectStatics::ObjectStatics(const Scene& scene, const std::vector<int>& held_no
   if (!contact_) unheld_reason_ = find_unheld_part(*mesh_, held);
 }
 
-EnergyTerms ObjectStatics::terms(const EnergyTerm* extra) const {
+EnergyTerms ObjectStatics::terms(const EnergyTerm* extra, const ObstacleContact* contact) const {
   EnergyTerms t = {&elasticity_, &gravity_};
   if (loads_) t.push_back(&*loads_);
-  if (contact_) t.push_back(&*contact_);
+  if (contact_) t.push_back(contact ? contact : &*contact_);
   if (self_contact_) t.push_back(&*self_contact_);
   if (extra) t.push_back(extra);
   return t;
@@ -196,7 +205,7 @@ Eigen::VectorXd ObjectStatics::load_forces() const {
 
 StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra,
                                    int max_iterations, const StaticsWorkspace* chord,
-                                   const StopRequest& stop) const {
+                                   const StopRequest& stop, const ObstacleContact* posed) const {
   const auto refused = [](StaticsStatus status, std::string reason) {
     StaticsResult r;
     r.status = status;
@@ -206,11 +215,13 @@ StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const Ene
   if (!unheld_reason_.empty()) return refused(StaticsStatus::Singular, unheld_reason_);
   // The barrier is infinite there: say where instead of "a non-finite energy".
   if (contact_) {
-    const auto [obstacle, triangle] = contact_->first_intersection(x);
+    // With obstacles on links this refuses a warm start a moved obstacle has reached.
+    const ObstacleContact& contact = posed ? *posed : *contact_;
+    const auto [obstacle, triangle] = contact.first_intersection(x);
     if (obstacle >= 0)
       return refused(StaticsStatus::Inverted,
                      "the starting state touches or intersects obstacle '" +
-                         contact_->obstacles()[static_cast<std::size_t>(obstacle)].name +
+                         contact.obstacles()[static_cast<std::size_t>(obstacle)].name +
                          "' (object surface triangle " + std::to_string(triangle) +
                          "): no equilibrium sought from there");
   }
@@ -222,7 +233,7 @@ StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const Ene
                          std::to_string(a) + " and " + std::to_string(b) +
                          "): no equilibrium sought from there");
   }
-  return solver_.solve(terms(extra), ws, x, max_iterations, chord, stop);
+  return solver_.solve(terms(extra, posed), ws, x, max_iterations, chord, stop);
 }
 
 StaticsResult ObjectStatics::solve(Positions& x, int max_iterations) const {

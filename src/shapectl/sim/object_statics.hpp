@@ -26,16 +26,19 @@ class ObjectStatics {
   explicit ObjectStatics(const Scene& scene, const std::vector<int>& held_nodes = {});
 
   // The object's energy terms (elasticity, gravity, the loads, the obstacle contact and the
-  // self-contact if any), plus `extra` if given.
-  EnergyTerms terms(const EnergyTerm* extra = nullptr) const;
+  // self-contact if any), plus `extra` if given; `contact` (if given) instead of contact(): the
+  // same term posed at other joint angles (ObstacleContact::posed).
+  EnergyTerms terms(const EnergyTerm* extra = nullptr,
+                    const ObstacleContact* contact = nullptr) const;
   StaticsWorkspace make_workspace() const { return solver_.make_workspace(); }
   // Equilibrium from the warm start x (fixed nodes must be at their prescribed positions) with
   // the energy plus `extra`, in `ws` (see StaticsSolver::solve for `chord`). An object that
   // nothing holds is reported as Singular without iterating; a start that touches or intersects
   // an obstacle or itself as Inverted without iterating, naming the obstacle or the triangles.
+  // `contact`: as in terms().
   StaticsResult solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra = nullptr,
                       int max_iterations = 0, const StaticsWorkspace* chord = nullptr,
-                      const StopRequest& stop = {}) const;
+                      const StopRequest& stop = {}, const ObstacleContact* contact = nullptr) const;
   // The same from scratch (a workspace of its own, no earlier factorization).
   StaticsResult solve(Positions& x, int max_iterations = 0) const;
   // The true Hessian of the object's own energy at x (for tests and tools).
@@ -45,7 +48,8 @@ class ObjectStatics {
   const TetMesh& mesh() const { return *mesh_; }
   const std::vector<char>& fixed_node() const { return fixed_node_; }
   double weight() const { return gravity_.weight(); }
-  // The contact with the scene's obstacles; null without obstacles (no contact term at all).
+  // The contact with the scene's obstacles (and the robot's spheres with contact.robot), those on
+  // links placed at the reference joints; null without obstacles (no contact term at all).
   const ObstacleContact* contact() const { return contact_ ? &*contact_ : nullptr; }
   // The contact of the object with itself; null unless the scene's contact.self.
   const SelfContact* self_contact() const { return self_contact_ ? &*self_contact_ : nullptr; }

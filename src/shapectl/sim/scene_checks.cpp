@@ -9,6 +9,7 @@
 #include <shapectl/io/input_error.hpp>
 #include <shapectl/robot/joint_limits.hpp>
 #include <shapectl/robot/kinematics.hpp>
+#include <shapectl/sim/contact_obstacles.hpp>
 
 namespace shapectl {
 
@@ -267,6 +268,7 @@ void warn_distant_obstacles(const Scene& scene, std::vector<std::string>& warnin
   if (scene.robot) reach += robot_extent(*scene.robot);
   const double limit = std::max(distant_obstacle_floor, distant_obstacle_factor * reach);
   for (std::size_t k = 0; k < scene.obstacles.size(); ++k) {
+    if (scene.obstacles[k].link >= 0) continue;  // it moves with the robot, near the object
     const double d = obstacle_distance(scene.obstacles[k], lo, hi);
     if (d > limit)
       warnings.push_back(scene.source.string() + ": obstacles[" + std::to_string(k) + "] ('" +
@@ -276,19 +278,41 @@ void warn_distant_obstacles(const Scene& scene, std::vector<std::string>& warnin
   }
 }
 
+// The contact's obstacles (the robot's spheres too) in the world, those on links where the
+// reference joints put them.
+std::vector<Obstacle> obstacles_at_reference(const Scene& scene) {
+  std::vector<Obstacle> obstacles = contact_obstacles(scene);
+  if (!scene.robot) return obstacles;
+  const KinematicsState reference =
+      forward_kinematics(*scene.robot->model, scene.robot->reference_joints);
+  for (Obstacle& o : obstacles)
+    if (o.link >= 0) {
+      o = moved(o, reference.T_world_link[o.link]);
+      o.link = -1;
+    }
+  return obstacles;
+}
+
 void check_obstacle_gaps(const Scene& scene) {
-  if (scene.obstacles.empty()) return;
-  const ObstacleContact contact(*scene.object_mesh, scene.obstacles, scene.contact.distance, 1.0);
+  const std::vector<Obstacle> obstacles = obstacles_at_reference(scene);
+  if (obstacles.empty()) return;
+  const ObstacleContact contact(*scene.object_mesh, obstacles, scene.contact.distance, 1.0);
   const Positions x = scene.world_rest_positions();
   auto field = [&](std::size_t k) {
+    if (k >= scene.obstacles.size()) return "contact.robot (sphere '" + obstacles[k].name + "')";
     return "obstacles[" + std::to_string(k) + "] ('" + scene.obstacles[k].name + "')";
+  };
+  auto on_link = [&](std::size_t k) {
+    return k >= scene.obstacles.size() || scene.obstacles[k].link >= 0;
   };
   const auto [obstacle, triangle] = contact.first_intersection(x);
   if (obstacle >= 0) {
     const auto nodes = scene.object_mesh->surface_triangles()[static_cast<std::size_t>(triangle)];
     throw InputError(scene.source.string(), field(static_cast<std::size_t>(obstacle)),
                      "the object's rest shape (placed by object.pose) touches or intersects this " +
-                         scene.obstacles[static_cast<std::size_t>(obstacle)].shape +
+                         obstacles[static_cast<std::size_t>(obstacle)].shape +
+                         (on_link(static_cast<std::size_t>(obstacle)) ? " (at the reference joints)"
+                                                                      : "") +
                          " at surface triangle " + std::to_string(triangle) + " (nodes " +
                          std::to_string(nodes[0]) + ", " + std::to_string(nodes[1]) + ", " +
                          std::to_string(nodes[2]) +
@@ -297,11 +321,13 @@ void check_obstacle_gaps(const Scene& scene) {
   std::vector<Vec3> nodes(x.size() / 3);
   for (std::size_t i = 0; i < nodes.size(); ++i) nodes[i] = x.segment<3>(3 * i);
   const auto surface = scene.object_mesh->surface_triangles();
-  for (std::size_t k = 0; k < scene.obstacles.size(); ++k)
-    if (!surface.empty() && one_inside_the_other(scene.obstacles[k], nodes, surface))
+  // (An obstacle of a gripper, which ignores the gripped nodes, may hold the object.)
+  for (std::size_t k = 0; k < obstacles.size(); ++k)
+    if (!surface.empty() && obstacles[k].ignored_nodes.empty() &&
+        one_inside_the_other(obstacles[k], nodes, surface))
       throw InputError(scene.source.string(), field(k),
                        "the object's rest shape (placed by object.pose) and this " +
-                           scene.obstacles[k].shape +
+                           obstacles[k].shape +
                            " overlap, one wholly inside the other; move the object or the "
                            "obstacle so that they are apart");
 }
