@@ -46,7 +46,7 @@ struct ContactSettings {
   double distance = 1e-3;  // d̂, m: the barrier acts on gaps below it
   bool self = false;       // object self-contact (not supported yet: load_scene refuses true)
   bool robot = false;      // robot collision spheres as obstacles (not supported yet: refused)
-  double friction = 0;     // Coulomb coefficient (not supported yet: > 0 refused)
+  double friction = 0;     // Coulomb coefficient μ (contact/friction.hpp; 0: frictionless)
   // κ, J/m² (= N/m); none: from the object's mean nodal weight (obstacle_contact.hpp).
   std::optional<double> stiffness;
 };

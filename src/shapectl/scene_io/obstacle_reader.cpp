@@ -126,13 +126,7 @@ ContactSettings read_contact(const JsonInput& j) {
   if (j.has("robot") && j.at("robot").boolean())
     j.at("robot").fail_problem(
         "contact with the robot is not supported yet (give false or leave it out)");
-  if (j.has("friction")) {
-    const double mu = j.at("friction").non_negative();
-    if (mu > 0)
-      j.at("friction")
-          .fail_problem(
-              "friction is not supported yet: contact is frictionless (give 0 or leave it out)");
-  }
+  if (j.has("friction")) c.friction = j.at("friction").non_negative();
   if (j.has("stiffness")) {
     j.at("stiffness").positive();
     c.stiffness = j.at("stiffness").number_in(1e-12, max_contact_stiffness, "N/m");

@@ -15,8 +15,8 @@ class JsonInput;
 // refused as not supported yet.
 std::vector<Obstacle> read_obstacles(const JsonInput& list);
 
-// "contact": {"distance", "self", "robot", "friction", "stiffness"}; self or robot contact and
-// friction are refused as not supported yet.
+// "contact": {"distance", "self", "robot", "friction", "stiffness"}; self or robot contact are
+// refused as not supported yet; friction is a non-negative Coulomb coefficient.
 ContactSettings read_contact(const JsonInput& j);
 
 }  // namespace shapectl

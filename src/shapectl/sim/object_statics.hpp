@@ -9,6 +9,7 @@
 #include <shapectl/contact/obstacle_contact.hpp>
 #include <shapectl/fem/gravity.hpp>
 #include <shapectl/fem/neo_hookean.hpp>
+#include <shapectl/sim/lagged_friction.hpp>
 #include <shapectl/sim/scene.hpp>
 #include <shapectl/sim/statics.hpp>
 
@@ -45,6 +46,8 @@ class ObjectStatics {
   double weight() const { return gravity_.weight(); }
   // The contact with the scene's obstacles; null without obstacles (no contact term at all).
   const ObstacleContact* contact() const { return contact_ ? &*contact_ : nullptr; }
+  // The scene's friction (coefficient 0: frictionless, no friction term).
+  const FrictionSettings& friction() const { return friction_; }
   // The applied loads' nodal forces (3n, N); zero without loads.
   Eigen::VectorXd load_forces() const;
   // The force Newton stops at: the scene's tolerance, or the round-off floor if larger.
@@ -56,6 +59,7 @@ class ObjectStatics {
   Gravity gravity_;
   std::optional<ConstantForce> loads_;      // none without loads: the default terms stay two
   std::optional<ObstacleContact> contact_;  // none without obstacles
+  FrictionSettings friction_;
   std::vector<char> fixed_node_;
   std::string unheld_reason_;
   StaticsSolver solver_;
