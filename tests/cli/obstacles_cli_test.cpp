@@ -131,8 +131,8 @@ TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
             "expected a positive number"},
            {obstacles(plane) + R"(, "contact": {"friction": -0.1})", "contact.friction",
             "expected a non-negative number"},
-           {obstacles(plane) + R"(, "contact": {"friction": 0.3})", "contact.friction",
-            "friction is not supported yet"},
+           {obstacles(plane) + R"(, "contact": {"friction": "0.3"})", "contact.friction",
+            "expected a number"},
            {obstacles(plane) + R"(, "contact": {"self": 1})", "contact.self", "true or false"},
            {obstacles(plane) + R"(, "contact": {"robot": true})", "contact.robot",
             "contact with the robot needs a \"robot\""},
@@ -148,6 +148,37 @@ TEST(ObstaclesCli, BadObstaclesAndContactAreBadInputNamingTheField) {
                                                                                 << s.run.err;
     EXPECT_NE(s.run.err.find(what), std::string::npos) << what << ":\n" << s.run.err;
   }
+}
+
+// A 100 × 60 × 40 mm block on a plane tilted 20° about y (tan α = 0.364), turned with it, its
+// bottom 0.5 mm above it; gravity straight down. Friction `mu`.
+std::string block_on_slope(double mu) {
+  const double a = 20 * M_PI / 180, up = 0.0205;  // the block's centre above the plane
+  return R"({"object": {"mesh": {"box": {"size": [0.1, 0.06, 0.04], "cells": [5, 3, 2]}},
+               "material": {"youngs_modulus": 1e6, "poisson_ratio": 0.3, "density": 500},
+               "pose": {"position": [)" +
+         std::to_string(std::sin(a) * up) + ", 0, " + std::to_string(std::cos(a) * up) +
+         R"(], "rpy": [0, )" + std::to_string(a) + R"(, 0]}},
+    "gravity": [0, 0, -9.81],
+    "obstacles": [{"name": "slope", "plane": {"point": [0, 0, 0], "normal": [)" +
+         std::to_string(std::sin(a)) + ", 0, " + std::to_string(std::cos(a)) + R"(]}}],
+    "contact": {"distance": 0.001, "friction": )" +
+         std::to_string(mu) + "}}";
+}
+
+TEST(ObstaclesCli, FrictionHoldsABlockOnASlopeOrTheStaticsSaysItSlides) {
+  TempDir dir;
+  const Statics held = statics(dir, block_on_slope(0.5));
+  ASSERT_EQ(held.run.exit_code, 0) << held.run.err;
+  EXPECT_TRUE(held.result["converged"].get<bool>());
+  EXPECT_GT(held.result["contacts"]["count"].get<int>(), 0);
+  const Statics slides = statics(dir, block_on_slope(0.2));
+  EXPECT_EQ(slides.run.exit_code, 2) << slides.run.err;
+  EXPECT_NE(slides.run.err.find("slides along obstacle 'slope'"), std::string::npos)
+      << slides.run.err;
+  ASSERT_TRUE(slides.result.contains("converged")) << "the failed state is written too";
+  EXPECT_FALSE(slides.result["converged"].get<bool>());
+  EXPECT_EQ(slides.result["status"], "not converged");
 }
 
 // The bundled peg scene's purpose: bend the bar around the peg. Centre-line targets make a

@@ -87,7 +87,7 @@ def test_a_solve_reports_the_contacts_of_its_best_joints(bar_scene):
 
 
 @pytest.mark.parametrize("contact, field", [
-    ({"friction": 0.3}, "contact.friction"),
+    ({"friction": -0.3}, "contact.friction"),
     ({"self": 1}, "contact.self"),
     ({"distance": -1}, "contact.distance"),
 ])

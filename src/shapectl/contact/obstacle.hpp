@@ -54,7 +54,7 @@ struct ContactSettings {
   double distance = 1e-3;  // d̂, m: the barrier acts on gaps below it
   bool self = false;       // object self-contact (self_contact.hpp)
   bool robot = false;      // the robot's collision spheres as obstacles on their links
-  double friction = 0;     // Coulomb coefficient (not supported yet: > 0 refused)
+  double friction = 0;     // Coulomb coefficient μ (contact/friction.hpp; 0: frictionless)
   // κ, J/m² (= N/m); none: from the object's mean nodal weight (obstacle_contact.hpp).
   std::optional<double> stiffness;
 };

@@ -820,6 +820,31 @@ ContactSummary ObstacleContact::summary(const Positions& x) const {
   return s;
 }
 
+std::vector<ContactPair> ObstacleContact::pairs(const Positions& x) const {
+  const Impl& m = *impl_;
+  std::vector<ContactPair> out;
+  m.for_each_contact(x, distance_, [&](const Contact& contact) {
+    with_element_size(m.element_size(contact), [&](auto k) {
+      constexpr int K = decltype(k)::value;
+      VecN<3 * K> g;
+      const double d =
+          m.contact_gap<K>(contact, m.element_positions<K>(contact.element, x), &g, nullptr);
+      if (!(d > 0 && d < distance_)) return;
+      // ∂d/∂x_a = w_a n (the closest points' envelope), the weights summing to 1: n = Σ ∂d/∂x_a.
+      ContactPair p{.element = contact.element, .obstacle = m.obstacle(contact), .node_count = K};
+      for (int a = 0; a < K; ++a) p.normal += g.template segment<3>(3 * a);
+      const std::array<int, K> nodes = m.element_nodes<K>(contact.element);
+      for (int a = 0; a < K; ++a) {
+        p.nodes[a] = nodes[a];
+        p.weights[a] = g.template segment<3>(3 * a).dot(p.normal);
+      }
+      p.force = stiffness_ * std::abs(barrier(d, distance_).first);
+      out.push_back(p);
+    });
+  });
+  return out;
+}
+
 std::array<int, 2> ObstacleContact::first_intersection(const Positions& x) const {
   const Impl& m = *impl_;
   for (int t = 0; t < static_cast<int>(m.triangles.size()); ++t) {

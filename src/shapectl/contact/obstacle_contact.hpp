@@ -47,6 +47,18 @@ struct ContactSummary {
   std::vector<ContactPoint> points;      // every pair with d < d̂
 };
 
+// One pair in contact at x, as friction (friction.hpp) lags it: the object's closest point is
+// Σ weights[a] x(nodes[a]) over its element's nodes.
+struct ContactPair {
+  int element = -1;   // its Hessian element (hessian_elements order)
+  int obstacle = -1;  // index into the obstacles
+  int node_count = 0;
+  std::array<int, 3> nodes{};
+  std::array<double, 3> weights{};  // closest-point weights (barycentric, segment parameter)
+  Vec3 normal = Vec3::Zero();       // unit, from the obstacle towards the object
+  double force = 0;                 // normal force λ = κ |b′(d)|, N
+};
+
 class ObstacleContact : public EnergyTerm {
  public:
   // The object's surface from `mesh` (its surface_triangles()), `obstacles` in the world.
@@ -77,6 +89,8 @@ class ObstacleContact : public EnergyTerm {
   double max_step(const Positions& x, const Eigen::VectorXd& dx) const override;
 
   ContactSummary summary(const Positions& x) const;
+  // Every pair with 0 < d < d̂ at x, with its closest-point weights, normal and normal force.
+  std::vector<ContactPair> pairs(const Positions& x) const;
   // The first object surface triangle that intersects or touches (d ≤ 0) an obstacle at x, as
   // {obstacle, triangle index into the mesh's surface_triangles()}; {-1, -1} if none.
   std::array<int, 2> first_intersection(const Positions& x) const;

@@ -150,13 +150,7 @@ ContactSettings read_contact(const JsonInput& j, const RobotSetup* robot) {
           "contact with the robot uses its collision spheres: give robot.collision_spheres");
     c.robot = true;
   }
-  if (j.has("friction")) {
-    const double mu = j.at("friction").non_negative();
-    if (mu > 0)
-      j.at("friction")
-          .fail_problem(
-              "friction is not supported yet: contact is frictionless (give 0 or leave it out)");
-  }
+  if (j.has("friction")) c.friction = j.at("friction").non_negative();
   if (j.has("stiffness")) {
     j.at("stiffness").positive();
     c.stiffness = j.at("stiffness").number_in(1e-12, max_contact_stiffness, "N/m");

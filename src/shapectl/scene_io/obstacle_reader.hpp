@@ -17,8 +17,8 @@ struct RobotSetup;
 // cannot.
 std::vector<Obstacle> read_obstacles(const JsonInput& list, const RobotSetup* robot);
 
-// "contact": {"distance", "self", "robot", "friction", "stiffness"}; self contact and friction
-// are refused as not supported yet; robot: true needs `robot` with collision spheres.
+// "contact": {"distance", "self", "robot", "friction", "stiffness"}; robot: true needs `robot`
+// with collision spheres; friction is a non-negative Coulomb coefficient.
 ContactSettings read_contact(const JsonInput& j, const RobotSetup* robot);
 
 }  // namespace shapectl

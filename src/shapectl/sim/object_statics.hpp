@@ -11,6 +11,7 @@
 #include <shapectl/contact/self_contact.hpp>
 #include <shapectl/fem/gravity.hpp>
 #include <shapectl/fem/neo_hookean.hpp>
+#include <shapectl/sim/lagged_friction.hpp>
 #include <shapectl/sim/scene.hpp>
 #include <shapectl/sim/statics.hpp>
 
@@ -53,6 +54,8 @@ class ObjectStatics {
   const ObstacleContact* contact() const { return contact_ ? &*contact_ : nullptr; }
   // The contact of the object with itself; null unless the scene's contact.self.
   const SelfContact* self_contact() const { return self_contact_ ? &*self_contact_ : nullptr; }
+  // The scene's friction (coefficient 0: frictionless, no friction term).
+  const FrictionSettings& friction() const { return friction_; }
   // The applied loads' nodal forces (3n, N); zero without loads.
   Eigen::VectorXd load_forces() const;
   // The force Newton stops at: the scene's tolerance, or the round-off floor if larger.
@@ -65,6 +68,7 @@ class ObjectStatics {
   std::optional<ConstantForce> loads_;       // none without loads: the default terms stay two
   std::optional<ObstacleContact> contact_;   // none without obstacles
   std::optional<SelfContact> self_contact_;  // none without contact.self
+  FrictionSettings friction_;
   std::vector<char> fixed_node_;
   std::string unheld_reason_;
   StaticsSolver solver_;
