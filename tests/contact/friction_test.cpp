@@ -106,10 +106,10 @@ TEST(Friction, DerivativesMatchCentralDifferencesStickingAndSliding) {
 TEST(Friction, HessianElementsAreTheContactsWhateverIsLagged) {
   const Scenario s;
   ElementNodes contact, none, some;
-  s.contact.hessian_elements(contact);
   const Positions x = s.mesh.rest_vector();
-  ObstacleFriction(s.contact, {}, x, 0.5, 1e-4).hessian_elements(none);
-  ObstacleFriction(s.contact, s.contact.pairs(x), x, 0.5, 1e-4).hessian_elements(some);
+  s.contact.hessian_elements(x, contact);
+  ObstacleFriction(s.contact, {}, x, 0.5, 1e-4).hessian_elements(x, none);
+  ObstacleFriction(s.contact, s.contact.pairs(x), x, 0.5, 1e-4).hessian_elements(x, some);
   EXPECT_EQ(none, contact);
   EXPECT_EQ(some, contact);
 }
