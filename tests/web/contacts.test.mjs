@@ -8,7 +8,8 @@ import assert from 'node:assert/strict';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
-import { openSession, closeSession, waitFor, sourceDir, colourNear } from './support.mjs';
+import { openSession, closeSession, waitFor, sourceDir, colourNear, RawWebSocket } from './support.mjs';
+import { Command, Message } from '../../web/js/protocol.js';
 
 const hooks = (page, f, arg) => page.evaluate(f, arg);
 const close = (a, b, tolerance, what) =>
@@ -26,7 +27,10 @@ const OBSTACLES = [
   { name: 'peg', capsule: { a: [0.33, 0, PEG_Z], b: [0.45, 0, PEG_Z], radius: PEG_RADIUS } },
   { name: 'block', box: { size: [0.06, 0.04, 0.02], pose: { position: [0.55, 0.2, 0.11], rpy: [0, 0, 0.3] } } },
   { name: 'ball', sphere: { center: [0.55, -0.2, 0.13], radius: 0.03 } },
+  // On the left upper arm, off the link's origin and turned: drawn at the link's pose.
+  { name: 'cuff', link: 'yumi_link_3_l', box: { size: [0.02, 0.03, 0.04], pose: { position: [0.08, 0.08, 0.01], rpy: [0.3, 0, 0] } } },
 ];
+const CUFF_IN_LINK = [0.08, 0.08, 0.01];
 
 function writeScene(dir) {
   const scene = JSON.parse(readFileSync(path.join(sourceDir, 'scenes/yumi_bar.json'), 'utf8'));
@@ -57,7 +61,8 @@ describe('obstacles and contacts', () => {
       scene: window.shapectl.scene, drawn: window.shapectl.obstacles(), centroid: window.shapectl.objectCentroid(),
     }));
     assert.deepEqual(scene.obstacles.map((o) => [o.name, o.shape]),
-      [['table', 'plane'], ['peg', 'capsule'], ['block', 'box'], ['ball', 'sphere']]);
+      [['table', 'plane'], ['peg', 'capsule'], ['block', 'box'], ['ball', 'sphere'], ['cuff', 'box']]);
+    assert.deepEqual(scene.obstacles.map((o) => o.link), [null, null, null, null, 'yumi_link_3_l']);
     assert.equal(scene.contact.distance, 0.001);
     assert.deepEqual(drawn.map((o) => [o.name, o.shape, o.visible]), scene.obstacles.map((o) => [o.name, o.shape, true]));
     const [table, peg, block, ball] = drawn;
@@ -121,6 +126,42 @@ describe('obstacles and contacts', () => {
     await page.check('#show-contacts');
     assert.equal((await hooks(page, () => window.shapectl.contacts())).visible, true);
     assert.deepEqual(page.problems, []);
+  });
+
+  it('draws an obstacle on a robot link at that link\'s pose, and moves it with the link', async () => {
+    const cuff = () => hooks(page, () => {
+      const { scene, state } = window.shapectl;
+      const k = scene.robot.links.findIndex((l) => l.name === 'yumi_link_3_l');
+      return { links: state?.links, k, drawn: window.shapectl.obstacles().find((o) => o.name === 'cuff') };
+    });
+    // T_world_link (column-major) applied to the box's centre in the link frame.
+    const expected = (m) => [0, 1, 2].map((r) => m[12 + r] + CUFF_IN_LINK.reduce((s, p, c) => s + m[4 * c + r] * p, 0));
+    const first = await waitFor(async () => { const c = await cuff(); return c.links && c; }, 'a state');
+    assert.equal(first.drawn.link, 'yumi_link_3_l');
+    close(first.drawn.centre, expected(first.links[first.k]), 1e-6, 'cuff at its link pose');
+    assert.ok(Math.hypot(...first.drawn.centre.map((v, i) => v - CUFF_IN_LINK[i])) > 0.1, 'not at the link-frame coordinates');
+
+    // Another program pauses and jogs yumi_joint_1_l by two jog steps: the cuff follows its link.
+    const ws = await RawWebSocket.connect(session.server.port);
+    const reply = (id) => ws.next((m) => m.text?.includes(`"id":"${id}"`)).then((m) => JSON.parse(m.text));
+    const { scene, state } = await hooks(page, () => ({ scene: window.shapectl.scene, state: window.shapectl.state }));
+    const joint = scene.robot.joint_names.indexOf('yumi_joint_1_l');
+    assert.ok(joint >= 0);
+    ws.sendJson({ type: Command.SetPaused, paused: true, id: 'pause' });
+    assert.equal((await reply('pause')).type, Message.Ok);
+    const joints = [...state.joints];
+    for (let n = 0; n < 2; n++) {
+      joints[joint] -= scene.limits.max_jog_step;
+      ws.sendJson({ type: Command.SetJoints, joints, id: `jog${n}` });
+      const answer = await reply(`jog${n}`);
+      assert.equal(answer.type, Message.Ok, `jog ${n}: ${answer.message}`);
+    }
+    ws.close();
+    const moved = await waitFor(async () => {
+      const c = await cuff();
+      return Math.hypot(...c.drawn.centre.map((v, i) => v - first.drawn.centre[i])) > 0.003 && c;
+    }, 'the cuff moved with its link');
+    close(moved.drawn.centre, expected(moved.links[moved.k]), 1e-6, 'cuff at its new link pose');
   });
 
   it('shows the bundled cable on its table, and nothing of the peg scene after it', async () => {

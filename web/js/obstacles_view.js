@@ -1,8 +1,8 @@
-// The scene's static obstacles in the 3D view (the scene message's "obstacles", docs/contact.md):
+// The scene's obstacles in the 3D view (the scene message's "obstacles", docs/contact.md):
 // a plane as a translucent square with a grid, centred under the object; a box or a mesh from its
 // triangles; a sphere; a capsule as a cylinder with two spheres (in general: a sphere of the
 // radius at every point and a cylinder along every edge, the inflated shape the contact sees).
-// World frame, metres.
+// World frame, metres; an obstacle on a robot link at that link's pose.
 import * as THREE from 'three';
 
 const PLANE_SIZE_M = 1.2;         // the plane's square: wider than the object and the robot's reach
@@ -72,9 +72,22 @@ export class ObstaclesView {
     this.obstacles = obstacles.map((o) => {
       const object = o.plane ? planeObject(o.plane) : shapeObject(o);
       object.name = `obstacle ${o.name}`;
+      // On a robot link: its points are in the link's frame, the link's pose its matrix.
+      if (o.link) object.matrixAutoUpdate = false;
       this.group.add(object);
-      return { name: o.name, shape: o.shape, object };
+      return { name: o.name, shape: o.shape, link: o.link ?? null, object };
     });
+  }
+
+  // `poses` (a state's "links", column-major T_world_link) for the links named `linkNames`:
+  // obstacles on a link move with it.
+  setLinkPoses(poses, linkNames) {
+    for (const { link, object } of this.obstacles) {
+      const k = link ? linkNames.indexOf(link) : -1;
+      if (k < 0 || !poses[k]) continue;
+      object.matrix.fromArray(poses[k]);
+      object.matrixWorldNeedsUpdate = true;
+    }
   }
 
   // Moves each plane's square under `point` (the object's centroid): its foot on the plane.
@@ -87,14 +100,15 @@ export class ObstaclesView {
     }
   }
 
-  // For tests: each obstacle as drawn, {name, shape, visible, meshes, centre: [x, y, z] of its box}.
+  // For tests: each obstacle as drawn, {name, shape, link, visible, meshes, centre: [x, y, z] of
+  // its box}.
   describe() {
-    return this.obstacles.map(({ name, shape, object }) => {
+    return this.obstacles.map(({ name, shape, link, object }) => {
       let meshes = 0;
       object.traverse((o) => { if (o.isMesh) meshes++; });
       object.updateMatrixWorld(true);
       const centre = new THREE.Box3().setFromObject(object).getCenter(new THREE.Vector3()).toArray();
-      return { name, shape, visible: object.visible && this.group.visible, meshes, centre };
+      return { name, shape, link, visible: object.visible && this.group.visible, meshes, centre };
     });
   }
 }

@@ -200,6 +200,7 @@ export class View3D {
     if (this.ghostView.setState(state)) this.requestRender();
     if (unchanged) return;  // same snapshot: nothing to redraw (saves software-GL time)
     this.robotView.setLinkPoses(state.links);
+    this.obstaclesView.setLinkPoses(state.links, this.robotView.linkGroups.map((g) => g.name));
     this.objectView.setCenterline(state.centerline);
     this.objectView.setTargets(state.targets, state.centerline.length === 0);  // the curve is the handle there
     this.objectView.setObservedMarkers(state.observed_markers);

@@ -8,19 +8,23 @@
 
 namespace shapectl::server {
 
-nlohmann::json obstacles_json(const std::vector<Obstacle>& obstacles) {
+nlohmann::json obstacles_json(const std::vector<Obstacle>& obstacles, const RobotModel* robot) {
   nlohmann::json out = nlohmann::json::array();
   for (const Obstacle& o : obstacles) {
     nlohmann::json plane = nullptr;
     if (o.plane)
       plane = {{"point", vec3_json(o.plane->point)}, {"normal", vec3_json(o.plane->normal)}};
-    out.push_back({{"name", o.name},
-                   {"shape", o.shape},
-                   {"plane", plane},
-                   {"points", points_json(o.points)},
-                   {"edges", o.edges},
-                   {"triangles", o.triangles},
-                   {"radius", o.radius}});
+    out.push_back(
+        {{"name", o.name},
+         {"shape", o.shape},
+         {"plane", plane},
+         {"points", points_json(o.points)},
+         {"edges", o.edges},
+         {"triangles", o.triangles},
+         {"radius", o.radius},
+         {"link", o.link >= 0 && robot
+                      ? nlohmann::json(robot->links()[static_cast<std::size_t>(o.link)].name)
+                      : nlohmann::json(nullptr)}});
   }
   return out;
 }

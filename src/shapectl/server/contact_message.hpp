@@ -8,14 +8,18 @@
 
 #include <shapectl/contact/obstacle.hpp>
 #include <shapectl/contact/obstacle_contact.hpp>
+#include <shapectl/robot/robot_model.hpp>
 
 namespace shapectl::server {
 
 // A state lists at most this many contact points (the closest first); "count" is all of them.
 inline constexpr std::size_t max_contact_points = 2000;
 
-// [{name, shape, plane: {point, normal} or null, points, edges, triangles, radius}, ...]
-nlohmann::json obstacles_json(const std::vector<Obstacle>& obstacles);
+// [{name, shape, plane: {point, normal} or null, points, edges, triangles, radius, link}, ...];
+// link: the name of the robot link (of `robot`) the obstacle moves with, its points then in that
+// link's frame; null: the world.
+nlohmann::json obstacles_json(const std::vector<Obstacle>& obstacles,
+                              const RobotModel* robot = nullptr);
 
 // {count, min_distance (null without a pair within d̂), force_total, by_obstacle: {name:
 // {count, force}}, points: [[px, py, pz, fx, fy, fz], ...] (at most `max_points`, the closest

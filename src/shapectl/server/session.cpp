@@ -622,7 +622,8 @@ nlohmann::json Session::describe_scene() const {
           {"robot",
            scene.robot ? robot_json(*scene.robot, robot_meshes_) : nlohmann::json(nullptr)},
           {"warnings", mesh_warnings(scene, robot_meshes_)},
-          {"obstacles", obstacles_json(scene.obstacles)},
+          {"obstacles",
+           obstacles_json(scene.obstacles, scene.robot ? scene.robot->model.get() : nullptr)},
           {"contact", contact ? nlohmann::json{{"distance", contact->distance()},
                                                {"stiffness", contact->stiffness()}}
                               : nlohmann::json(nullptr)},
