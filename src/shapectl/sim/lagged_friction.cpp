@@ -70,9 +70,12 @@ StaticsResult solve_with_friction(const StaticsSolver& solver, const EnergyTerms
   }
 
   // 2. Lagged: μ with λ, n, w of the last equilibrium, until the friction forces settle.
+  const auto lagged_at = [&](const Positions& at) {
+    return ObstacleFriction(contact, contact.pairs(at), anchor, settings.coefficient,
+                            settings.slip);
+  };
+  ObstacleFriction friction = lagged_at(x);
   for (int lag = 1; lag <= settings.max_lags; ++lag) {
-    const ObstacleFriction friction(contact, contact.pairs(x), anchor, settings.coefficient,
-                                    settings.slip);
     with.back() = &friction;
     add_solve(result, solver.solve(with, ws, x, max_iterations, &ws, stop));
     const Slide slide = find_slide(friction, x, contact.obstacles().size());
@@ -86,8 +89,7 @@ StaticsResult solve_with_friction(const StaticsSolver& solver, const EnergyTerms
     }
     if (!result.converged()) return result;
     // Settled when the friction lagged at this equilibrium pushes as the one it was solved with.
-    const ObstacleFriction next(contact, contact.pairs(x), anchor, settings.coefficient,
-                                settings.slip);
+    ObstacleFriction next = lagged_at(x);  // also the next solve's friction
     const double change =
         largest_node_norm(solver.gradient({&next}, x) - solver.gradient({&friction}, x));
     if (change <= solver.effective_tolerance()) {
@@ -100,6 +102,7 @@ StaticsResult solve_with_friction(const StaticsSolver& solver, const EnergyTerms
                       std::to_string(lag) + " lagged solves (they still change by " +
                       short_number(change) + " N)";
     }
+    friction = std::move(next);
   }
   return result;
 }
