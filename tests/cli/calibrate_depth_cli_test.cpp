@@ -102,6 +102,9 @@ TEST_F(CalibrateDepthCli, BadDepthImagesExitOneNamingTheFileAndTheField) {
          d["camera_pose"]["rpy"] = {0, 0};
        },
        field + ".camera_pose.rpy: "},
+      {[](nlohmann::json& d) { d["camera_pose"].erase("rpy"); },
+       field + ".camera_pose: expected {\"position\": [x, y, z], \"rpy\": [roll, pitch, yaw]}, "
+               "both given"},
   };
   for (const auto& [change, expected] : cases) {
     nlohmann::json bad = good;

@@ -48,7 +48,11 @@ DepthImageObservation read_depth_image(const JsonInput& j) {
   if (!j.is_object()) j.fail("an object {\"file\", \"intrinsics\", \"camera_pose\", ...}");
   j.expect_only({"file", "scale", "intrinsics", "camera_pose", "crop", "stride", "camera"});
   const PinholeIntrinsics intrinsics = read_intrinsics(j.at("intrinsics"));
-  const Eigen::Isometry3d T_world_camera = read_pose(j.at("camera_pose"));
+  const JsonInput pose = j.at("camera_pose");
+  // Unlike an object's pose, a camera's has no natural default (rpy 0 looks straight up).
+  if (!pose.has("position") || !pose.has("rpy"))
+    pose.fail("{\"position\": [x, y, z], \"rpy\": [roll, pitch, yaw]}, both given");
+  const Eigen::Isometry3d T_world_camera = read_pose(pose);
   const int stride = j.has("stride") ? static_cast<int>(j.at("stride").integer_in(1, 1000)) : 1;
   DepthImageObservation out;
   out.camera.index =
