@@ -158,6 +158,13 @@ void print_summary(const CalibrationResult& r) {
       std::cerr << "calibrate: warning: " << p.name << " moved " << p.fitted - p.initial << " "
                 << p.unit << ", more than 3 prior σ (" << p.prior << " " << p.unit
                 << "): implausible; the model may miss something the fit absorbs here\n";
+  // Background the fit reads and drops every iteration: worth cutting away before the fit.
+  for (std::size_t k = 0; k < r.frames.size(); ++k)
+    if (const FrameFit& f = r.frames[k]; f.points > 0 && 2 * f.inlier_points_after < f.points)
+      std::cerr << "calibrate: note: frames[" << k << "]: only " << f.inlier_points_after << " of "
+                << f.points << " points lie near the fitted surface; the rest (the table, the "
+                << "robot, the room?) were read as outliers on every iteration: a \"crop\" box "
+                << "(depth images) or a cropped cloud would leave them out\n";
   std::cerr << "calibrate: " << r.reason << "; RMS residual " << r.rms_before * 1e3 << " mm -> "
             << r.rms_after * 1e3 << " mm (χ²/dof " << r.chi_squared_per_dof << ") in " << r.seconds
             << " s\n";

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <random>
+#include <set>
 
 #include <shapectl/calib/depth_npy.hpp>
 #include <shapectl/calib/depth_png.hpp>
@@ -67,6 +68,7 @@ TEST_F(CalibrateDepthCli, FitsTheCameraPoseWithItsPrior) {
   // The scene is the truth here: nothing moves beyond its noise.
   for (const auto& p : report["parameters"]) EXPECT_FALSE(p["implausible"].get<bool>()) << p;
   EXPECT_GT(report["frames"][0]["points"].get<int>(), 500);
+  EXPECT_EQ(run.err.find("near the fitted surface"), std::string::npos) << run.err;
   const auto priors = run_cli({"calibrate", kClamped.string(), "--observations",
                                (dir.path() / "obs.json").string(), "--out", out, "--fit",
                                "youngs_modulus,camera_poses", "--prior", "camera_poses=5mm/1deg"});
@@ -129,4 +131,34 @@ TEST_F(CalibrateDepthCli, BadDepthImagesExitOneNamingTheFileAndTheField) {
 }
 
 }  // namespace
+TEST_F(CalibrateDepthCli, AFrameMostlyOfBackgroundKeepsItsObjectPointsAndGetsANoteToCropIt) {
+  // The bar's surface nodes as a cloud, with four times as many points of a floor 20 cm below
+  // it: the median distance lies on the floor, yet the cut-off keeps the bar's points (and only
+  // them), and the report says the floor could be cropped.
+  const Scene scene = load_scene(kClamped);
+  Positions x = scene.world_rest_positions();
+  ASSERT_TRUE(ObjectStatics(scene).solve(x).converged());
+  std::set<int> surface;
+  for (const auto& t : scene.object_mesh->surface_triangles()) surface.insert(t.begin(), t.end());
+  nlohmann::json cloud = nlohmann::json::array();
+  Vec3 centre = Vec3::Zero();
+  for (int i : surface) {
+    cloud.push_back(vec3_json(x.segment<3>(3 * i)));
+    centre += x.segment<3>(3 * i) / surface.size();
+  }
+  for (int i = 0; i < 4 * static_cast<int>(surface.size()); ++i)
+    cloud.push_back(
+        vec3_json(centre + Vec3(0.002 * (i % 100) - 0.1, 0.002 * (i / 100) - 0.1, -0.2)));
+  nlohmann::json observations = good;
+  observations["frames"].push_back({{"points", cloud}, {"sigma", 0.0003}});
+  const auto run = calibrate(observations, "youngs_modulus");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(test::read_text(dir.path() / "report.json"));
+  EXPECT_EQ(report["frames"][2]["inlier_points_after"].get<int>(), surface.size());
+  EXPECT_LT(report["frames"][2]["rms_after"].get<double>(), 1e-3);
+  EXPECT_NE(run.err.find("frames[2]: only "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("\"crop\" box"), std::string::npos) << run.err;
+  EXPECT_EQ(run.err.find("frames[0]: only "), std::string::npos) << run.err;
+}
+
 }  // namespace shapectl

@@ -12,7 +12,10 @@ double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surf
   for (const Vec3& p : frame.points) d.push_back(surface.closest(camera.motion * p).distance);
   auto middle = d.begin() + d.size() / 2;
   std::nth_element(d.begin(), middle, d.end());
-  return std::max(4 * frame.sigma, 3 * 1.4826 * *middle);
+  // A cloud mostly of background (no crop) puts the median on the background: capped, a point
+  // a quarter of the object's size from it is never the object, however far the model is off.
+  const double robust = std::min(3 * 1.4826 * *middle, 0.25 * surface.diagonal());
+  return std::max(4 * frame.sigma, robust);
 }
 
 FrameResiduals frame_residuals(const ObservationFrame& frame, const Positions& x,

@@ -31,7 +31,8 @@ struct FrameResiduals {
 
 // A cut-off for the frame's cloud at the positions x: every point within 4σ, and otherwise
 // points within 3 robust standard deviations (1.4826 × the median distance) of the surface,
-// so a model still centimetres off keeps its inliers while background stays out.
+// so a model still centimetres off keeps its inliers while background stays out; never beyond
+// a quarter of the surface's bounding-box diagonal (a cloud mostly of background).
 double outlier_cutoff(const ObservationFrame& frame, const SurfaceDistance& surface,
                       const CameraMotion& camera = {});
 

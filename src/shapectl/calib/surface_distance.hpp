@@ -45,6 +45,10 @@ class SurfaceDistance {
   SurfaceHit closest(const Vec3& p) const;
 
   const std::vector<std::array<int, 3>>& triangles() const { return triangles_; }
+  // The diagonal of the surface's bounding box at the last update, m.
+  double diagonal() const {
+    return tree_.empty() ? 0 : (tree_[0].box.max - tree_[0].box.min).norm();
+  }
 
  private:
   struct Box {
