@@ -300,7 +300,7 @@ describe('panel controls', () => {
       const set = (id, text) => { document.getElementById(id).textContent = text; };
       set('status', 'best effort · unreachable: joint limit, collision, reach, buckling');
       set('status-reason', 'error 123.4 mm above the tolerance 1.0 mm; yumi_joint_7_l within 0.01 rad of its limit and pulled further out, yumi_link_4_l and yumi_link_4_r 0.8 mm apart and pulled closer, the left arm stretched to 97 % of its reach');
-      set('status-detail', '12 targets · 123456 iterations · 3 page(s) · clearance 123 mm · UNSAFE · jog refused: self-collision: yumi_link_7_l and yumi_link_6_r would overlap by 3.1 mm');
+      set('status-detail', '12 targets · 123456 iterations · 3 pages · clearance 123 mm · UNSAFE · jog refused: self-collision: yumi_link_7_l and yumi_link_6_r would overlap by 3.1 mm');
       set('error-mean', '12345.67'); set('error-max', '123456.78'); set('rate', '1234');
       set('observed', '1234 observations · model error 12.34 mm · observed error 12.34 mm · true error (simulated world) 12.34 mm · gate rejected 12 of 1234 markers, 3 frames');
       set('plot-readout', '-12.3 s: mean error 123.456 mm · true error 123.456 mm · model error 123.456 mm · observed error 123.456 mm');

@@ -145,7 +145,9 @@ function onState(state) {
   $('rate').textContent = running ? state.iterations_per_second.toFixed(0) : '–';
   // Wrapped between its parts, never inside one ("53" and "mm" on separate lines).
   const whole = (part) => part.replaceAll(' ', '\u00a0');
-  const parts = [`${state.targets.length} targets`, `${state.iterations} iterations`, `${state.clients} page(s)`];
+  const count = (n, one, many) => `${n} ${n === 1 ? one : many}`;
+  const parts = [count(state.targets.length, 'target', 'targets'), count(state.iterations, 'iteration', 'iterations'),
+    count(state.clients, 'page', 'pages')];
   if (state.min_clearance !== null) parts.push(`clearance ${(1000 * state.min_clearance).toFixed(0)} mm`);
   if (state.contacts) parts.push(contactSummary(state.contacts));
   if (!state.safe) parts.push('UNSAFE');
