@@ -20,7 +20,7 @@ if(NOT EXISTS /usr/bin/chromium)
                       "or configure with -DSHAPECTL_WEB_TESTS=OFF")
 endif()
 foreach(script gui_e2e ws_fuzz robot_link real_object units robot_visuals targets targets_files panel robot_meshes status_jog
-               panel_controls contacts occlusion unreachable)
+               panel_controls contacts self_contacts occlusion unreachable)
   add_test(NAME web_${script}
     COMMAND ${NODE_EXECUTABLE} --test --test-reporter=spec ${PROJECT_SOURCE_DIR}/tests/web/${script}.test.mjs)
   set_tests_properties(web_${script} PROPERTIES TIMEOUT 300

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <limits>
 
 #include <shapectl/io/json_eigen.hpp>
 #include <shapectl/io/json_output.hpp>
@@ -36,16 +37,26 @@ nlohmann::json fixed_joints_json(const RobotModel& robot) {
   return out;
 }
 
-nlohmann::json contacts_json(const ObstacleContact& contact, const Positions& x) {
-  const ContactSummary summary = contact.summary(x);
+nlohmann::json contacts_json(const ObstacleContact* contact, const SelfContact* self,
+                             const Positions& x) {
+  if (!contact && !self) return nullptr;
+  ContactSummary summary;
+  summary.min_distance = std::numeric_limits<double>::infinity();
+  if (contact) summary = contact->summary(x);
   nlohmann::json out = {{"count", summary.count}, {"force_total", vec3_json(summary.force_total)}};
   // +inf when no pair is that close: JSON has no infinity, so the key is left out.
   if (std::isfinite(summary.min_distance)) out["min_distance"] = summary.min_distance;
   nlohmann::json by_obstacle = nlohmann::json::object();
   for (std::size_t k = 0; k < summary.by_obstacle.size(); ++k)
-    by_obstacle[contact.obstacles()[k].name] = {{"count", summary.by_obstacle[k].count},
-                                                {"force", vec3_json(summary.by_obstacle[k].force)}};
+    by_obstacle[contact->obstacles()[k].name] = {{"count", summary.by_obstacle[k].count},
+                                                 {"force",
+                                                  vec3_json(summary.by_obstacle[k].force)}};
   out["by_obstacle"] = by_obstacle;
+  if (self) {
+    const SelfContactSummary s = self->summary(x);
+    out["self"] = {{"count", s.count}};
+    if (std::isfinite(s.min_distance)) out["self"]["min_distance"] = s.min_distance;
+  }
   return out;
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <shapectl/contact/obstacle_contact.hpp>
+#include <shapectl/contact/self_contact.hpp>
 #include <shapectl/sim/scene.hpp>
 
 #include "commands.hpp"
@@ -19,8 +20,11 @@ nlohmann::json robot_json(const Scene& scene, const Eigen::VectorXd& joints);
 nlohmann::json fixed_joints_json(const RobotModel& robot);
 // The contacts at positions x: {"count", "min_distance" (m; left out when no pair is within
 // the contact distance), "force_total": [..] (N, the obstacles' force on the object),
-// "by_obstacle": {name: {"count", "force"}}}.
-nlohmann::json contacts_json(const ObstacleContact& contact, const Positions& x);
+// "by_obstacle": {name: {"count", "force"}}} with the obstacles (else count 0, no force, no
+// obstacle), and "self": {"count", "min_distance"} with self-contact (its pairs are in neither
+// count nor force_total: internal forces sum to zero). Null with neither.
+nlohmann::json contacts_json(const ObstacleContact* contact, const SelfContact* self,
+                             const Positions& x);
 // --tolerance M: the target error (m) under which a result counts as reached (default 1 mm).
 void add_tolerance_option(CLI::App& command, double& tolerance);
 // Throws SolverFailure ("<what>: <field> is not finite (<context>)") if any number in `result` is

@@ -130,8 +130,11 @@ void run_solve(const SolveArgs& args) {
         {{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
   out["loads_total"] = vec3_json(scene.loads_total());
-  if (const auto contact = object.contact_at(best.state->kinematics()))
-    out["contacts"] = contacts_json(*contact, best.positions());
+  const auto contact = object.contact_at(best.state->kinematics());
+  if (auto contacts = contacts_json(contact ? &*contact : nullptr, object.statics().self_contact(),
+                                    best.positions());
+      !contacts.is_null())
+    out["contacts"] = std::move(contacts);
   out["positions"] = positions_json(best.positions());
   out["targets"] = targets_json(objective.targets());
   for (const auto& h : result.history)

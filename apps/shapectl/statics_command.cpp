@@ -50,8 +50,9 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const Scene&
   result["residual"] = r.residual;
   result["energy"] = r.energy;
   result["loads_total"] = vec3_json(scene.loads_total());
-  if (const ObstacleContact* contact = statics.contact())
-    result["contacts"] = contacts_json(*contact, x);
+  if (auto contacts = contacts_json(statics.contact(), statics.self_contact(), x);
+      !contacts.is_null())
+    result["contacts"] = std::move(contacts);
   result["positions"] = positions_json(x);
   require_finite(result, "statics", r.reason);
   std::vector<FileContent> files = {{args.out, to_pretty_json(result)}};

@@ -72,7 +72,7 @@ class StaticsSolution:
     energy: float
     result: StaticsResult
     loads_total: FloatArray  # (3,), N
-    contacts: Optional[Dict[str, Any]]  # count, min_distance, force_total, by_obstacle; None without obstacles
+    contacts: Optional[Dict[str, Any]]  # count, min_distance, force_total, by_obstacle, self; None without obstacles and self-contact
     positions: FloatArray  # (n, 3)
     joints: Optional[FloatArray]  # (m,)
     joint_names: List[str]
@@ -147,7 +147,7 @@ class SolveResult:
     min_clearance: Optional[float]
     limit_violations: List[LimitViolation]
     loads_total: FloatArray  # (3,), N
-    contacts: Optional[Dict[str, Any]]  # count, min_distance, force_total, by_obstacle; None without obstacles
+    contacts: Optional[Dict[str, Any]]  # count, min_distance, force_total, by_obstacle, self; None without obstacles and self-contact
     positions: FloatArray  # (n, 3)
     target_nodes: IntArray  # (k,)
     target_positions: FloatArray  # (k, 3)

@@ -109,17 +109,20 @@ std::map<std::string, Pose> tool_poses(const Scene& scene, const Eigen::VectorXd
 // Every joint of `full_joints` outside its hard limits (the CLI's "limit_violations").
 std::vector<LimitViolation> violations_at(const RobotModel& robot, const Eigen::VectorXd& active);
 
-// A result's contacts with the scene's obstacles (docs/contact.md): computed without the GIL,
-// handed to Python as a dict by contacts_dict.
+// A result's contacts with the scene's obstacles and with itself (docs/contact.md): computed
+// without the GIL, handed to Python as a dict by contacts_dict.
 struct ContactsResult {
-  ContactSummary summary;
+  ContactSummary summary;  // empty without obstacles
   std::vector<std::string> obstacle_names;
+  std::optional<SelfContactSummary> self;  // none without self-contact
 };
-// The contacts at x; none without a contact term (null).
-std::optional<ContactsResult> contacts_at(const ObstacleContact* contact, const Positions& x);
+// The contacts at x; none without a contact term or a self-contact term (both null).
+std::optional<ContactsResult> contacts_at(const ObstacleContact* contact, const SelfContact* self,
+                                          const Positions& x);
 // {"count", "min_distance" (m; None without a pair within the contact distance), "force_total"
-// ((3,) N, the obstacles' force on the object), "by_obstacle": {name: {"count", "force"}}}, the
-// fields of RESULT.json's "contacts"; None without obstacles.
+// ((3,) N, the obstacles' force on the object), "by_obstacle": {name: {"count", "force"}}}, plus
+// "self": {"count", "min_distance"} with self-contact, the fields of RESULT.json's "contacts";
+// None without obstacles and self-contact.
 py::object contacts_dict(const std::optional<ContactsResult>& contacts);
 
 void bind_scene(py::module_& m);

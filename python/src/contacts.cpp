@@ -1,14 +1,22 @@
-// Results' contacts with the scene's obstacles, as RESULT.json's "contacts" (docs/contact.md).
+// Results' contacts with the scene's obstacles and the object's with itself, as RESULT.json's
+// "contacts" (docs/contact.md).
 #include <cmath>
+#include <limits>
 
 #include "bindings.hpp"
 
 namespace shapectl::python {
 
-std::optional<ContactsResult> contacts_at(const ObstacleContact* contact, const Positions& x) {
-  if (!contact) return std::nullopt;
-  ContactsResult out{contact->summary(x), {}};
-  for (const Obstacle& o : contact->obstacles()) out.obstacle_names.push_back(o.name);
+std::optional<ContactsResult> contacts_at(const ObstacleContact* contact, const SelfContact* self,
+                                          const Positions& x) {
+  if (!contact && !self) return std::nullopt;
+  ContactsResult out;
+  out.summary.min_distance = std::numeric_limits<double>::infinity();
+  if (contact) {
+    out.summary = contact->summary(x);
+    for (const Obstacle& o : contact->obstacles()) out.obstacle_names.push_back(o.name);
+  }
+  if (self) out.self = self->summary(x);
   return out;
 }
 
@@ -28,6 +36,13 @@ py::object contacts_dict(const std::optional<ContactsResult>& contacts) {
       std::isfinite(s.min_distance) ? py::object(py::float_(s.min_distance)) : py::none();
   out["force_total"] = Eigen::Vector3d(s.force_total);
   out["by_obstacle"] = by_obstacle;
+  if (const auto& self = contacts->self) {
+    py::dict one;
+    one["count"] = self->count;
+    one["min_distance"] =
+        std::isfinite(self->min_distance) ? py::object(py::float_(self->min_distance)) : py::none();
+    out["self"] = one;
+  }
   return out;
 }
 

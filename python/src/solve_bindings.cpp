@@ -113,7 +113,8 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
   out.loads_total = s.scene->loads_total();
   out.positions = best.positions();
   const auto contact = object.contact_at(best.state->kinematics());
-  out.contacts = contacts_at(contact ? &*contact : nullptr, out.positions);
+  out.contacts =
+      contacts_at(contact ? &*contact : nullptr, object.statics().self_contact(), out.positions);
   out.targets = objective.targets();
   out.history = result.history;
   out.timing = objective.timing();
@@ -182,8 +183,8 @@ void bind_solve(py::module_& m) {
                     "Sum of the scene's applied loads, N, world frame: array of shape (3,).")
       .def_property_readonly(
           "contacts", [](const SolveResult& r) { return contacts_dict(r.contacts); },
-          "Contacts with the scene's obstacles at the best θ, as StaticsSolution.contacts; None "
-          "without obstacles.")
+          "Contacts with the scene's obstacles and with itself at the best θ, as "
+          "StaticsSolution.contacts; None without obstacles and self-contact.")
       .def_property_readonly(
           "positions", [](const SolveResult& r) { return positions_array(r.positions); },
           "Equilibrium at the best θ: array of shape (n, 3).")

@@ -30,7 +30,7 @@ StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in)
     out.positions = s.scene->world_rest_positions();
     const ObjectStatics statics(*s.scene);
     out.result = statics.solve(out.positions);
-    out.contacts = contacts_at(statics.contact(), out.positions);
+    out.contacts = contacts_at(statics.contact(), statics.self_contact(), out.positions);
     return out;
   }
   const GrippedObject& object = *s.object;
@@ -41,7 +41,8 @@ StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in)
   out.result = state.statics();
   out.positions = state.positions();
   const auto contact = object.contact_at(state.kinematics());
-  out.contacts = contacts_at(contact ? &*contact : nullptr, out.positions);
+  out.contacts =
+      contacts_at(contact ? &*contact : nullptr, object.statics().self_contact(), out.positions);
   out.joints = joints;
   out.joint_names = object.robot().active_joint_names();
   out.tools = tool_poses(*s.scene, joints);
@@ -129,7 +130,9 @@ void bind_statics(py::module_& m) {
           "contacts", [](const StaticsSolution& s) { return contacts_dict(s.contacts); },
           "Contacts with the scene's obstacles at the equilibrium: {'count', 'min_distance' (m or "
           "None), 'force_total' ((3,) N, the obstacles' force on the object), 'by_obstacle': "
-          "{name: {'count', 'force'}}}; None without obstacles (docs/contact.md).")
+          "{name: {'count', 'force'}}}, with self-contact also 'self': {'count', 'min_distance'} "
+          "(its pairs are in neither count nor force_total); None without obstacles and "
+          "self-contact (docs/contact.md).")
       .def_property_readonly(
           "positions", [](const StaticsSolution& s) { return positions_array(s.positions); },
           "Equilibrium positions, world frame, metres: array of shape (n, 3), mesh node order.")

@@ -6,6 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <random>
 
 #include <shapectl/mesh/box_mesh.hpp>
@@ -163,6 +166,85 @@ TEST(SelfContact, MaxStepStopsBeforeTheSurfacesPassThroughEachOther) {
     EXPECT_TRUE(std::isfinite(term.value(y)));
   }
   EXPECT_GT(term.min_distance(x + alpha * dx), 0);
+}
+
+// B where it is meant to be, unperturbed.
+Positions placed(const TetMesh& mesh) {
+  Positions x = mesh.rest_vector();
+  for (int i = 4; i < 8; ++i) x[3 * i] -= 1;
+  return x;
+}
+
+// Whether `points` holds p (to round-off).
+bool holds(const std::vector<Vec3>& points, const Vec3& p) {
+  return std::any_of(points.begin(), points.end(),
+                     [&](const Vec3& q) { return (q - p).norm() < 1e-12; });
+}
+
+TEST(SelfContact, SummaryPlacesEachPairMidwayBetweenItsClosestPoints) {
+  // B's apex 5 mm below A's bottom face (z = 0) at (0.02, 0.02): they meet 2.5 mm below it.
+  const TetMesh apex = vertex_triangle();
+  const SelfContact a(apex, kDhat, 3.0);
+  const SelfContactSummary s = a.summary(placed(apex));
+  ElementNodes elements;
+  a.hessian_elements(placed(apex), elements);
+  EXPECT_EQ(s.count, static_cast<int>(elements.size()));
+  ASSERT_EQ(s.points.size(), elements.size());
+  EXPECT_NEAR(s.min_distance, 0.005, 1e-15);
+  EXPECT_EQ(s.min_distance, a.min_distance(placed(apex)));
+  EXPECT_TRUE(holds(s.points, Vec3(0.02, 0.02, -0.0025)));
+  // B's top edge, 5 mm below A's bottom face at x = 0.05, crosses A's edges on y = 0 and on
+  // x + y = 0.1 there: two edge–edge pairs meeting 2.5 mm below them.
+  const TetMesh edge = edge_edge();
+  const SelfContact e(edge, kDhat, 3.0);
+  const SelfContactSummary t = e.summary(placed(edge));
+  EXPECT_NEAR(t.min_distance, 0.005, 1e-15);
+  EXPECT_TRUE(holds(t.points, Vec3(0.05, 0.0, -0.0025)));
+  EXPECT_TRUE(holds(t.points, Vec3(0.05, 0.05, -0.0025)));
+  for (std::size_t k = 0; k < t.points.size(); ++k) {
+    EXPECT_GE(t.distances[k], t.min_distance);
+    EXPECT_LT(t.distances[k], kDhat);
+  }
+  // Nothing near: nothing listed.
+  const SelfContactSummary none = e.summary(edge.rest_vector());
+  EXPECT_EQ(none.count, 0);
+  EXPECT_TRUE(none.points.empty());
+  EXPECT_EQ(none.min_distance, std::numeric_limits<double>::infinity());
+}
+
+// The pairs a term finds are remembered across calls (near pairs kept while the surface moves
+// less than a margin, a short step's CCD over them alone): a term used along a walk of states
+// must answer exactly as a new term (which knows no earlier state) does at each.
+TEST(SelfContact, ATermUsedAlongAWalkAnswersAsANewTermAtEachState) {
+  for (const TetMesh& mesh : {vertex_triangle(), edge_edge()}) {
+    const SelfContact walker(mesh, kDhat, 3.0);
+    Positions x = brought_close(mesh, 4);
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    int active = 0;
+    for (int step = 0; step < 60; ++step) {
+      // Steps from 0.1 mm to 3 cm: within a margin (2 cm here) and beyond it.
+      const double size = 1e-4 * std::pow(300.0, (step % 7) / 6.0);
+      Eigen::VectorXd dx(x.size());
+      for (int i = 0; i < dx.size(); ++i) dx[i] = size * u(rng);
+      const SelfContact fresh(mesh, kDhat, 3.0);
+      ElementNodes mine, theirs;
+      walker.hessian_elements(x, mine);
+      fresh.hessian_elements(x, theirs);
+      ASSERT_EQ(mine, theirs) << "step " << step;
+      active += mine.size() > 0;
+      EXPECT_EQ(walker.value(x), fresh.value(x)) << "step " << step;
+      Eigen::VectorXd g = Eigen::VectorXd::Zero(x.size()), h = g;
+      walker.add_gradient(x, g);
+      fresh.add_gradient(x, h);
+      EXPECT_EQ(g, h) << "step " << step;
+      const double alpha = walker.max_step(x, dx);
+      EXPECT_EQ(alpha, SelfContact(mesh, kDhat, 3.0).max_step(x, dx)) << "step " << step;
+      const Positions next = x + alpha * dx;
+      if (walker.first_intersection(next)[0] < 0 && std::isfinite(walker.value(next))) x = next;
+    }
+    EXPECT_GT(active, 10) << "the walk stays in contact for a good part";
+  }
 }
 
 }  // namespace

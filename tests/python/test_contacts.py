@@ -1,6 +1,6 @@
 """Scenes with "obstacles" from Python (docs/contact.md): the keys pass through Scene.from_dict
 and to_dict, and statics and solve results carry "contacts" as the CLI's RESULT.json does, the
-obstacles' force on the object upwards."""
+obstacles' force on the object upwards; with contact.self also its "self" part."""
 
 import json
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import shapectl
-from conftest import BAR
+from conftest import BAR, SOURCE_DIR
 
 GAP = 0.0005  # m: every obstacle this far from the object at the start, within d̂ = 1 mm
 SIZE = [0.1, 0.04, 0.04]
@@ -84,6 +84,46 @@ def test_a_solve_reports_the_contacts_of_its_best_joints(bar_scene):
     # Part of the weight is on the peg, the rest in the grips.
     weight = 40 * 0.32 * 0.03 * 0.03 * 9.81
     assert r.contacts["force_total"][2] < weight
+
+
+def slit_bar(bar_scene, press):
+    """The YuMi bar slit through its middle (tests/data/slit_bar.py), its upper slab's middle
+    pressed down by `press` N onto the lower one, with contact.self."""
+    d = json.loads(json.dumps(bar_scene.to_dict()))
+    d["object"]["mesh"] = {"file": str(SOURCE_DIR / "tests" / "data" / "slit_bar.node")}
+    d["loads"] = [{"box": {"min": [-0.021, -1, 0.0005], "max": [0.021, 1, 0.0076]},
+                   "force": [0, 0, -press]}]
+    d["contact"] = {"self": True}
+    return d
+
+
+def test_self_contact_has_its_count_and_gap_as_in_the_cli(bar_scene, cli, write_json):
+    d = slit_bar(bar_scene, 0.5)
+    py = shapectl.statics(shapectl.Scene.from_dict(d))
+    assert py.converged, py.reason
+    c = py.contacts
+    # No obstacle: nothing in the obstacles' part; the slab pressed shut within d̂.
+    assert (c["count"], c["min_distance"], c["by_obstacle"]) == (0, None, {})
+    np.testing.assert_array_equal(c["force_total"], [0, 0, 0])
+    assert c["self"]["count"] > 0
+    assert 0 < c["self"]["min_distance"] < 0.001
+    run = cli("statics", write_json("scene.json", d))
+    assert run.exit_code == 0, run.stderr
+    assert run.result["contacts"]["self"]["count"] == c["self"]["count"]
+    assert run.result["contacts"]["self"]["min_distance"] == pytest.approx(c["self"]["min_distance"], rel=1e-9)
+    # A solve's best joints: the slit stays shut.
+    targets = {"targets": [{"node": i, "position": py.positions[i]} for i in range(0, 306, 17)]}
+    r = shapectl.solve(shapectl.Scene.from_dict(d), targets, max_iterations=2)
+    assert r.contacts["self"]["count"] > 0
+    # Open: none, no gap.
+    assert shapectl.statics(shapectl.Scene.from_dict(slit_bar(bar_scene, 0))).contacts["self"] == {
+        "count": 0, "min_distance": None}
+
+
+def test_without_self_contact_there_is_no_self_part(bar_scene):
+    d = slit_bar(bar_scene, 0)
+    d["contact"] = {"self": False}
+    assert shapectl.statics(shapectl.Scene.from_dict(d)).contacts is None
 
 
 @pytest.mark.parametrize("contact, field", [

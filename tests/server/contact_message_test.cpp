@@ -71,5 +71,29 @@ TEST(ContactMessage, NoPairWithinTheDistanceHasANullMinimumGap) {
   EXPECT_NO_THROW((void)j.dump());  // no infinity reaches the JSON text
 }
 
+TEST(ContactMessage, SelfContactHasItsCountGapAndPointsClosestFirst) {
+  ContactSummary none;
+  none.min_distance = std::numeric_limits<double>::infinity();
+  SelfContactSummary self;
+  self.count = 3;
+  self.min_distance = 2e-4;
+  self.points = {Vec3(1, 2, 3), Vec3(4, 5, 6), Vec3(7, 8, 9)};
+  self.distances = {6e-4, 2e-4, 4e-4};
+  const nlohmann::json j = contacts_json(none, {}, 2, &self);
+  EXPECT_EQ(j["count"], 0);  // the obstacles' part: none
+  EXPECT_TRUE(j["by_obstacle"].empty());
+  EXPECT_EQ(j["self"]["count"], 3);
+  EXPECT_EQ(j["self"]["min_distance"], 2e-4);
+  EXPECT_EQ(j["self"]["points_total"], 3);
+  EXPECT_EQ(j["self"]["points"], nlohmann::json({{4.0, 5.0, 6.0}, {7.0, 8.0, 9.0}}));
+  // None touching: a null gap, no points; without self-contact no "self" at all.
+  const SelfContactSummary untouched;
+  const nlohmann::json open = contacts_json(none, {}, 2, &untouched);
+  EXPECT_EQ(open["self"]["count"], 0);
+  EXPECT_TRUE(open["self"]["min_distance"].is_null());
+  EXPECT_TRUE(open["self"]["points"].empty());
+  EXPECT_FALSE(contacts_json(none, {}).contains("self"));
+}
+
 }  // namespace
 }  // namespace shapectl::server

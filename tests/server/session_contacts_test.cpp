@@ -60,6 +60,45 @@ TEST(SessionContacts, TheSceneMessageCarriesTheObstaclesAndEachStateTheContacts)
       << sum.transpose() << " vs " << total.transpose();
 }
 
+// yumi_bar.json with the bar slit through its middle (tests/data/slit_bar.py), its upper slab's
+// middle pressed down onto the lower one, and contact.self.
+std::string slit_bar_pressed() {
+  nlohmann::json scene = nlohmann::json::parse(test::bundled_scene_text("yumi_bar.json"));
+  scene["object"]["mesh"] = {{"file", test::source_path("tests/data/slit_bar.node").string()}};
+  scene["loads"] = {{{"box", {{"min", {-0.021, -1, 0.0005}}, {"max", {0.021, 1, 0.0076}}}},
+                     {"force", {0, 0, -0.5}}}};
+  scene["contact"] = {{"self", true}};
+  return scene.dump();
+}
+
+TEST(SessionContacts, SelfContactWithoutObstaclesHasItsOwnPart) {
+  const test::TempDir dir;
+  Session session(dir.write("slit_bar.json", slit_bar_pressed()), {});
+  const auto scene = nlohmann::json::parse(session.scene_message());
+  EXPECT_EQ(scene["obstacles"], nlohmann::json::array());
+  EXPECT_EQ(scene["contact"]["distance"], 0.001);
+  EXPECT_EQ(scene["contact"]["self"], true);
+  test::wait_until(
+      session.controller(), [](const ControllerSnapshot& s) { return s.positions.size() > 0; }, 60);
+  session.tick();
+  const auto contacts = nlohmann::json::parse(session.state_message(1))["contacts"];
+  ASSERT_TRUE(contacts.is_object()) << contacts;
+  EXPECT_EQ(contacts["count"], 0);
+  const auto& self = contacts["self"];
+  const int count = self["count"];
+  EXPECT_GT(count, 0);
+  EXPECT_GT(self["min_distance"].get<double>(), 0);
+  EXPECT_LT(self["min_distance"].get<double>(), 0.001);
+  ASSERT_EQ(self["points"].size(), static_cast<std::size_t>(count));
+  // Each point in the slit, in the bar's middle: the bar is along y at x 0.39047, z 0.25527
+  // (yumi_bar.json), the slit 2 mm high, its upper slab pressed down by ~1.5 mm there.
+  for (const auto& p : self["points"]) {
+    EXPECT_NEAR(p[0].get<double>(), 0.39047, 0.016) << p;
+    EXPECT_LT(std::abs(p[1].get<double>()), 0.12) << p;
+    EXPECT_NEAR(p[2].get<double>(), 0.25527, 0.01) << p;
+  }
+}
+
 TEST(SessionContacts, WithoutObstaclesThereAreNoContacts) {
   Session session(test::source_path("scenes/yumi_bar.json"), {});
   const auto scene = nlohmann::json::parse(session.scene_message());

@@ -5,10 +5,7 @@
 // and gone once the Contacts box is unticked). Then the bundled scenes/yumi_cable_table.json.
 import { describe, it, before, after } from 'node:test';
 import assert from 'node:assert/strict';
-import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import path from 'node:path';
-import { openSession, closeSession, waitFor, sourceDir, colourNear, RawWebSocket } from './support.mjs';
+import { openBarSession, waitFor, colourNear, RawWebSocket } from './support.mjs';
 import { Command, Message } from '../../web/js/protocol.js';
 
 const hooks = (page, f, arg) => page.evaluate(f, arg);
@@ -32,29 +29,13 @@ const OBSTACLES = [
 ];
 const CUFF_IN_LINK = [0.08, 0.08, 0.01];
 
-function writeScene(dir) {
-  const scene = JSON.parse(readFileSync(path.join(sourceDir, 'scenes/yumi_bar.json'), 'utf8'));
-  for (const key of ['urdf', 'collision_spheres']) scene.robot[key] = path.join(sourceDir, 'scenes', scene.robot[key]);
-  scene.obstacles = OBSTACLES;
-  const file = path.join(dir, 'bar_on_peg.json');
-  writeFileSync(file, JSON.stringify(scene));
-  return file;
-}
-
 describe('obstacles and contacts', () => {
-  let dir, session, page;
+  let bar, session, page;
   before(async () => {
-    dir = mkdtempSync(path.join(tmpdir(), 'shapectl-contacts-'));
-    session = await openSession([writeScene(dir)]);
-    page = session.page;
+    bar = await openBarSession('bar_on_peg.json', (scene) => { scene.obstacles = OBSTACLES; });
+    ({ session, page } = bar);
   });
-  after(async () => {
-    try {
-      await closeSession(session);  // fails on any console problem of the run
-    } finally {
-      rmSync(dir, { recursive: true, force: true });
-    }
-  });
+  after(() => bar?.close());
 
   it('draws every obstacle where the scene puts it', async () => {
     const { scene, drawn, centroid } = await hooks(page, () => ({

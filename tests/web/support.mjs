@@ -1,7 +1,7 @@
 // Shared by the browser and fuzz tests: start `shapectl serve` on a free port, launch Debian's
 // Chromium headless through playwright-core, and a minimal raw WebSocket client.
 import { spawn } from 'node:child_process';
-import { mkdtempSync, rmSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import path from 'node:path';
 import net from 'node:net';
@@ -293,6 +293,26 @@ export async function openSession(args = [], { socket = false } = {}) {
 export async function closeSession(session) {
   session?.ws?.close();
   await closeAll(session?.browser, session?.server);
+}
+
+// A session on scenes/yumi_bar.json changed by edit(scene) (its robot files found from a copy in
+// a temporary directory, which close() removes): {session, page, close}.
+export async function openBarSession(name, edit) {
+  const dir = mkdtempSync(path.join(tmpdir(), 'shapectl-bar-'));
+  const scene = JSON.parse(readFileSync(path.join(sourceDir, 'scenes/yumi_bar.json'), 'utf8'));
+  for (const key of ['urdf', 'collision_spheres']) scene.robot[key] = path.join(sourceDir, 'scenes', scene.robot[key]);
+  edit(scene);
+  const file = path.join(dir, name);
+  writeFileSync(file, JSON.stringify(scene));
+  const session = await openSession([file]);
+  const close = async () => {
+    try {
+      await closeSession(session);  // fails on any console problem of the run
+    } finally {
+      rmSync(dir, { recursive: true, force: true });
+    }
+  };
+  return { session, page: session.page, close };
 }
 
 // Page coordinates of the node nearest the object's centroid (a bent object's centroid may lie

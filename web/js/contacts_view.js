@@ -3,9 +3,12 @@
 // along the force, drawn over everything (the points lie between the object and the obstacle).
 // Arrow lengths are to one scale per state, a round number of newtons per centimetre chosen so
 // the largest force is at most MAX_ARROW_CM long; the page shows it ("1 cm = 0.05 N").
+// The object's contacts with itself ("contacts.self") as dots of their own colour, no arrows: a
+// pair pushes its two sides apart with equal and opposite forces.
 import * as THREE from 'three';
 
 const COLOR = 0xffe14d;        // yellow: apart from targets (orange), grips (red), observations
+const SELF_COLOR = 0x5cff6e;   // green: self-contact, apart from the obstacles' yellow
 const POINT_PIXELS = 5;
 const MAX_ARROW_CM = 3;        // the largest force's arrow, at most
 const HEAD_FRACTION = 0.25;    // head length / arrow length
@@ -39,8 +42,11 @@ export class ContactsView {
     this.shafts = new THREE.LineSegments(this.shaftGeometry, new THREE.LineBasicMaterial(overlay));
     this.heads = null;  // InstancedMesh, regrown with the capacity
     this.headMaterial = new THREE.MeshBasicMaterial(overlay);
-    for (const o of [this.points, this.shafts]) { o.frustumCulled = false; o.renderOrder = RENDER_ORDER; }
-    this.group.add(this.points, this.shafts);
+    this.selfGeometry = new THREE.BufferGeometry();
+    this.selfPoints = new THREE.Points(this.selfGeometry, new THREE.PointsMaterial({ ...overlay, color: SELF_COLOR, size: POINT_PIXELS, sizeAttenuation: false }));
+    this.selfCount = 0;
+    for (const o of [this.points, this.shafts, this.selfPoints]) { o.frustumCulled = false; o.renderOrder = RENDER_ORDER; }
+    this.group.add(this.points, this.shafts, this.selfPoints);
     this.grow(64);
     this.set(null);
   }
@@ -56,8 +62,9 @@ export class ContactsView {
     this.group.add(this.heads);
   }
 
-  // A state's "contacts" (undefined or null: the scene has no obstacles).
+  // A state's "contacts" (undefined or null: the scene has no obstacles and no self-contact).
   set(contacts) {
+    this.setSelf(contacts?.self?.points ?? []);
     const list = contacts?.points ?? [];
     if (list.length > this.capacity) this.grow(Math.max(list.length, 2 * this.capacity));
     let largest = 0;
@@ -90,12 +97,18 @@ export class ContactsView {
     this.heads.count = arrows;
     this.count = list.length;
     this.arrowCount = arrows;
-    this.group.visible = this.enabled && list.length > 0;
+    this.group.visible = this.enabled && this.count + this.selfCount > 0;
+  }
+
+  // The self-contact points, [[x, y, z], ...].
+  setSelf(list) {
+    this.selfGeometry.setAttribute('position', new THREE.BufferAttribute(new Float32Array(list.flat()), 3));
+    this.selfCount = list.length;
   }
 
   setEnabled(on) {
     this.enabled = on;
-    this.group.visible = on && this.count > 0;
+    this.group.visible = on && this.count + this.selfCount > 0;
   }
 
   get scaleLabel() { return this.newtonsPerCm === null ? '' : `1 cm = ${forceLabel(this.newtonsPerCm)}`; }
@@ -108,6 +121,9 @@ export class ContactsView {
       this.heads.getMatrixAt(k, m);
       arrows.push([[shaft.getX(2 * k), shaft.getY(2 * k), shaft.getZ(2 * k)], tip.setFromMatrixPosition(m).toArray()]);
     }
-    return { visible: this.group.visible && !!this.group.parent?.visible, points: this.count, arrows, newtonsPerCm: this.newtonsPerCm, scale: this.scaleLabel };
+    const at = this.selfGeometry.getAttribute('position');
+    const selfPoints = [];
+    for (let k = 0; k < this.selfCount; k++) selfPoints.push([at.getX(k), at.getY(k), at.getZ(k)]);
+    return { visible: this.group.visible && !!this.group.parent?.visible, points: this.count, arrows, newtonsPerCm: this.newtonsPerCm, scale: this.scaleLabel, selfPoints };
   }
 }

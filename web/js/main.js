@@ -100,7 +100,7 @@ function onScene(scene) {
   $('face-bar').disabled = !scene.bar;
   $('sketch').title = scene.bar ? 'Sketch a centre-line with the mouse (C)' : 'Only for bar-like objects';
   $('link-section').hidden = !scene.link;
-  $('contacts-toggle').hidden = !scene.obstacles?.length;
+  $('contacts-toggle').hidden = !scene.obstacles?.length && !scene.contact?.self;
   $('contact-scale').textContent = '';
   jointPanel.setRobot(scene.robot);
   showRobotWarnings(scene.warnings ?? []);
@@ -149,7 +149,7 @@ function onState(state) {
   const parts = [count(state.targets.length, 'target', 'targets'), count(state.iterations, 'iteration', 'iterations'),
     count(state.clients, 'page', 'pages')];
   if (state.min_clearance !== null) parts.push(`clearance ${(1000 * state.min_clearance).toFixed(0)} mm`);
-  if (state.contacts) parts.push(contactSummary(state.contacts));
+  if (state.contacts) parts.push(...contactSummary(state.contacts));
   if (!state.safe) parts.push('UNSAFE');
   $('status-detail').textContent = parts.map(whole).join(' · ') + (state.last_error ? ` · ${state.last_error}` : '');
   $('pause').textContent = state.paused ? 'Resume' : 'Pause';
@@ -174,12 +174,17 @@ function onState(state) {
 
 const observationRate = new ObservationRate();
 
-// The status line's contacts: how many pairs touch, the smallest gap and the obstacles' total
-// force on the object.
+// The status line's contacts: with obstacles how many pairs touch, the smallest gap and the
+// obstacles' total force on the object; with self-contact how many of its pairs touch and their
+// smallest gap.
 function contactSummary(c) {
-  if (!c.count) return 'no contact';
-  const f = Math.hypot(...c.force_total);
-  return `${c.count} contacts, gap ${mm(c.min_distance)} mm, ${f.toPrecision(3)} N`;
+  const parts = [];
+  if (Object.keys(c.by_obstacle).length) {
+    const f = Math.hypot(...c.force_total);
+    parts.push(c.count ? `${c.count} contacts, gap ${mm(c.min_distance)} mm, ${f.toPrecision(3)} N` : 'no contact');
+  }
+  if (c.self) parts.push(c.self.count ? `${c.self.count} self-contacts, gap ${mm(c.self.min_distance)} mm` : 'no self-contact');
+  return parts;
 }
 
 // The Real object panel's line: observations, the errors, what the gate refused and why the

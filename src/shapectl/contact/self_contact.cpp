@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <mutex>
 #include <stdexcept>
 
 #include <shapectl/contact/barrier.hpp>
@@ -11,6 +12,7 @@
 #include <shapectl/contact/point_triangle_distance.hpp>
 #include <shapectl/contact/segment_segment_distance.hpp>
 #include <shapectl/contact/segment_triangle_distance.hpp>
+#include <shapectl/contact/separation.hpp>
 #include <shapectl/contact/triangle_edges.hpp>
 
 namespace shapectl {
@@ -32,6 +34,10 @@ struct Pair {
 };
 
 Vec3 node(const Positions& x, int i) { return x.segment<3>(3 * i); }
+
+// Whether a pair whose distance is at least `bound` (separation.hpp) is surely farther apart than
+// `reach`: with room for the bound's round-off (~1e-16 of the coordinates, in metres).
+bool surely_beyond(double bound, double reach) { return bound > reach * (1 + 1e-9) + 1e-12; }
 
 Aabb box_of(std::initializer_list<Vec3> points) {
   Aabb box;
@@ -65,11 +71,22 @@ struct SelfContact::Impl {
     return {node(x, n[0]), node(x, n[1]), node(x, n[2]), node(x, n[3])};
   }
 
-  // Calls visit(pair) for every pair sharing no node, not left out, whose boxes come within
-  // `reach`: at x, or swept from x to x + dx if dx is given.
+  // A lower bound on the pair's distance at x, far cheaper than distance().
+  double separation(const Pair& p, const Positions& x) const {
+    const std::array<Vec3, 4> at = positions(p, x);
+    return p.edge_edge ? segment_segment_separation(at[0], at[1], at[2], at[3])
+                       : point_triangle_separation(at[0], at[1], at[2], at[3]);
+  }
+
+  bool kept(const Pair& p) const {
+    return !std::binary_search(left_out.begin(), left_out.end(), p.key());
+  }
+
+  // Calls visit(pair) for every pair sharing no node whose boxes come within `reach`: at x, or
+  // swept from x to x + dx if dx is given. Two BVHs built at x: the dear part.
   template <class Visit>
-  void for_each_candidate(const Positions& x, const Eigen::VectorXd* dx, double reach,
-                          Visit&& visit) const {
+  void for_each_box_pair(const Positions& x, const Eigen::VectorXd* dx, double reach,
+                         Visit&& visit) const {
     const auto box = [&](std::initializer_list<int> ids) {
       Aabb b;
       for (int i : ids) {
@@ -82,34 +99,134 @@ struct SelfContact::Impl {
     for (const auto& t : triangles) triangle_boxes.push_back(box({t[0], t[1], t[2]}));
     for (const auto& e : edges) edge_boxes.push_back(box({e[0], e[1]}));
     const Bvh triangle_bvh(triangle_boxes), edge_bvh(edge_boxes);
-    const auto kept = [&](const Pair& p) {
-      return !std::binary_search(left_out.begin(), left_out.end(), p.key());
-    };
     for (int v : vertices)
       triangle_bvh.query(box({v}).inflated(reach), [&](int t) {
         const auto& tri = triangles[t];
         if (tri[0] == v || tri[1] == v || tri[2] == v) return;
-        const Pair p{false, v, t};
-        if (kept(p)) visit(p);
+        visit(Pair{false, v, t});
       });
     for (int e = 0; e < static_cast<int>(edges.size()); ++e)
       edge_bvh.query(edge_boxes[e].inflated(reach), [&](int f) {
         if (f <= e) return;
         const auto &a = edges[e], &b = edges[f];
         if (a[0] == b[0] || a[0] == b[1] || a[1] == b[0] || a[1] == b[1]) return;
-        const Pair p{true, e, f};
-        if (kept(p)) visit(p);
+        visit(Pair{true, e, f});
       });
   }
 
-  // The pairs closer than d̂ at x, in key order.
-  std::vector<Pair> active(const Positions& x, double dhat) const {
+  // The pairs (sharing no node, not left out) that may be within `reach` of each other at x,
+  // sorted: those whose cheap lower bound is within reach.
+  std::vector<Pair> near(const Positions& x, double reach) const {
     std::vector<Pair> pairs;
-    for_each_candidate(x, nullptr, dhat, [&](const Pair& p) {
-      if (distance(p, positions(p, x)) < dhat) pairs.push_back(p);
+    for_each_box_pair(x, nullptr, reach, [&](const Pair& p) {
+      if (kept(p) && !surely_beyond(separation(p, x), reach)) pairs.push_back(p);
     });
     std::sort(pairs.begin(), pairs.end(),
               [](const Pair& a, const Pair& b) { return a.key() < b.key(); });
+    return pairs;
+  }
+
+  // The near pairs at `reference` for a reach of d̂ + 2 margin: while no surface node is farther
+  // than `margin` from there, no pair's distance has fallen by more than 2 margin, so every pair
+  // within d̂ is among them. Found once for the many calls of a Newton solve at nearby states.
+  struct NearCache {
+    Positions reference;
+    double margin = 0;
+    std::vector<Pair> pairs;
+  };
+  double dhat = 0;
+  double margin = 0;  // NearCache's
+  // The last few found: solves on several threads (at other joints) each keep theirs.
+  static constexpr std::size_t kCaches = 4;
+  mutable std::mutex cache_mutex;
+  mutable std::array<std::shared_ptr<const NearCache>, kCaches> caches;
+  mutable std::size_t next_cache = 0;  // the one replaced next
+
+  // Whether no surface vertex of x is farther than `limit` from where it is in `reference`; the
+  // farthest in `largest`.
+  bool within(const Positions& x, const Positions& reference, double limit,
+              double* largest = nullptr) const {
+    if (x.size() != reference.size()) return false;
+    double l = 0;
+    for (int v : vertices) {
+      l = std::max(l, (node(x, v) - node(reference, v)).norm());
+      if (!(l <= limit)) return false;  // NaN too
+    }
+    if (largest) *largest = l;
+    return true;
+  }
+
+  // A near cache valid at x (x within its margin of its reference), found anew if none is.
+  std::shared_ptr<const NearCache> near_cache(const Positions& x, double* move) const {
+    std::array<std::shared_ptr<const NearCache>, kCaches> known;
+    {
+      const std::lock_guard<std::mutex> lock(cache_mutex);
+      known = caches;
+    }
+    for (const auto& c : known)
+      if (c && within(x, c->reference, c->margin, move)) return c;
+    // Found outside the lock: another thread may do the same meanwhile, to the same effect.
+    auto fresh = std::make_shared<NearCache>(NearCache{x, margin, near(x, dhat + 2 * margin)});
+    *move = 0;
+    const std::lock_guard<std::mutex> lock(cache_mutex);
+    caches[next_cache] = fresh;
+    next_cache = (next_cache + 1) % kCaches;
+    return fresh;
+  }
+
+  // Calls visit(pair), in key order, for every pair sharing no node, not left out, that may be
+  // within d̂ at x: a superset of those within d̂ (others are farther than d̂ and add nothing).
+  template <class Visit>
+  void for_each_candidate(const Positions& x, Visit&& visit) const {
+    double move = 0;
+    const std::shared_ptr<const NearCache> c = near_cache(x, &move);
+    for (const Pair& p : c->pairs)
+      if (!surely_beyond(separation(p, x), dhat)) visit(p);
+  }
+
+  // Calls visit(pair) for every pair sharing no node, not left out, whose boxes swept from x to
+  // x + dx come within d̂ (the pairs whose CCD may bound the step). A short step tries only the
+  // near pairs: any other is farther apart than d̂ + 2 (margin − move) at x (move: x's from the
+  // near pairs' reference), its gap falls by at most l ≤ twice the longest node step, so while
+  // that is at most 0.8 of it, its CCD's first advance (0.9 d0 / l) passes the whole step: it
+  // bounds nothing. A longer step: BVHs over the swept boxes.
+  template <class Visit>
+  void for_each_swept_candidate(const Positions& x, const Eigen::VectorXd& dx,
+                                Visit&& visit) const {
+    double move = 0;
+    const std::shared_ptr<const NearCache> c = near_cache(x, &move);
+    double longest = 0;
+    for (int v : vertices) longest = std::max(longest, dx.segment<3>(3 * v).norm());
+    if (!(2 * longest <= 0.8 * (dhat + 2 * (c->margin - move)))) {
+      for_each_box_pair(x, &dx, dhat, [&](const Pair& p) {
+        if (kept(p)) visit(p);
+      });
+      return;
+    }
+    // The boxes and their test as for_each_box_pair's.
+    const auto box = [&](std::initializer_list<int> ids) {
+      Aabb b;
+      for (int i : ids) {
+        b.extend(node(x, i));
+        b.extend(Vec3(node(x, i) + dx.segment<3>(3 * i)));
+      }
+      return b;
+    };
+    for (const Pair& p : c->pairs) {
+      const std::array<int, 4> n = nodes(p);
+      const bool overlap = p.edge_edge
+                               ? box({n[0], n[1]}).inflated(dhat).overlaps(box({n[2], n[3]}))
+                               : box({n[0]}).inflated(dhat).overlaps(box({n[1], n[2], n[3]}));
+      if (overlap) visit(p);
+    }
+  }
+
+  // The pairs closer than d̂ at x, in key order.
+  std::vector<Pair> active(const Positions& x) const {
+    std::vector<Pair> pairs;
+    for_each_candidate(x, [&](const Pair& p) {
+      if (distance(p, positions(p, x)) < dhat) pairs.push_back(p);
+    });
     return pairs;
   }
 };
@@ -121,8 +238,25 @@ SelfContact::SelfContact(const TetMesh& mesh, double distance, double stiffness)
   m->triangles = mesh.surface_triangles();
   m->edges = triangle_edges(m->triangles);
   m->vertices = triangle_corners(m->triangles);
-  // Neighbours at rest: left out for good (with none left out yet, active() lists them).
-  for (const Pair& p : m->active(mesh.rest_vector(), distance)) m->left_out.push_back(p.key());
+  const Positions rest = mesh.rest_vector();
+  // A quarter of the shortest surface edge: at rest, pairs of a flat stretch of surface are
+  // farther apart than d̂ + 2 margin (their distance is about an edge length), so the near
+  // pairs are few while nothing touches, and the statics' steps seldom move a node that far.
+  double shortest = kInf;
+  for (const auto& e : m->edges)
+    shortest = std::min(shortest, (node(rest, e[0]) - node(rest, e[1])).norm());
+  m->dhat = distance;
+  m->margin = std::isfinite(shortest) ? 0.25 * shortest : 0.0;
+  // Neighbours at rest (within d̂ there) are left out for good; the other near pairs at rest
+  // serve the first states, usually the rest shape or close to it.
+  std::vector<Pair> near = m->near(rest, distance + 2 * m->margin);
+  for (const Pair& p : near)
+    if (Impl::distance(p, m->positions(p, rest)) < distance) m->left_out.push_back(p.key());
+  near.erase(std::remove_if(near.begin(), near.end(), [&](const Pair& p) { return !m->kept(p); }),
+             near.end());
+  m->caches[0] =
+      std::make_shared<Impl::NearCache>(Impl::NearCache{rest, m->margin, std::move(near)});
+  m->next_cache = 1;
   impl_ = std::move(m);
 }
 
@@ -130,7 +264,7 @@ double SelfContact::value(const Positions& x) const {
   const Impl& m = *impl_;
   double sum = 0;
   bool intersecting = false;
-  m.for_each_candidate(x, nullptr, distance_, [&](const Pair& p) {
+  m.for_each_candidate(x, [&](const Pair& p) {
     const double d = Impl::distance(p, m.positions(p, x));
     if (!(d > 0)) intersecting = true;
     else if (d < distance_) sum += barrier(d, distance_).value;
@@ -140,7 +274,7 @@ double SelfContact::value(const Positions& x) const {
 
 void SelfContact::add_gradient(const Positions& x, Eigen::VectorXd& gradient) const {
   const Impl& m = *impl_;
-  m.for_each_candidate(x, nullptr, distance_, [&](const Pair& p) {
+  m.for_each_candidate(x, [&](const Pair& p) {
     VecN<N> g;
     const double d = Impl::distance(p, m.positions(p, x), &g);
     if (!(d < distance_)) return;
@@ -152,7 +286,7 @@ void SelfContact::add_gradient(const Positions& x, Eigen::VectorXd& gradient) co
 }
 
 void SelfContact::hessian_elements(const Positions& x, ElementNodes& elements) const {
-  for (const Pair& p : impl_->active(x, distance_)) {
+  for (const Pair& p : impl_->active(x)) {
     const std::array<int, 4> n = impl_->nodes(p);
     elements.add({n[0], n[1], n[2], n[3]});
   }
@@ -161,7 +295,7 @@ void SelfContact::hessian_elements(const Positions& x, ElementNodes& elements) c
 void SelfContact::add_hessian(const Positions& x, ElementHessianSink& sink,
                               bool project_psd) const {
   const Impl& m = *impl_;
-  const std::vector<Pair> pairs = m.active(x, distance_);  // hessian_elements(x)'s, in its order
+  const std::vector<Pair> pairs = m.active(x);  // hessian_elements(x)'s, in its order
   sink.add_blocks([&](std::size_t e, double* block) {
     VecN<N> g;
     MatN<N> h;
@@ -184,12 +318,8 @@ void SelfContact::add_hessian(const Positions& x, ElementHessianSink& sink,
 double SelfContact::max_step(const Positions& x, const Eigen::VectorXd& dx) const {
   const Impl& m = *impl_;
   double alpha = 1;
-  m.for_each_candidate(x, &dx, distance_, [&](const Pair& p) {
+  m.for_each_swept_candidate(x, dx, [&](const Pair& p) {
     const std::array<int, 4> nodes = m.nodes(p);
-    std::array<Vec3, 4> at = m.positions(p, x);
-    const double d0 = Impl::distance(p, at);
-    if (!(d0 > 0)) return;  // already intersecting: no step keeps it out
-    const double target = 0.1 * d0;
     // Additive CCD (Li et al. 2021): the gap changes no faster than the largest displacement
     // of one primitive's nodes plus the other's, l, so from t with gap d it stays ≥ target up
     // to t + (d − target)/l.
@@ -201,6 +331,13 @@ double SelfContact::max_step(const Positions& x, const Eigen::VectorXd& dx) cons
     }
     const double l = la + lb;
     if (!(l > 0)) return;
+    // Its first advance, 0.9 d0 / l, would pass the whole step: nothing to bound (the cheap
+    // lower bound on d0 says so for most candidates without their exact distance).
+    if (surely_beyond(0.9 * m.separation(p, x), l)) return;
+    std::array<Vec3, 4> at = m.positions(p, x);
+    const double d0 = Impl::distance(p, at);
+    if (!(d0 > 0)) return;  // already intersecting: no step keeps it out
+    const double target = 0.1 * d0;
     double t = 0, d = d0;
     for (int iteration = 0; iteration < 100; ++iteration) {
       t += (d - target) / l;
@@ -217,9 +354,34 @@ double SelfContact::max_step(const Positions& x, const Eigen::VectorXd& dx) cons
 
 double SelfContact::min_distance(const Positions& x) const {
   double smallest = kInf;
-  for (const Pair& p : impl_->active(x, distance_))
+  for (const Pair& p : impl_->active(x))
     smallest = std::min(smallest, Impl::distance(p, impl_->positions(p, x)));
   return smallest;
+}
+
+SelfContactSummary SelfContact::summary(const Positions& x) const {
+  const Impl& m = *impl_;
+  SelfContactSummary out;
+  for (const Pair& p : m.active(x)) {
+    VecN<N> g;
+    const std::array<Vec3, 4> at = m.positions(p, x);
+    const double d = Impl::distance(p, at, &g);
+    // ∂d/∂x of the first primitive's nodes are their closest-point weights times the unit
+    // normal n from the second towards it (envelope theorem): its closest point is Σ w x, the
+    // other's that less d n.
+    const int first = p.edge_edge ? 2 : 1;
+    Vec3 n = Vec3::Zero();
+    for (int k = 0; k < first; ++k) n += g.segment<3>(3 * k);
+    Vec3 closest = Vec3::Zero();
+    for (int k = 0; k < first; ++k) closest += g.segment<3>(3 * k).dot(n) * at[k];
+    // Touching (d = 0: no normal): the first primitive's first node.
+    const bool normal = d > 0 && n.allFinite() && closest.allFinite();
+    out.points.push_back(normal ? Vec3(closest - 0.5 * d * n) : at[0]);
+    out.distances.push_back(d);
+    out.min_distance = std::min(out.min_distance, d);
+  }
+  out.count = static_cast<int>(out.points.size());
+  return out;
 }
 
 std::array<int, 2> SelfContact::first_intersection(const Positions& x) const {
@@ -239,6 +401,7 @@ std::array<int, 2> SelfContact::first_intersection(const Positions& x) const {
       // Two triangles meet where an edge of one meets the other.
       const std::array<Vec3, 3> a{node(x, A[0]), node(x, A[1]), node(x, A[2])},
           b{node(x, B[0]), node(x, B[1]), node(x, B[2])};
+      if (surely_beyond(triangle_triangle_separation(a, b), 0)) return;
       for (int k = 0; k < 3 && found < 0; ++k)
         if (segment_triangle_distance(a[k], a[(k + 1) % 3], b[0], b[1], b[2]) <= 0 ||
             segment_triangle_distance(b[k], b[(k + 1) % 3], a[0], a[1], a[2]) <= 0)

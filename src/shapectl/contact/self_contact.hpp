@@ -20,9 +20,15 @@
 // 1/sin of the edges' angle (exact, but badly conditioned); parallel ones (to rounding) take an
 // end (point–line), where the energy is C⁰ in the angle only.
 //
+// Finding the pairs: a BVH finds the "near" pairs at a reference state (within d̂ + 2 margin by
+// a cheap separating-axis bound, separation.hpp); every call at a state whose surface vertices
+// are all within the margin of it reuses them (the last few kept, thread-safe), as does max_step
+// for a short step. Same pairs, same order as a BVH at every call (docs/contact.md).
+//
 // It does not depend on θ: nothing in ∂F/∂θ.
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -30,6 +36,15 @@
 #include <shapectl/mesh/tet_mesh.hpp>
 
 namespace shapectl {
+
+// The pairs within d̂ at x, for results and the GUI. No force: a pair pushes its two sides
+// apart with equal and opposite forces, so the object's self-contact forces sum to zero.
+struct SelfContactSummary {
+  int count = 0;                                                  // pairs with d < d̂
+  double min_distance = std::numeric_limits<double>::infinity();  // smallest d over them
+  std::vector<Vec3> points;       // each pair's meeting point: midway between its closest points, m
+  std::vector<double> distances;  // each pair's d, in the order of points
+};
 
 class SelfContact : public EnergyTerm {
  public:
@@ -49,6 +64,7 @@ class SelfContact : public EnergyTerm {
 
   // The smallest gap over the pairs within d̂ at x; +inf if none is.
   double min_distance(const Positions& x) const;
+  SelfContactSummary summary(const Positions& x) const;
   // Two surface triangles (indices into the mesh's surface_triangles()) sharing no node that
   // intersect or touch at x; {-1, -1} if none. Every such pair, neighbours at rest included.
   std::array<int, 2> first_intersection(const Positions& x) const;

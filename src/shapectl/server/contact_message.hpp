@@ -8,6 +8,7 @@
 
 #include <shapectl/contact/obstacle.hpp>
 #include <shapectl/contact/obstacle_contact.hpp>
+#include <shapectl/contact/self_contact.hpp>
 #include <shapectl/robot/robot_model.hpp>
 
 namespace shapectl::server {
@@ -23,8 +24,11 @@ nlohmann::json obstacles_json(const std::vector<Obstacle>& obstacles,
 
 // {count, min_distance (null without a pair within d̂), force_total, by_obstacle: {name:
 // {count, force}}, points: [[px, py, pz, fx, fy, fz], ...] (at most `max_points`, the closest
-// first), points_total}. `obstacles` names the summary's obstacle indices.
+// first), points_total}, and with `self` (self-contact) "self": {count, min_distance, points:
+// [[px, py, pz], ...] (each pair's meeting point, the closest first, at most `max_points`),
+// points_total}. `obstacles` names the summary's obstacle indices.
 nlohmann::json contacts_json(const ContactSummary& summary, const std::vector<Obstacle>& obstacles,
-                             std::size_t max_points = max_contact_points);
+                             std::size_t max_points = max_contact_points,
+                             const SelfContactSummary* self = nullptr);
 
 }  // namespace shapectl::server

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
+#include <optional>
 
 #include <shapectl/control/centerline.hpp>
 #include <shapectl/control/targets_file.hpp>
@@ -373,7 +375,7 @@ void Session::load(const SceneEntry& entry) {
   // Only an armed link has something to say about it (at start-up it is disarmed already).
   if (link_ && link_->status().armed) link_->disarm("scene changed to " + entry.name);
   robot_meshes_ = find_visual_meshes(*scene.robot->model, package_paths_);
-  statics_ = scene.obstacles.empty() && !scene.contact.robot
+  statics_ = scene.obstacles.empty() && !scene.contact.robot && !scene.contact.self
                  ? nullptr
                  : std::make_unique<ObjectStatics>(scene);
   contacts_ = nullptr;
@@ -556,18 +558,31 @@ void Session::tick() {
 
 void Session::update_contacts() {
   const ObstacleContact* contact = statics_ ? statics_->contact() : nullptr;
-  if (!contact || (!contacts_.is_null() && snapshot_->sequence == contacts_sequence_)) return;
+  const SelfContact* self = statics_ ? statics_->self_contact() : nullptr;
+  if ((!contact && !self) || (!contacts_.is_null() && snapshot_->sequence == contacts_sequence_))
+    return;
   if (snapshot_->positions.size() != 3 * controller_->mesh().node_count()) return;  // none yet
   contacts_sequence_ = snapshot_->sequence;
+  std::optional<SelfContactSummary> self_summary;
+  if (self) self_summary = self->summary(snapshot_->positions);
+  const SelfContactSummary* self_part = self_summary ? &*self_summary : nullptr;
+  if (!contact) {
+    ContactSummary none;
+    none.min_distance = std::numeric_limits<double>::infinity();
+    contacts_ = contacts_json(none, {}, max_contact_points, self_part);
+    return;
+  }
   if (contact->moves() &&
       snapshot_->joints.size() == controller_->scene().robot->reference_joints.size()) {
     // Obstacles on links where the snapshot's joints put them.
     const ObstacleContact posed = contact->posed(
         forward_kinematics(*controller_->scene().robot->model, snapshot_->joints).T_world_link);
-    contacts_ = contacts_json(posed.summary(snapshot_->positions), posed.obstacles());
+    contacts_ = contacts_json(posed.summary(snapshot_->positions), posed.obstacles(),
+                              max_contact_points, self_part);
     return;
   }
-  contacts_ = contacts_json(contact->summary(snapshot_->positions), contact->obstacles());
+  contacts_ = contacts_json(contact->summary(snapshot_->positions), contact->obstacles(),
+                            max_contact_points, self_part);
 }
 
 void Session::set_world(std::unique_ptr<SimulatedWorld> world) {
@@ -610,7 +625,14 @@ nlohmann::json Session::describe_scene() const {
            {"thickness", axis->thickness}};
   nlohmann::json scenes = nlohmann::json::array();
   for (const auto& s : scenes_) scenes.push_back(s.name);
+  // d̂ and κ of the obstacles' contact or else the self-contact's: the same.
   const ObstacleContact* contact = statics_ ? statics_->contact() : nullptr;
+  const SelfContact* self = statics_ ? statics_->self_contact() : nullptr;
+  nlohmann::json contact_json = nullptr;
+  if (contact || self)
+    contact_json = {{"distance", contact ? contact->distance() : self->distance()},
+                    {"stiffness", contact ? contact->stiffness() : self->stiffness()},
+                    {"self", self != nullptr}};
   return {{"type", "scene"},
           {"protocol", protocol_version},
           {"scene", scene_name_},
@@ -624,9 +646,7 @@ nlohmann::json Session::describe_scene() const {
           {"warnings", mesh_warnings(scene, robot_meshes_)},
           {"obstacles",
            obstacles_json(scene.obstacles, scene.robot ? scene.robot->model.get() : nullptr)},
-          {"contact", contact ? nlohmann::json{{"distance", contact->distance()},
-                                               {"stiffness", contact->stiffness()}}
-                              : nlohmann::json(nullptr)},
+          {"contact", contact_json},
           {"link", link_ != nullptr},
           {"limits",
            {{"max_message_bytes", max_message_bytes},
@@ -696,7 +716,7 @@ std::string Session::state_message(int clients) const {
       {"link", link_ ? link_status_json(link_->status()) : nlohmann::json(nullptr)},
       {"measured_links",
        link_ ? measured_links_json(controller_->scene(), link_->status()) : nlohmann::json()}};
-  if (!contacts_.is_null()) m["contacts"] = contacts_;  // only with obstacles
+  if (!contacts_.is_null()) m["contacts"] = contacts_;  // only with obstacles or self-contact
   return m.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 

@@ -126,9 +126,9 @@ class Session {
   nlohmann::json scene_description_;  // the static part of scene_message()
   std::vector<std::filesystem::path> package_paths_;
   std::vector<VisualMesh> robot_meshes_;  // of the current scene's robot, found or not
-  // The scene object's energy, for its contact term (null without obstacles): the same obstacles,
-  // d̂ and κ as the controller's statics. The states' "contacts", of the snapshot
-  // contacts_sequence_.
+  // The scene object's energy, for its contact terms (null without obstacles and self-contact):
+  // the same obstacles, d̂ and κ as the controller's statics. The states' "contacts", of the
+  // snapshot contacts_sequence_.
   std::unique_ptr<ObjectStatics> statics_;
   nlohmann::json contacts_;
   std::uint64_t contacts_sequence_ = 0;
