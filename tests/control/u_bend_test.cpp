@@ -126,9 +126,8 @@ TEST(UBend, TheYumiBendsTheBarIntoAUUntilItsEndsTouch) {
   ASSERT_EQ(ends.nodes[1].size(), 9u);
   ASSERT_GE(ends.centre[0], 0);
   ASSERT_GE(ends.centre[1], 0);
-  const Vec3 tip0 = rest.segment<3>(3 * ends.centre[0]);
   const double span = (ends.grip[0] - ends.grip[1]).norm();
-  const double arm = (tip0 - ends.grip[0]).norm();
+  const double arm = (rest.segment<3>(3 * ends.centre[0]) - ends.grip[0]).norm();
   const double meet = meeting_angle(span, arm);
   // 10° steps (20° ones work too, in more iterations; the last stage given at once stops
   // after 9 iterations with the ends still 290 mm apart).
@@ -152,7 +151,9 @@ TEST(UBend, TheYumiBendsTheBarIntoAUUntilItsEndsTouch) {
   self.hessian_elements(x, pairs);
   const double gap = self.min_distance(x);
   // The robot's spheres as obstacles, placed at the joints reached.
-  const ContactSummary robot = object.contact_at(with.state.state->kinematics())->summary(x);
+  const std::optional<ObstacleContact> posed = object.contact_at(with.state.state->kinematics());
+  ASSERT_TRUE(posed.has_value());
+  const ContactSummary robot = posed->summary(x);
   std::cout << "  end faces' centres " << ends_apart(ends, rest) * 1e3 << " mm apart at rest, "
             << ends_apart(ends, before.state.positions()) * 1e3 << " mm before the last stage "
             << "(smallest self gap " << gap_before * 1e3 << " mm), " << ends_apart(ends, x) * 1e3
