@@ -68,8 +68,8 @@ std::string joined(const std::vector<std::string>& lines) {
 }
 
 TEST(SceneChecks, BundledScenesLoadWithoutWarningsAndTheirGripsSitAtTheTools) {
-  for (const char* name :
-       {"foam_bar_clamped.json", "foam_bar_tip_weight.json", "yumi_bar.json", "yumi_frame.json"}) {
+  for (const char* name : {"foam_bar_clamped.json", "foam_bar_tip_weight.json", "yumi_bar.json",
+                           "yumi_frame.json", "yumi_bar_u.json"}) {
     const Scene scene = load_scene(test::source_path(std::string("scenes/") + name));
     EXPECT_TRUE(scene.warnings.empty()) << name << ":\n" << joined(scene.warnings);
     for (const GripPlacement& p : grip_placements(scene)) {
