@@ -6,7 +6,9 @@
 // obstacle triangle (point–triangle distance, its edges and corners included) / segment /
 // point / half-space; obstacle point – object surface triangle; obstacle segment – object
 // surface edge. b is C² at d̂, so Newton and the sensitivities stay exact; each pair's Hessian
-// block is exact and, with project_psd, projected on its own.
+// block is exact and, with project_psd, projected on its own. No edge–edge mollifier (self-
+// contact has IPC's): contacts are merged as pairs of features, and mollifying the line–line one
+// alone would make the energy jump where its closest point reaches an edge's end.
 //
 // Obstacles on robot links (Obstacle::link) are placed by the links' poses (posed()); they
 // couple x and θ: for_each_coupling gives ∂²E/∂x∂p, p their points, for ∂F/∂θ.
