@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <shapectl/contact/edge_mollifier.hpp>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
@@ -31,11 +33,11 @@ TetMesh two_tets(std::array<Vec3, 4> b) {
 
 // B where it is meant to be (its rest shifted back by 1 m), every node moved by up to 1e-3 m
 // (a generic configuration: no symmetry hides an error).
-Positions brought_close(const TetMesh& mesh, unsigned seed) {
+Positions brought_close(const TetMesh& mesh, unsigned seed, double by = 1e-3) {
   Positions x = mesh.rest_vector();
   for (int i = 4; i < 8; ++i) x[3 * i] -= 1;
   std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1e-3, 1e-3);
+  std::uniform_real_distribution<double> u(-by, by);
   for (int i = 0; i < x.size(); ++i) x[i] += u(rng);
   return x;
 }
@@ -74,9 +76,9 @@ std::array<int, 2> pair_kinds(const SelfContact& term, const Positions& x) {
   return kinds;
 }
 
-void expect_derivatives_match(const TetMesh& mesh, unsigned seed) {
+void expect_derivatives_match(const TetMesh& mesh, unsigned seed, double by = 1e-3) {
   const SelfContact term(mesh, kDhat, 3.0);
-  const Positions x = brought_close(mesh, seed);
+  const Positions x = brought_close(mesh, seed, by);
   ASSERT_TRUE(std::isfinite(term.value(x)));
   ASSERT_GT(term.value(x), 0);
   const auto gradient_at = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
@@ -116,6 +118,70 @@ TEST(SelfContact, EdgeEdgeDerivativesMatchCentralDifferences) {
     EXPECT_EQ(kinds[0], 0);
     EXPECT_GE(kinds[1], 2) << "B's edge crosses two of A's";
     expect_derivatives_match(mesh, seed);
+  }
+}
+
+// B's top edge, 6 cm long, 5.8 mm beside and below A's edge along x (10 cm), at an angle whose
+// sine is `sine` (about z): the mollifier's c/ε is 1000 sine².
+TetMesh nearly_parallel(double sine) {
+  const Vec3 a(0.02, -0.005, -0.003);
+  const Vec3 b = a + 0.06 * Vec3(std::sqrt(1 - sine * sine), sine, 0);
+  return two_tets({a, b, Vec3(0.05, -0.06, -0.1), Vec3(0.03, -0.1, -0.08)});
+}
+
+// The mollifier alone, against central differences of its value and gradient, from edges
+// nearly parallel (c ≪ ε) to across ε and beyond (e = 1: zero derivatives).
+TEST(SelfContact, EdgeMollifierDerivativesMatchCentralDifferences) {
+  for (double ratio : {0.02, 0.4, 0.97, 1.03, 3.0}) {
+    const double sine = std::sqrt(ratio / 1000);
+    const std::array<Vec3, 4> p{Vec3(0, 0, 0), Vec3(0.1, 0, 0), Vec3(0.02, -0.005, -0.003),
+                                Vec3(0.02, -0.005, -0.003) + 0.06 * Vec3(std::sqrt(1 - sine * sine),
+                                                                         sine * 0.8, sine * 0.6)};
+    const double eps = contact::edge_mollifier_threshold(0.01, 0.0036);
+    constexpr std::array<bool, 4> all{true, true, true, true};
+    Eigen::VectorXd x(12);
+    for (int k = 0; k < 4; ++k) x.segment<3>(3 * k) = p[k];
+    const auto points = [](const Eigen::VectorXd& y) {
+      return std::array<Vec3, 4>{y.segment<3>(0), y.segment<3>(3), y.segment<3>(6),
+                                 y.segment<3>(9)};
+    };
+    const auto value = [&](const Eigen::VectorXd& y) {
+      return contact::edge_mollifier<12>(points(y), all, eps, nullptr, nullptr);
+    };
+    const auto gradient = [&](const Eigen::VectorXd& y) -> Eigen::VectorXd {
+      VecN<12> g;
+      contact::edge_mollifier<12>(points(y), all, eps, &g, nullptr);
+      return g;
+    };
+    VecN<12> g;
+    MatN<12> h;
+    const double e = contact::edge_mollifier<12>(p, all, eps, &g, &h);
+    const double c = ((p[1] - p[0]).cross(p[3] - p[2])).squaredNorm();
+    EXPECT_NEAR(c / eps, ratio, 1e-6 * ratio);
+    EXPECT_NEAR(e, ratio < 1 ? -ratio * ratio + 2 * ratio : 1.0, 1e-12) << "c/ε " << ratio;
+    if (ratio > 1) {
+      EXPECT_EQ(g.norm(), 0.0);
+      EXPECT_EQ(h.norm(), 0.0);
+      continue;
+    }
+    // h relative to the coordinates (0.1 m): the differences stay on one side of ε.
+    EXPECT_TRUE(test::derivative_matches(g, test::central_difference_gradient(value, x, 1e-8), 1e-5,
+                                         "mollifier gradient"))
+        << "c/ε " << ratio;
+    EXPECT_TRUE(test::derivative_matches(h, test::central_difference_jacobian(gradient, x, 1e-8),
+                                         1e-5, "mollifier Hessian"))
+        << "c/ε " << ratio;
+  }
+}
+
+// The whole term (the product rule of barrier and mollifier) with a pair of nearly parallel
+// edges within d̂, below ε and just across it.
+TEST(SelfContact, NearlyParallelEdgesDerivativesMatchCentralDifferences) {
+  for (double ratio : {0.05, 0.4, 0.9, 1.2}) {
+    const TetMesh mesh = nearly_parallel(std::sqrt(ratio / 1000));
+    const auto kinds = pair_kinds(SelfContact(mesh, kDhat, 3.0), brought_close(mesh, 1, 1e-6));
+    EXPECT_GE(kinds[1], 1) << "edge–edge pairs";
+    expect_derivatives_match(mesh, 1, 1e-6);
   }
 }
 

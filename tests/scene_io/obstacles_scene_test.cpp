@@ -49,7 +49,8 @@ std::string scene_with_obstacles() {
     {"name": "rod", "capsule": {"a": [0, -0.1, -0.05], "b": [0, 0.1, -0.05], "radius": 0.01}},
     {"name": "fixture", "mesh": {"file": "meshes/cube.obj", "units": "mm",
                                  "pose": {"position": [0, 0, 0.05]}}}],
-  "contact": {"distance": 0.002, "self": false, "robot": false, "friction": 0, "stiffness": 50},
+  "contact": {"distance": 0.002, "self": false, "robot": false, "friction": 0, "stiffness": 50,
+              "sweep_steps": 12},
   "gravity")");
   return text;
 }
@@ -91,6 +92,7 @@ TEST(ObstaclesScene, EveryShapeIsReadInTheWorldFrame) {
   EXPECT_NEAR((hi - Vec3(0.01, 0.01, 0.06)).norm(), 0, 1e-15);
   EXPECT_EQ(scene.contact.distance, 0.002);
   EXPECT_EQ(scene.contact.stiffness, 50.0);
+  EXPECT_EQ(scene.contact.sweep_steps, 12);
   EXPECT_FALSE(scene.contact.self);
 }
 
@@ -100,6 +102,7 @@ TEST(ObstaclesScene, WithoutObstaclesTheSceneHasNoneAndDefaultContact) {
   EXPECT_TRUE(scene.obstacles.empty());
   EXPECT_EQ(scene.contact.distance, 1e-3);
   EXPECT_FALSE(scene.contact.stiffness);
+  EXPECT_EQ(scene.contact.sweep_steps, 64);
 }
 
 TEST(ObstaclesScene, TheWriterKeepsObstaclesAndRebasesTheirMeshFiles) {

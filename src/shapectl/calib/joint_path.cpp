@@ -14,7 +14,8 @@ ObjectState step_to(const GrippedObject& object, const ObjectState& from, const 
                     int depth, const StopRequest& stop) {
   Positions carried = from.positions();
   object.carry_gripped_nodes(from.joints(), to, from.positions(), carried);
-  ObjectState state = object.solve_from(to, carried, 0, nullptr, stop, from.workspaces());
+  ObjectState state =
+      object.solve_along(from.joints(), to, carried, 0, nullptr, stop, from.workspaces());
   if (state.statics().converged() || depth == 0 || (stop && stop())) return state;
   ObjectState halfway = step_to(object, from, (from.joints() + to) / 2, depth - 1, stop);
   if (!halfway.statics().converged()) return halfway;

@@ -31,7 +31,8 @@ std::optional<ObservationFrame> SimulatedWorld::step(double time,
     // the last shape alone Newton first pulls the grips across, which can take it past its cap.
     Positions x = state_->positions();
     object_.carry_gripped_nodes(state_->joints(), measured_joints, state_->positions(), x);
-    ObjectState next = object_.solve_from(measured_joints, x, 0, nullptr, {}, workspaces_);
+    ObjectState next =
+        object_.solve_along(state_->joints(), measured_joints, x, 0, nullptr, {}, workspaces_);
     if (!next.statics().converged())
       next = equilibrium_along_path(object_, measured_joints, 0.05, {}, workspaces_);
     state_.emplace(std::move(next));

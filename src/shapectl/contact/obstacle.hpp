@@ -55,6 +55,9 @@ struct ContactSettings {
   bool self = false;       // object self-contact (self_contact.hpp)
   bool robot = false;      // the robot's collision spheres as obstacles on their links
   double friction = 0;     // Coulomb coefficient μ (contact/friction.hpp; 0: frictionless)
+  // The most sub-steps a joint step is split into where obstacles on links would sweep into
+  // the object on the way (quasi-static continuation, GrippedObject::solve).
+  int sweep_steps = 64;
   // κ, J/m² (= N/m); none: from the object's mean nodal weight (obstacle_contact.hpp).
   std::optional<double> stiffness;
 };

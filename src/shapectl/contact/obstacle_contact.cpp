@@ -162,30 +162,54 @@ struct ObstacleContact::Impl {
   }
 
   // The gap of candidate p with its object nodes at `at`: the distance between its two
-  // primitives less the obstacle's radius (for CCD; the energy uses contact_gap).
+  // primitives less the obstacle's radius (for CCD; the energy uses contact_gap). With
+  // `moved`, the obstacle's primitive moved rigidly by it first (not a half-space's).
   template <int K>
-  double candidate_gap(const Pair& p, const std::array<Vec3, K>& at) const {
+  double candidate_gap(const Pair& p, const std::array<Vec3, K>& at,
+                       const Eigen::Isometry3d* moved = nullptr) const {
     constexpr std::array<bool, 4> fixed{false, false, false, false};
+    const auto place = [moved](const Vec3& v) -> Vec3 { return moved ? Vec3(*moved * v) : v; };
     if constexpr (K == 1) {
       switch (p.kind) {
         case PairKind::VertexHalfSpace:
           return (at[0] - planes[p.other].h.point).dot(planes[p.other].h.normal);
         case PairKind::VertexTriangle: {
           const Triangle& t = obstacle_triangles[p.other];
-          return point_triangle_distance<0>(at[0], t.a, t.b, t.c, fixed) - t.radius;
+          return point_triangle_distance<0>(at[0], place(t.a), place(t.b), place(t.c), fixed) -
+                 t.radius;
         }
         case PairKind::VertexSegment: {
           const Segment& s = segments[p.other];
-          return point_segment_distance<0>(at[0], s.a, s.b, {false, false, false}) - s.radius;
+          return point_segment_distance<0>(at[0], place(s.a), place(s.b), {false, false, false}) -
+                 s.radius;
         }
-        default: return (at[0] - points[p.other].p).norm() - points[p.other].radius;
+        default: return (at[0] - place(points[p.other].p)).norm() - points[p.other].radius;
       }
     } else if constexpr (K == 2) {
       const Segment& s = segments[p.other];
-      return segment_segment_distance<0>(at[0], at[1], s.a, s.b, fixed) - s.radius;
+      return segment_segment_distance<0>(at[0], at[1], place(s.a), place(s.b), fixed) - s.radius;
     } else {
       const Point& q = points[p.other];
-      return point_triangle_distance<0>(q.p, at[0], at[1], at[2], fixed) - q.radius;
+      return point_triangle_distance<0>(place(q.p), at[0], at[1], at[2], fixed) - q.radius;
+    }
+  }
+
+  // The points spanning candidate p's obstacle primitive (world): a triangle's corners, a
+  // segment's ends, a point; none for a half-space. Returns how many.
+  int obstacle_points(const Pair& p, std::array<Vec3, 3>& out) const {
+    switch (p.kind) {
+      case PairKind::VertexHalfSpace: return 0;
+      case PairKind::VertexTriangle: {
+        const Triangle& t = obstacle_triangles[p.other];
+        out = {t.a, t.b, t.c};
+        return 3;
+      }
+      case PairKind::VertexSegment:
+      case PairKind::SegmentEdge:
+        out[0] = segments[p.other].a;
+        out[1] = segments[p.other].b;
+        return 2;
+      default: out[0] = points[p.other].p; return 1;
     }
   }
 
@@ -758,6 +782,78 @@ double ObstacleContact::max_step(const Positions& x, const Eigen::VectorXd& dx) 
     });
   });
   return alpha;
+}
+
+double ObstacleContact::max_obstacle_step(const Positions& x, ObstacleMotion& motion,
+                                          int* limiting) const {
+  if (!moves()) return 1;
+  const Impl& m = *impl_;
+  const auto link_of = [&](const Pair& p) { return (*obstacles_)[m.obstacle(p)].link; };
+  // The farthest any obstacle point travels over the whole path widens the broad phase: a
+  // pair missed there stays more than d̂ apart all the way.
+  motion.move_to(0);
+  double reach = 0;
+  for (const Point& q : m.points)
+    if (const int link = (*obstacles_)[q.obstacle].link; link >= 0)
+      reach = std::max(reach, motion.travel(link, q.p, 1));
+  // A candidate whose obstacle moves, with its gap at the start, its target (10 % of it, as
+  // max_step's) and its gap now.
+  struct Moving {
+    Pair pair;
+    int link;
+    double d0, target, d;
+  };
+  std::vector<Moving> moving;
+  m.for_each_candidate(x, nullptr, distance_ + reach, [&](const Pair& p) {
+    const int link = link_of(p);
+    if (link < 0) return;  // fixed obstacles: x is clear of them and neither moves
+    const double d0 = with_arity(p.kind, [&](auto k) {
+      constexpr int K = decltype(k)::value;
+      return m.candidate_gap<K>(p, m.positions<K>(p, x));
+    });
+    if (!(d0 > 0)) return;  // already intersecting: no step keeps it out
+    // Pairs whose obstacle cannot travel as far as 90 % of the gap never reach the target.
+    std::array<Vec3, 3> q;
+    double far = 0;
+    for (int i = m.obstacle_points(p, q) - 1; i >= 0; --i)
+      far = std::max(far, motion.travel(link, q[i], 1));
+    if (far > 0.9 * d0) moving.push_back({p, link, d0, 0.1 * d0, d0});
+  });
+  // Conservative advancement (Li et al. 2021, additive CCD, with the obstacle moving): from s,
+  // no point of a pair's obstacle primitive (a convex combination of its points, moved
+  // rigidly) travels farther than its gap less the target before s + h, so every gap stays
+  // above its target up to there. Stop where one comes close to its target.
+  double s = 0;
+  const Moving* slowest = nullptr;  // the pair that bounds the last advance
+  for (int iteration = 0; iteration < 1000 && !moving.empty(); ++iteration) {
+    double h = kInf;
+    for (const Moving& c : moving) {
+      std::array<Vec3, 3> q;
+      const Eigen::Isometry3d& T = motion.displacement(c.link);
+      for (int i = m.obstacle_points(c.pair, q) - 1; i >= 0; --i)
+        if (const double t = motion.time_to_travel(c.link, T * q[i], c.d - c.target); t < h) {
+          h = t;
+          slowest = &c;
+        }
+    }
+    if (!(s + h < 1)) return 1;
+    s += h;
+    motion.move_to(s);
+    for (Moving& c : moving) {
+      c.d = with_arity(c.pair.kind, [&](auto k) {
+        constexpr int K = decltype(k)::value;
+        return m.candidate_gap<K>(c.pair, m.positions<K>(c.pair, x), &motion.displacement(c.link));
+      });
+      // Close enough to the target: further steps would shrink geometrically.
+      if (c.d - c.target <= 0.1 * (c.d0 - c.target)) {
+        if (limiting) *limiting = m.obstacle(c.pair);
+        return s;
+      }
+    }
+  }
+  if (!slowest) return 1;
+  if (limiting) *limiting = m.obstacle(slowest->pair);  // 1000 advances: a bound all the same
+  return s;
 }
 
 void ObstacleContact::for_each_coupling(const Positions& x, const CouplingVisit& visit) const {

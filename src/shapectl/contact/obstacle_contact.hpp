@@ -6,7 +6,9 @@
 // obstacle triangle (point–triangle distance, its edges and corners included) / segment /
 // point / half-space; obstacle point – object surface triangle; obstacle segment – object
 // surface edge. b is C² at d̂, so Newton and the sensitivities stay exact; each pair's Hessian
-// block is exact and, with project_psd, projected on its own.
+// block is exact and, with project_psd, projected on its own. No edge–edge mollifier (self-
+// contact has IPC's): contacts are merged as pairs of features, and mollifying the line–line one
+// alone would make the energy jump where its closest point reaches an edge's end.
 //
 // Obstacles on robot links (Obstacle::link) are placed by the links' poses (posed()); they
 // couple x and θ: for_each_coupling gives ∂²E/∂x∂p, p their points, for ∂F/∂θ.
@@ -22,6 +24,7 @@
 #include <vector>
 
 #include <shapectl/contact/obstacle.hpp>
+#include <shapectl/contact/obstacle_motion.hpp>
 #include <shapectl/fem/energy_term.hpp>
 #include <shapectl/mesh/tet_mesh.hpp>
 
@@ -87,6 +90,13 @@ class ObstacleContact : public EnergyTerm {
   // x + α·dx no pair's gap falls below 10 % of where it started (so no surface passes through
   // an obstacle, however thin); 1 if none comes that close.
   double max_step(const Positions& x, const Eigen::VectorXd& dx) const override;
+  // CCD of the obstacles' own motion: the object fixed at x (clear of them), the obstacles on
+  // links moving along `motion` from where this term has them (its s = 0): the largest
+  // s ∈ [0, 1] such that no pair's gap falls below 10 % of where it started on the way (a
+  // bound: conservative advancement with motion's travel bounds). 1 if none moves. If s < 1,
+  // `limiting` (if given) is set to the obstacle that bounds it.
+  double max_obstacle_step(const Positions& x, ObstacleMotion& motion,
+                           int* limiting = nullptr) const;
 
   ContactSummary summary(const Positions& x) const;
   // Every pair with 0 < d < d̂ at x, with its closest-point weights, normal and normal force.

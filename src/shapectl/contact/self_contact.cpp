@@ -9,6 +9,7 @@
 
 #include <shapectl/contact/barrier.hpp>
 #include <shapectl/contact/bvh.hpp>
+#include <shapectl/contact/edge_mollifier.hpp>
 #include <shapectl/contact/point_triangle_distance.hpp>
 #include <shapectl/contact/segment_segment_distance.hpp>
 #include <shapectl/contact/segment_triangle_distance.hpp>
@@ -51,7 +52,8 @@ struct SelfContact::Impl {
   std::vector<int> vertices;  // node ids
   std::vector<std::array<int, 2>> edges;
   std::vector<std::array<int, 3>> triangles;
-  std::vector<std::uint64_t> left_out;  // keys of the pairs closer than d̂ at rest, sorted
+  std::vector<std::uint64_t> left_out;    // keys of the pairs closer than d̂ at rest, sorted
+  std::vector<double> edge_rest_length2;  // |edge|² at rest, for the mollifier's threshold
 
   std::array<int, 4> nodes(const Pair& p) const {
     if (p.edge_edge) return {edges[p.a][0], edges[p.a][1], edges[p.b][0], edges[p.b][1]};
@@ -64,6 +66,20 @@ struct SelfContact::Impl {
     constexpr std::array<bool, 4> all{true, true, true, true};
     if (p.edge_edge) return segment_segment_distance<N>(at[0], at[1], at[2], at[3], all, g, h);
     return point_triangle_distance<N>(at[0], at[1], at[2], at[3], all, g, h);
+  }
+
+  // The pair's mollifier with its nodes at `at` (edge_mollifier.hpp; 1 for a vertex–triangle
+  // pair); gradient and Hessian if asked (may be null).
+  double mollifier(const Pair& p, const std::array<Vec3, 4>& at, VecN<N>* g = nullptr,
+                   MatN<N>* h = nullptr) const {
+    if (!p.edge_edge) {
+      if (g) g->setZero();
+      if (h) h->setZero();
+      return 1;
+    }
+    const double threshold =
+        contact::edge_mollifier_threshold(edge_rest_length2[p.a], edge_rest_length2[p.b]);
+    return contact::edge_mollifier<N>(at, {true, true, true, true}, threshold, g, h);
   }
 
   std::array<Vec3, 4> positions(const Pair& p, const Positions& x) const {
@@ -245,6 +261,8 @@ SelfContact::SelfContact(const TetMesh& mesh, double distance, double stiffness)
   double shortest = kInf;
   for (const auto& e : m->edges)
     shortest = std::min(shortest, (node(rest, e[0]) - node(rest, e[1])).norm());
+  for (const auto& e : m->edges)
+    m->edge_rest_length2.push_back((node(rest, e[1]) - node(rest, e[0])).squaredNorm());
   m->dhat = distance;
   m->margin = std::isfinite(shortest) ? 0.25 * shortest : 0.0;
   // Neighbours at rest (within d̂ there) are left out for good; the other near pairs at rest
@@ -265,9 +283,10 @@ double SelfContact::value(const Positions& x) const {
   double sum = 0;
   bool intersecting = false;
   m.for_each_candidate(x, [&](const Pair& p) {
-    const double d = Impl::distance(p, m.positions(p, x));
+    const std::array<Vec3, 4> at = m.positions(p, x);
+    const double d = Impl::distance(p, at);
     if (!(d > 0)) intersecting = true;
-    else if (d < distance_) sum += barrier(d, distance_).value;
+    else if (d < distance_) sum += barrier(d, distance_).value * m.mollifier(p, at);
   });
   return intersecting ? kInf : stiffness_ * sum;
 }
@@ -275,13 +294,18 @@ double SelfContact::value(const Positions& x) const {
 void SelfContact::add_gradient(const Positions& x, Eigen::VectorXd& gradient) const {
   const Impl& m = *impl_;
   m.for_each_candidate(x, [&](const Pair& p) {
-    VecN<N> g;
-    const double d = Impl::distance(p, m.positions(p, x), &g);
+    const std::array<Vec3, 4> at = m.positions(p, x);
+    VecN<N> g, gm;
+    const double d = Impl::distance(p, at, &g);
     if (!(d < distance_)) return;
-    // The gradient is NaN where the energy is +inf.
-    const double scale = d > 0 ? stiffness_ * barrier(d, distance_).first : kNaN;
+    if (d > 0) {  // ∇(b e) = e b′ ∇d + b ∇e
+      const BarrierValue b = barrier(d, distance_);
+      g = stiffness_ * (m.mollifier(p, at, &gm) * b.first * g + b.value * gm);
+    } else {
+      g.setConstant(kNaN);  // the gradient is NaN where the energy is +inf
+    }
     const std::array<int, 4> nodes = m.nodes(p);
-    for (int a = 0; a < 4; ++a) gradient.segment<3>(3 * nodes[a]) += scale * g.segment<3>(3 * a);
+    for (int a = 0; a < 4; ++a) gradient.segment<3>(3 * nodes[a]) += g.segment<3>(3 * a);
   });
 }
 
@@ -297,15 +321,19 @@ void SelfContact::add_hessian(const Positions& x, ElementHessianSink& sink,
   const Impl& m = *impl_;
   const std::vector<Pair> pairs = m.active(x);  // hessian_elements(x)'s, in its order
   sink.add_blocks([&](std::size_t e, double* block) {
-    VecN<N> g;
-    MatN<N> h;
-    const double d = Impl::distance(pairs[e], m.positions(pairs[e], x), &g, &h);
+    const std::array<Vec3, 4> at = m.positions(pairs[e], x);
+    VecN<N> g, gm;
+    MatN<N> h, hm;
+    const double d = Impl::distance(pairs[e], at, &g, &h);
     if (!(d > 0)) {  // intersecting: a NaN block, so the factorization fails
       std::fill(block, block + N * N, kNaN);
       return;
     }
     const BarrierValue b = barrier(d, distance_);
-    MatN<N> H = stiffness_ * (b.second * g * g.transpose() + b.first * h);
+    const double mollifier = m.mollifier(pairs[e], at, &gm, &hm);
+    // ∇²(b e) = e (b″ ∇d ∇dᵀ + b′ ∇²d) + b′ (∇d ∇eᵀ + ∇e ∇dᵀ) + b ∇²e
+    MatN<N> H = stiffness_ * (mollifier * (b.second * g * g.transpose() + b.first * h) +
+                              b.first * (g * gm.transpose() + gm * g.transpose()) + b.value * hm);
     if (project_psd) {
       Eigen::SelfAdjointEigenSolver<MatN<N>> eig(H);
       H = eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() *

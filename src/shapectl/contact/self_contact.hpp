@@ -15,10 +15,12 @@
 //
 // Smoothness: each pair's distance is one of IPC's smooth pieces (point–point, point–line,
 // point–plane, line–line) chosen by where the closest points lie: C¹ across the pieces' borders,
-// not C² there. Edge–edge pairs use the exact segment–segment distance, no mollifier: near-parallel
-// edges whose closest points lie inside both use the line–line piece, whose derivatives grow as
-// 1/sin of the edges' angle (exact, but badly conditioned); parallel ones (to rounding) take an
-// end (point–line), where the energy is C⁰ in the angle only.
+// not C² there. Edge–edge pairs use the exact segment–segment distance with IPC's mollifier:
+// their barrier is multiplied by e(c), c = |e0 × e1|², which fades from 1 to 0 as the edges
+// turn parallel (below ε = 10⁻³ |e0|²|e1|² at rest; edge_mollifier.hpp), so the line–line
+// piece's derivatives, which grow as 1/sin of the edges' angle, are damped to nothing and the
+// switch to an end (point–line) for parallel edges costs no smoothness; gradient and Hessian
+// by the product rule, exact. The vertex–triangle pairs keep parallel edges apart.
 //
 // Finding the pairs: a BVH finds the "near" pairs at a reference state (within d̂ + 2 margin by
 // a cheap separating-axis bound, separation.hpp); every call at a state whose surface vertices

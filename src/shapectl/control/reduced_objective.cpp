@@ -104,7 +104,11 @@ Evaluation ReducedObjective::evaluate(const Eigen::VectorXd& joints, const Posit
                                       const StopRequest& stop) const {
   const auto t0 = Clock::now();
   const ObjectState* chord = from && options_.chord_steps ? from->state.get() : nullptr;
-  ObjectState state = object_->solve_from(joints, x, max_newton, chord, stop, workspaces_);
+  // x is clear of the obstacles where `from`'s joints put them (its equilibrium, or carried
+  // from it): obstacles on links are swept on from there.
+  ObjectState state =
+      from ? object_->solve_along(from->joints(), joints, x, max_newton, chord, stop, workspaces_)
+           : object_->solve_from(joints, x, max_newton, chord, stop, workspaces_);
   count_statics(seconds_since(t0));
   return describe(std::move(state));
 }
@@ -141,8 +145,8 @@ Eigen::VectorXd ReducedObjective::gradient(Evaluation& at, GradientMethod method
       Eigen::VectorXd theta = at.joints();
       theta[j] += h;
       const ObjectState* chord = options_.chord_steps ? at.state.get() : nullptr;
-      const Evaluation e =
-          describe(object_->solve_from(theta, at.positions(), 0, chord, {}, workspaces_));
+      const Evaluation e = describe(
+          object_->solve_along(at.joints(), theta, at.positions(), 0, chord, {}, workspaces_));
       g[j] = (e.objective - at.objective) / h;
     }
   } else {

@@ -85,9 +85,10 @@ class ReducedObjective {
   int joint_count() const { return object_->joint_count(); }
 
   // Solves statics at θ from the warm start `x` (chord steps with `from`'s factorization if
-  // given, e.g. the state x came from) and scores it. max_newton > 0 caps the Newton
-  // iterations (a trial that needs more is not worth it); `stop` may end statics early (a time
-  // budget: the evaluation is then not converged).
+  // given, e.g. the state x came from; x must then be clear of the obstacles where from's
+  // joints put them: obstacles on links are swept on from there, GrippedObject::solve) and
+  // scores it. max_newton > 0 caps the Newton iterations (a trial that needs more is not worth
+  // it); `stop` may end statics early (a time budget: the evaluation is then not converged).
   Evaluation evaluate(const Eigen::VectorXd& joints, const Positions& x, int max_newton = 0,
                       const Evaluation* from = nullptr, const StopRequest& stop = {}) const;
   // True if `e` is a stable equilibrium (the Hessian there positive definite); otherwise

@@ -136,7 +136,7 @@ std::vector<Obstacle> read_obstacles(const JsonInput& list, const RobotSetup* ro
 }
 
 ContactSettings read_contact(const JsonInput& j, const RobotSetup* robot) {
-  j.expect_only({"distance", "self", "robot", "friction", "stiffness"});
+  j.expect_only({"distance", "self", "robot", "friction", "stiffness", "sweep_steps"});
   ContactSettings c;
   if (j.has("distance")) {
     j.at("distance").positive();
@@ -151,6 +151,8 @@ ContactSettings read_contact(const JsonInput& j, const RobotSetup* robot) {
     c.robot = true;
   }
   if (j.has("friction")) c.friction = j.at("friction").non_negative();
+  if (j.has("sweep_steps"))
+    c.sweep_steps = static_cast<int>(j.at("sweep_steps").integer_in(1, 10000));
   if (j.has("stiffness")) {
     j.at("stiffness").positive();
     c.stiffness = j.at("stiffness").number_in(1e-12, max_contact_stiffness, "N/m");

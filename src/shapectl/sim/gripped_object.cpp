@@ -3,6 +3,8 @@
 #include <stdexcept>
 
 #include <shapectl/sim/contact_force_jacobian.hpp>
+#include <shapectl/sim/link_motion.hpp>
+#include <shapectl/sim/rigid_motion.hpp>
 
 namespace shapectl {
 
@@ -63,6 +65,16 @@ ObjectState GrippedObject::unsolved_state(const Positions& x,
 const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::VectorXd& joints,
                                           int max_iterations, const ObjectState* chord,
                                           const StopRequest& stop) const {
+  const ObstacleContact* contact = statics_->contact();
+  if (contact && contact->moves() && state.joints_.size() == joints.size() &&
+      state.joints_ != joints)
+    solve_swept(state, joints, max_iterations, chord, stop);
+  else solve_at(state, joints, max_iterations, chord, stop);
+  return state.statics_;
+}
+
+void GrippedObject::solve_at(ObjectState& state, const Eigen::VectorXd& joints, int max_iterations,
+                             const ObjectState* chord, const StopRequest& stop) const {
   state.joints_ = joints;
   state.kinematics_ = forward_kinematics(robot(), joints);
   const GripEnergy grip(*grips_, state.kinematics_);
@@ -70,7 +82,79 @@ const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::Vecto
   const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
   state.statics_ = statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations,
                                    chord_ws, stop, contact ? &*contact : nullptr);
-  return state.statics_;
+}
+
+void GrippedObject::solve_swept(ObjectState& state, const Eigen::VectorXd& to, int max_iterations,
+                                const ObjectState* chord, const StopRequest& stop) const {
+  const ObstacleContact& contact = *statics_->contact();
+  const int most = scene_.contact.sweep_steps;
+  Eigen::VectorXd from = state.joints_;
+  int sub_steps = 0, iterations = 0, factorizations = 0;
+  std::string swept;  // the obstacle that split the step last
+  // The state is reported at `to`, its result counting every sub-step's work.
+  const auto finish = [&](const std::string& note) {
+    if (state.joints_ != to) {
+      state.joints_ = to;
+      state.kinematics_ = forward_kinematics(robot(), to);
+    }
+    state.statics_.iterations += iterations;
+    state.statics_.factorizations += factorizations;
+    if (!note.empty()) state.statics_.reason += " (" + note + ")";
+  };
+  for (;;) {
+    LinkMotion motion(robot(), from, to);
+    int limiting = -1;
+    const double s = contact.posed(motion.kinematics().T_world_link)
+                         .max_obstacle_step(state.positions_, motion, &limiting);
+    if (s >= 1) break;
+    swept = contact.obstacles()[static_cast<std::size_t>(limiting)].name;
+    if (sub_steps == most) {
+      state.statics_ = {};
+      state.statics_.reason =
+          "obstacle '" + swept +
+          "' sweeps into the object on the way to the joints: " + std::to_string(most) +
+          " sub-steps (contact.sweep_steps) did not reach them";
+      finish("");
+      return;
+    }
+    const Eigen::VectorXd at = from + s * (to - from);
+    solve_at(state, at, max_iterations, chord, stop);
+    ++sub_steps;
+    if (!state.statics_.converged()) {
+      finish("sub-step " + std::to_string(sub_steps) + " of a sweep of obstacle '" + swept +
+             "' towards the object: the joints were not reached");
+      return;
+    }
+    iterations += state.statics_.iterations;
+    factorizations += state.statics_.factorizations;
+    chord = &state;  // the last sub-step's factorization, the nearest
+    // The next warm start: the equilibrium at `at` predicted to `to` to first order (the object
+    // pushed ahead of the obstacle, so the next sweep goes farther than the gap), its gripped
+    // nodes carried, cut short where it would reach an obstacle where they are at `at`. The
+    // solve's last factorization is near enough for a prediction.
+    const Positions equilibrium = state.positions_;
+    constexpr double kAnyFactor = 1e300;
+    if (stable(state, kAnyFactor))
+      state.positions_ =
+          with_finite_rotation(equilibrium, sensitivity(state, kAnyFactor) * (to - at));
+    carry_gripped_nodes(at, to, equilibrium, state.positions_);
+    from = at;
+  }
+  solve_at(state, to, max_iterations, chord, stop);
+  finish(sub_steps == 0 ? ""
+                        : std::to_string(sub_steps) + " sub-steps: obstacle '" + swept +
+                              "' swept towards the object");
+}
+
+ObjectState GrippedObject::solve_along(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                                       const Positions& x, int max_iterations,
+                                       const ObjectState* chord, const StopRequest& stop,
+                                       std::shared_ptr<WorkspacePool> workspaces) const {
+  if (!workspaces && chord) workspaces = chord->workspaces_;
+  ObjectState s = unsolved_state(x, std::move(workspaces));
+  s.joints_ = from;  // where x is clear of the obstacles: solve() sweeps them on from there
+  solve(s, to, max_iterations, chord, stop);
+  return s;
 }
 
 ObjectState GrippedObject::solve_from(const Eigen::VectorXd& joints, const Positions& x,

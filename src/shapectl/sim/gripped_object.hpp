@@ -46,6 +46,11 @@ class GrippedObject {
   // Newton tries steps with `chord`'s factorization first if it holds one (a nearby state's,
   // e.g. the one the warm start came from; it may be `state` itself). max_iterations > 0
   // caps Newton for this call; `stop` may end it early (a time budget).
+  // A state at other joints (its positions clear of the obstacles where they put them) with
+  // obstacles on links: their motion from there to `joints` is swept against the positions
+  // (ObstacleContact::max_obstacle_step); where one would reach the object, the step is
+  // split: solved at θ0 + s (θ1 − θ0), the equilibrium carried on, and so on up to `joints`
+  // (quasi-static continuation, at most contact.sweep_steps sub-steps, else refused).
   const StaticsResult& solve(ObjectState& state, const Eigen::VectorXd& joints,
                              int max_iterations = 0, const ObjectState* chord = nullptr,
                              const StopRequest& stop = {}) const;
@@ -55,12 +60,21 @@ class GrippedObject {
                          const ObjectState* chord = nullptr, const StopRequest& stop = {},
                          std::shared_ptr<WorkspacePool> workspaces = nullptr) const;
 
+  // solve_from for a warm start x clear of the obstacles where `from` puts them (the
+  // equilibrium at `from`, or carry_gripped_nodes' warm start from it): obstacles on links are
+  // swept from `from` to `to` (solve above).
+  ObjectState solve_along(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
+                          const Positions& x, int max_iterations = 0,
+                          const ObjectState* chord = nullptr, const StopRequest& stop = {},
+                          std::shared_ptr<WorkspacePool> workspaces = nullptr) const;
+
   // A warm start for the equilibrium at `to` from the one at `from`: every gripped node of `x`
   // is set to its position in `at_from` moved rigidly with its end effector from `from` to
   // `to`. A linear prediction dx̂/dθ·Δθ puts them off their anchors by ~ r|Δθ|²/2 — tens of
   // newtons through stiff grip springs, and Newton iterations to undo. With obstacles the
   // result is then pulled back towards at_from (an equilibrium, clear of them) as far as the
-  // contact's CCD bound asks, so no surface of the warm start passes through an obstacle.
+  // contact's CCD bound asks, so no surface of the warm start passes through an obstacle where
+  // they are at `from` (solve_along sweeps the obstacles on links on to `to`).
   void carry_gripped_nodes(const Eigen::VectorXd& from, const Eigen::VectorXd& to,
                            const Positions& at_from, Positions& x) const;
 
@@ -95,6 +109,12 @@ class GrippedObject {
 
  private:
   bool factored(ObjectState& state, double stale_step) const;
+  // solve() at `joints` from the state's positions, with no sweep.
+  void solve_at(ObjectState& state, const Eigen::VectorXd& joints, int max_iterations,
+                const ObjectState* chord, const StopRequest& stop) const;
+  // solve() from the state's joints to `to`, sweeping the obstacles on links.
+  void solve_swept(ObjectState& state, const Eigen::VectorXd& to, int max_iterations,
+                   const ObjectState* chord, const StopRequest& stop) const;
   // Positions and a workspace only.
   ObjectState unsolved_state(const Positions& x, std::shared_ptr<WorkspacePool> workspaces) const;
 
