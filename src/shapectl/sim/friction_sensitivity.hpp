@@ -2,9 +2,10 @@
 // Solves with the Jacobian of the lagged friction's fixed point (contact/friction_lag.hpp),
 // A = H + L: H the symmetric Hessian (elasticity, grips, barrier, and the friction lagged at the
 // equilibrium), factored in a StaticsWorkspace, and L the friction's non-symmetric lag Jacobian.
-// A has no Cholesky factor; GMRES on (I + H⁻¹L) x = H⁻¹ b, preconditioned by H's, needs as many
-// solves with it as L's few significant directions (L lives on the contact nodes only): one or
-// two where friction is light, and never an answer short of the tolerance (it throws instead).
+// A has no Cholesky factor; GMRES on (I + H⁻¹L) x = H⁻¹ b, preconditioned by H's, needs about
+// as many solves with it as L has significant directions (L lives on the contact nodes only):
+// 6–9 per column for the tests' bar on a table, and never stops short of the tolerance (it
+// throws instead).
 #include <shapectl/sim/lagged_friction.hpp>
 
 namespace shapectl {
