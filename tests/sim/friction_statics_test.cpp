@@ -117,9 +117,7 @@ struct Swing {
 Swing swing_over_table(double friction) {
   Scene scene = test::two_arm_scene({12, 2, 2});
   const Positions rest = scene.world_rest_positions();
-  double bottom = INFINITY;
-  for (Eigen::Index i = 0; i < rest.size() / 3; ++i) bottom = std::min(bottom, rest[3 * i + 2]);
-  scene.obstacles.push_back(make_plane("table", Vec3(0, 0, bottom - 0.5e-3), Vec3::UnitZ()));
+  const double table = test::add_table_under(scene, 0.5e-3);
   scene.contact.distance = 1e-3;
   scene.contact.friction = friction;
   scene.statics.max_iterations = 300;
@@ -134,7 +132,7 @@ Swing swing_over_table(double friction) {
   const ObjectState after = object.solve_from(joints, x, 0, &before);
   Swing s{0, after.statics()};
   for (Eigen::Index i = 0; i < rest.size() / 3; ++i)
-    if (before.positions()[3 * i + 2] < bottom - 0.5e-3 + scene.contact.distance)
+    if (before.positions()[3 * i + 2] < table + scene.contact.distance)
       s.middle_motion = std::max(s.middle_motion,
                                  (after.positions() - before.positions()).segment<2>(3 * i).norm());
   return s;

@@ -1,6 +1,9 @@
 #pragma once
 // A small two-arm robot (3 revolute joints per arm) holding a foam bar by its ends: fast enough
 // for finite-difference checks of every derivative. Built in code, no files.
+#include <cmath>
+
+#include <shapectl/contact/obstacle.hpp>
 #include <shapectl/mesh/box_mesh.hpp>
 #include <shapectl/robot/kinematics.hpp>
 #include <shapectl/sim/scene.hpp>
@@ -97,6 +100,16 @@ inline Scene two_arm_scene_with_clearance(double clearance) {
   s.robot->collisions = std::make_shared<const CollisionModel>(*s.robot->model, spheres,
                                                                old.margin(), old.stiffness());
   return s;
+}
+
+// A table, the plane obstacle "table", `gap` under the lowest node of the scene's rest shape;
+// returns its height.
+inline double add_table_under(Scene& s, double gap) {
+  const Positions rest = s.world_rest_positions();
+  double bottom = INFINITY;
+  for (Eigen::Index i = 0; i < rest.size() / 3; ++i) bottom = std::min(bottom, rest[3 * i + 2]);
+  s.obstacles.push_back(make_plane("table", Vec3(0, 0, bottom - gap), Vec3::UnitZ()));
+  return bottom - gap;
 }
 
 }  // namespace shapectl::test

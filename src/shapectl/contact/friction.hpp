@@ -9,7 +9,8 @@
 //   f₀(y) = −y³/(3ε²) + y²/ε + ε/3 for y < ε,  y beyond  (C², f₀′ = f₁ ∈ [0, 1]).
 // A pair resists up to μλ: below it the contact sticks (slips less than ε), at it slides.
 // D is convex in x (f₀ convex and increasing, u linear): each pair's Hessian is PSD as it
-// stands, in closed form.
+// stands, in closed form. Its force's change through the lag itself (the lagged solve's fixed
+// point, for exact sensitivities): friction_lag.hpp.
 //
 // The Hessian's elements are the contact's (the surface's vertices, edges, triangles), so the
 // assembler's pattern stays that of the barrier whatever pairs are lagged.

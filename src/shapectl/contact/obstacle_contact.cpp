@@ -917,25 +917,42 @@ ContactSummary ObstacleContact::summary(const Positions& x) const {
 }
 
 std::vector<ContactPair> ObstacleContact::pairs(const Positions& x) const {
-  const Impl& m = *impl_;
   std::vector<ContactPair> out;
+  for (const ContactPairDerivatives& p : pair_derivatives(x)) out.push_back(p.pair);
+  return out;
+}
+
+std::vector<ContactPairDerivatives> ObstacleContact::pair_derivatives(const Positions& x) const {
+  const Impl& m = *impl_;
+  std::vector<ContactPairDerivatives> out;
   m.for_each_contact(x, distance_, [&](const Contact& contact) {
     with_element_size(m.element_size(contact), [&](auto k) {
-      constexpr int K = decltype(k)::value;
-      VecN<3 * K> g;
+      constexpr int K = decltype(k)::value, N = 3 * K;
+      VecN<N> g;
+      MatN<N> h;
       const double d =
-          m.contact_gap<K>(contact, m.element_positions<K>(contact.element, x), &g, nullptr);
+          m.contact_gap<K>(contact, m.element_positions<K>(contact.element, x), &g, &h);
       if (!(d > 0 && d < distance_)) return;
       // ∂d/∂x_a = w_a n (the closest points' envelope), the weights summing to 1: n = Σ ∂d/∂x_a.
-      ContactPair p{.element = contact.element, .obstacle = m.obstacle(contact), .node_count = K};
-      for (int a = 0; a < K; ++a) p.normal += g.template segment<3>(3 * a);
+      ContactPairDerivatives jet;
+      ContactPair& p = jet.pair;
+      p = {.element = contact.element, .obstacle = m.obstacle(contact), .node_count = K};
+      for (int a = 0; a < K; ++a) {
+        p.normal += g.template segment<3>(3 * a);
+        jet.normal.leftCols<N>() += h.template middleRows<3>(3 * a);
+      }
       const std::array<int, K> nodes = m.element_nodes<K>(contact.element);
       for (int a = 0; a < K; ++a) {
         p.nodes[a] = nodes[a];
         p.weights[a] = g.template segment<3>(3 * a).dot(p.normal);
+        jet.weights.row(a).leftCols<N>() =
+            p.normal.transpose() * h.template middleRows<3>(3 * a) +
+            g.template segment<3>(3 * a).transpose() * jet.normal.leftCols<N>();
       }
-      p.force = stiffness_ * std::abs(barrier(d, distance_).first);
-      out.push_back(p);
+      const BarrierValue b = barrier(d, distance_);
+      p.force = stiffness_ * std::abs(b.first);  // b′ < 0 below d̂: λ = −κ b′
+      jet.force.leftCols<N>() = -stiffness_ * b.second * g.transpose();
+      out.push_back(jet);
     });
   });
   return out;

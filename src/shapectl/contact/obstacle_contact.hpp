@@ -62,6 +62,17 @@ struct ContactPair {
   double force = 0;                 // normal force λ = κ |b′(d)|, N
 };
 
+// A pair with the derivatives of what friction lags with respect to its element's node
+// coordinates (3 × node_count columns, the rest zero): how λ, n and w change with the lag state
+// (friction_lag.hpp). From the gap's gradient g and Hessian h: n = Σₐ gₐ (translating the
+// element by t moves the gap by n·t), wₐ = gₐ·n, λ = −κ b′(d).
+struct ContactPairDerivatives {
+  ContactPair pair;
+  Eigen::Matrix<double, 1, 9> force = Eigen::Matrix<double, 1, 9>::Zero();    // ∂λ/∂x
+  Eigen::Matrix<double, 3, 9> normal = Eigen::Matrix<double, 3, 9>::Zero();   // ∂n/∂x
+  Eigen::Matrix<double, 3, 9> weights = Eigen::Matrix<double, 3, 9>::Zero();  // row a: ∂wₐ/∂x
+};
+
 class ObstacleContact : public EnergyTerm {
  public:
   // The object's surface from `mesh` (its surface_triangles()), `obstacles` in the world.
@@ -101,6 +112,8 @@ class ObstacleContact : public EnergyTerm {
   ContactSummary summary(const Positions& x) const;
   // Every pair with 0 < d < d̂ at x, with its closest-point weights, normal and normal force.
   std::vector<ContactPair> pairs(const Positions& x) const;
+  // The same pairs with their derivatives (for the lagged friction's exact sensitivities).
+  std::vector<ContactPairDerivatives> pair_derivatives(const Positions& x) const;
   // The first object surface triangle that intersects or touches (d ≤ 0) an obstacle at x, as
   // {obstacle, triangle index into the mesh's surface_triangles()}; {-1, -1} if none.
   std::array<int, 2> first_intersection(const Positions& x) const;

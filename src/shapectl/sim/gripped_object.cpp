@@ -80,6 +80,8 @@ void GrippedObject::solve_at(ObjectState& state, const Eigen::VectorXd& joints, 
   const GripEnergy grip(*grips_, state.kinematics_);
   const StaticsWorkspace* chord_ws = chord ? chord->workspace_.get() : nullptr;
   const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
+  // The lagged friction anchors at the warm start (lagged_friction.hpp).
+  state.friction_anchor_ = statics_->friction().coefficient > 0 ? state.positions_ : Positions();
   state.statics_ = statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations,
                                    chord_ws, stop, contact ? &*contact : nullptr);
 }
@@ -193,7 +195,25 @@ bool GrippedObject::factored(ObjectState& state, double stale_step) const {
   if (solver.factor_distance(ws, state.positions_) <= stale_step) return true;
   const GripEnergy grip(*grips_, state.kinematics_);
   const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
-  return solver.factor(statics_->terms(&grip, contact ? &*contact : nullptr), ws, state.positions_);
+  EnergyTerms terms = statics_->terms(&grip, contact ? &*contact : nullptr);
+  const std::optional<FixedPointFriction> friction = friction_at(state);
+  if (friction) terms.push_back(&friction->term);
+  return solver.factor(terms, ws, state.positions_);
+}
+
+std::optional<FixedPointFriction> GrippedObject::friction_at(const ObjectState& state) const {
+  if (state.friction_anchor_.size() == 0) return std::nullopt;
+  return fixed_point_friction(*contact_at(state.kinematics_), statics_->friction(),
+                              state.friction_anchor_, state.positions_);
+}
+
+Eigen::MatrixXd GrippedObject::solve_equilibrium(const ObjectState& state,
+                                                 const Eigen::MatrixXd& rhs,
+                                                 bool transposed) const {
+  const std::optional<FixedPointFriction> friction = friction_at(state);
+  if (!friction) return statics_->solver().solve_with_factor(*state.workspace_, rhs);
+  const SparseMatrix lag = transposed ? SparseMatrix(friction->lag.transpose()) : friction->lag;
+  return solve_with_lag(statics_->solver(), *state.workspace_, lag, rhs);
 }
 
 std::optional<ObstacleContact> GrippedObject::moving_contact(const KinematicsState& state) const {
@@ -235,13 +255,13 @@ Eigen::MatrixXd GrippedObject::force_response(ObjectState& state,
                                               const Eigen::MatrixXd& force_change,
                                               double stale_step) const {
   factored(state, stale_step);
-  return statics_->solver().solve_with_factor(*state.workspace_, force_change);
+  return solve_equilibrium(state, force_change, false);
 }
 
 Eigen::VectorXd GrippedObject::adjoint(ObjectState& state, const Eigen::VectorXd& v,
                                        double stale_step) const {
   factored(state, stale_step);
-  const Eigen::VectorXd lambda = statics_->solver().solve_with_factor(*state.workspace_, v);
+  const Eigen::VectorXd lambda = solve_equilibrium(state, v, true);
   Eigen::VectorXd out = grips_->force_jacobian_transpose_times(state.kinematics_, lambda);
   if (const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_))
     add_contact_force_jacobian_transpose_times(*contact, robot(), state.kinematics_,

@@ -1,6 +1,7 @@
 #pragma once
 // The object held by the robot: joint angles θ → quasi-static shape x̂(θ) (paper Section II)
-// and its sensitivity dx̂/dθ = H⁻¹ ∂F/∂θ (eq. 9), H the true Hessian at the equilibrium.
+// and its sensitivity dx̂/dθ = H⁻¹ ∂F/∂θ (eq. 9), H the true Hessian at the equilibrium (with
+// friction, the Jacobian of the lagged fixed point's force balance: friction_sensitivity.hpp).
 //
 // Model and data, as in Pinocchio: GrippedObject is the fixed description (scene, robot, grip
 // springs, energies, fixed nodes, solver options), immutable and shareable across threads;
@@ -12,6 +13,7 @@
 #include <optional>
 
 #include <shapectl/robot/kinematics.hpp>
+#include <shapectl/sim/friction_sensitivity.hpp>
 #include <shapectl/sim/grip_springs.hpp>
 #include <shapectl/sim/object_state.hpp>
 #include <shapectl/sim/object_statics.hpp>
@@ -115,6 +117,13 @@ class GrippedObject {
   // solve() from the state's joints to `to`, sweeping the obstacles on links.
   void solve_swept(ObjectState& state, const Eigen::VectorXd& to, int max_iterations,
                    const ObjectState* chord, const StopRequest& stop) const;
+  // With friction, the friction at the state's lagged fixed point (friction_sensitivity.hpp);
+  // none without friction or for a state never solved.
+  std::optional<FixedPointFriction> friction_at(const ObjectState& state) const;
+  // A⁻¹ rhs (transposed: A⁻ᵀ rhs) with the state's factor, A the Jacobian of the equilibrium's
+  // force balance in x: the Hessian, and with friction its lag Jacobian too.
+  Eigen::MatrixXd solve_equilibrium(const ObjectState& state, const Eigen::MatrixXd& rhs,
+                                    bool transposed) const;
   // Positions and a workspace only.
   ObjectState unsolved_state(const Positions& x, std::shared_ptr<WorkspacePool> workspaces) const;
 

@@ -15,6 +15,8 @@
 // A friction that cannot hold the object (the tangential load beyond μ × the normal force)
 // leaves no equilibrium: the lagged solve fails and the result says which obstacle the object
 // slides along. No stick–slip history is kept beyond the anchor; no dynamics.
+// The result is a fixed point: x balances the friction lagged at x itself. Its sensitivities
+// (friction_sensitivity.hpp) differentiate that balance with the anchor held fixed.
 #include <shapectl/contact/friction.hpp>
 #include <shapectl/sim/statics.hpp>
 

@@ -42,6 +42,10 @@ class ObjectState {
   StaticsResult statics_;
   std::shared_ptr<WorkspacePool> workspaces_;
   std::shared_ptr<StaticsWorkspace> workspace_;  // from workspaces_ if set
+  // With friction: the anchor of its solve (its warm start; lagged_friction.hpp), which the
+  // friction at the equilibrium, hence its Hessian and sensitivities, count slip from. Empty
+  // without friction or before a solve.
+  Positions friction_anchor_;
 };
 
 }  // namespace shapectl
