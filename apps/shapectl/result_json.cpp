@@ -46,6 +46,7 @@ nlohmann::json contacts_json(const ObstacleContact& contact, const Positions& x)
     by_obstacle[contact.obstacles()[k].name] = {{"count", summary.by_obstacle[k].count},
                                                 {"force", vec3_json(summary.by_obstacle[k].force)}};
   out["by_obstacle"] = by_obstacle;
+  out["stiffness"] = summary.stiffness;
   return out;
 }
 

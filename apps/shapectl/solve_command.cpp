@@ -130,7 +130,7 @@ void run_solve(const SolveArgs& args) {
         {{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
   out["loads_total"] = vec3_json(scene.loads_total());
-  if (const auto contact = object.contact_at(best.state->kinematics()))
+  if (const auto contact = object.contact_at(*best.state))
     out["contacts"] = contacts_json(*contact, best.positions());
   out["positions"] = positions_json(best.positions());
   out["targets"] = targets_json(objective.targets());

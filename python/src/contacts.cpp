@@ -28,6 +28,7 @@ py::object contacts_dict(const std::optional<ContactsResult>& contacts) {
       std::isfinite(s.min_distance) ? py::object(py::float_(s.min_distance)) : py::none();
   out["force_total"] = Eigen::Vector3d(s.force_total);
   out["by_obstacle"] = by_obstacle;
+  out["stiffness"] = s.stiffness;
   return out;
 }
 

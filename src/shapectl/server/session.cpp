@@ -559,15 +559,17 @@ void Session::update_contacts() {
   if (!contact || (!contacts_.is_null() && snapshot_->sequence == contacts_sequence_)) return;
   if (snapshot_->positions.size() != 3 * controller_->mesh().node_count()) return;  // none yet
   contacts_sequence_ = snapshot_->sequence;
+  // The forces at the stiffness the state was solved at (the adaptive barrier).
+  const ObstacleContact scaled = contact->scaled(snapshot_->contact_scale);
   if (contact->moves() &&
       snapshot_->joints.size() == controller_->scene().robot->reference_joints.size()) {
     // Obstacles on links where the snapshot's joints put them.
-    const ObstacleContact posed = contact->posed(
+    const ObstacleContact posed = scaled.posed(
         forward_kinematics(*controller_->scene().robot->model, snapshot_->joints).T_world_link);
     contacts_ = contacts_json(posed.summary(snapshot_->positions), posed.obstacles());
     return;
   }
-  contacts_ = contacts_json(contact->summary(snapshot_->positions), contact->obstacles());
+  contacts_ = contacts_json(scaled.summary(snapshot_->positions), scaled.obstacles());
 }
 
 void Session::set_world(std::unique_ptr<SimulatedWorld> world) {

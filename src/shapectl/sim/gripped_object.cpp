@@ -1,5 +1,6 @@
 #include <shapectl/sim/gripped_object.hpp>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include <shapectl/sim/contact_force_jacobian.hpp>
@@ -43,8 +44,10 @@ GrippedObject::GrippedObject(const Scene& scene) : scene_(scene) {
 }
 
 ObjectState GrippedObject::make_state(const Eigen::VectorXd& joints, const Positions& x,
-                                      std::shared_ptr<WorkspacePool> workspaces) const {
+                                      std::shared_ptr<WorkspacePool> workspaces,
+                                      double contact_scale) const {
   ObjectState s = unsolved_state(x, std::move(workspaces));
+  s.statics_.contact_scale = contact_scale;
   s.joints_ = joints;
   s.kinematics_ = forward_kinematics(robot(), joints);
   return s;
@@ -68,8 +71,9 @@ const StaticsResult& GrippedObject::solve(ObjectState& state, const Eigen::Vecto
   const GripEnergy grip(*grips_, state.kinematics_);
   const StaticsWorkspace* chord_ws = chord ? chord->workspace_.get() : nullptr;
   const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
+  const double scale = std::max(state.contact_scale(), chord ? chord->contact_scale() : 1.0);
   state.statics_ = statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations,
-                                   chord_ws, stop, contact ? &*contact : nullptr);
+                                   chord_ws, stop, contact ? &*contact : nullptr, scale);
   return state.statics_;
 }
 
@@ -108,8 +112,12 @@ bool GrippedObject::factored(ObjectState& state, double stale_step) const {
   StaticsWorkspace& ws = *state.workspace_;
   if (solver.factor_distance(ws, state.positions_) <= stale_step) return true;
   const GripEnergy grip(*grips_, state.kinematics_);
+  return solver.factor(statics_->terms(&grip, contact_terms(state)), ws, state.positions_);
+}
+
+ContactTerms GrippedObject::contact_terms(const ObjectState& state) const {
   const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
-  return solver.factor(statics_->terms(&grip, contact ? &*contact : nullptr), ws, state.positions_);
+  return statics_->contact_terms(state.contact_scale(), contact ? &*contact : nullptr);
 }
 
 std::optional<ObstacleContact> GrippedObject::moving_contact(const KinematicsState& state) const {
@@ -118,15 +126,13 @@ std::optional<ObstacleContact> GrippedObject::moving_contact(const KinematicsSta
   return contact->posed(state.T_world_link);
 }
 
-std::optional<ObstacleContact> GrippedObject::contact_at(const KinematicsState& state) const {
-  if (std::optional<ObstacleContact> posed = moving_contact(state)) return posed;
-  if (const ObstacleContact* contact = statics_->contact()) return *contact;
-  return std::nullopt;
+std::optional<ObstacleContact> GrippedObject::contact_at(const ObjectState& state) const {
+  return contact_terms(state).obstacles;
 }
 
 Eigen::MatrixXd GrippedObject::force_jacobian(const ObjectState& state) const {
   Eigen::MatrixXd dF = grips_->force_jacobian(state.kinematics_, node_count());
-  if (const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_))
+  if (const std::optional<ObstacleContact> contact = contact_at(state); contact && contact->moves())
     dF += contact_force_jacobian(*contact, robot(), state.kinematics_, state.positions_);
   return dF;
 }
@@ -159,7 +165,7 @@ Eigen::VectorXd GrippedObject::adjoint(ObjectState& state, const Eigen::VectorXd
   factored(state, stale_step);
   const Eigen::VectorXd lambda = statics_->solver().solve_with_factor(*state.workspace_, v);
   Eigen::VectorXd out = grips_->force_jacobian_transpose_times(state.kinematics_, lambda);
-  if (const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_))
+  if (const std::optional<ObstacleContact> contact = contact_at(state); contact && contact->moves())
     add_contact_force_jacobian_transpose_times(*contact, robot(), state.kinematics_,
                                                state.positions_, lambda, out);
   return out;

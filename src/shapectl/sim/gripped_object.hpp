@@ -39,13 +39,17 @@ class GrippedObject {
   const ObjectStatics& statics() const { return *statics_; }
 
   // A state at θ with positions x (not solved: statics() reports NotConverged, 0 iterations),
-  // its workspace from `workspaces` (null: one of its own).
+  // its workspace from `workspaces` (null: one of its own), its contact stiffness scaled by
+  // `contact_scale` (ObjectState::contact_scale: a solve of it starts there).
   ObjectState make_state(const Eigen::VectorXd& joints, const Positions& x,
-                         std::shared_ptr<WorkspacePool> workspaces = nullptr) const;
+                         std::shared_ptr<WorkspacePool> workspaces = nullptr,
+                         double contact_scale = 1) const;
   // Equilibrium at θ = joints, Newton from the state's positions; `state` then describes it.
   // Newton tries steps with `chord`'s factorization first if it holds one (a nearby state's,
   // e.g. the one the warm start came from; it may be `state` itself). max_iterations > 0
-  // caps Newton for this call; `stop` may end it early (a time budget).
+  // caps Newton for this call; `stop` may end it early (a time budget). The contact stiffness
+  // starts at the larger contact_scale() of `state` and `chord` (adaptive barrier: it only grows
+  // along a chain of states).
   const StaticsResult& solve(ObjectState& state, const Eigen::VectorXd& joints,
                              int max_iterations = 0, const ObjectState* chord = nullptr,
                              const StopRequest& stop = {}) const;
@@ -87,14 +91,17 @@ class GrippedObject {
   // The contact term with its obstacles on links placed at `state`; none if no obstacle is on
   // a link (then statics().contact() is the term at every θ).
   std::optional<ObstacleContact> moving_contact(const KinematicsState& state) const;
-  // The contact term with the robot at `state` (for its contacts); none without obstacles.
-  std::optional<ObstacleContact> contact_at(const KinematicsState& state) const;
+  // The contact term at `state` (for its contacts): obstacles on links at its joints, κ at its
+  // contact_scale(); none without obstacles.
+  std::optional<ObstacleContact> contact_at(const ObjectState& state) const;
   // (dx̂/dθ)ᵀ v by the adjoint method, one solve: λ = H⁻¹ v, result = (∂F/∂θ)ᵀ λ.
   Eigen::VectorXd adjoint(ObjectState& state, const Eigen::VectorXd& v,
                           double stale_step = 0) const;
 
  private:
   bool factored(ObjectState& state, double stale_step) const;
+  // The contact terms at `state`: posed at its joints, κ at its contact_scale().
+  ContactTerms contact_terms(const ObjectState& state) const;
   // Positions and a workspace only.
   ObjectState unsolved_state(const Positions& x, std::shared_ptr<WorkspacePool> workspaces) const;
 
