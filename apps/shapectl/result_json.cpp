@@ -57,6 +57,7 @@ nlohmann::json contacts_json(const ObstacleContact* contact, const SelfContact* 
     out["self"] = {{"count", s.count}};
     if (std::isfinite(s.min_distance)) out["self"]["min_distance"] = s.min_distance;
   }
+  if (contact) out["stiffness"] = summary.stiffness;
   return out;
 }
 

@@ -130,7 +130,7 @@ void run_solve(const SolveArgs& args) {
         {{"joint", v.joint}, {"value", v.value}, {"lower", v.lower}, {"upper", v.upper}});
   out["limit_violations"] = violations;
   out["loads_total"] = vec3_json(scene.loads_total());
-  const auto contact = object.contact_at(best.state->kinematics());
+  const auto contact = object.contact_at(*best.state);
   if (auto contacts = contacts_json(contact ? &*contact : nullptr, object.statics().self_contact(),
                                     best.positions());
       !contacts.is_null())

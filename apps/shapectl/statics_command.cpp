@@ -4,6 +4,7 @@
 // joints) and writes the deformed positions.
 #include <chrono>
 #include <iostream>
+#include <optional>
 
 #include <shapectl/io/atomic_file.hpp>
 #include <shapectl/io/input_error.hpp>
@@ -39,9 +40,12 @@ struct StaticsArgs {
 // the scene has obstacles), so the failure can be inspected,
 // but never with a non-finite number, and with --vtu or --surface all files or none.
 // `seconds`: set-up and Newton, reported on stderr (not in RESULT.json: it stays reproducible).
+// `contact`: the contact term at x (posed at the joints, at the solve's stiffness); none without
+// obstacles.
 void write_outputs(const StaticsArgs& args, const StaticsResult& r, const Scene& scene,
-                   const ObjectStatics& statics, const Positions& rest, const Positions& x,
-                   nlohmann::json result, double seconds) {
+                   const ObjectStatics& statics, const std::optional<ObstacleContact>& contact,
+                   const Positions& rest, const Positions& x, nlohmann::json result,
+                   double seconds) {
   const TetMesh& mesh = statics.mesh();
   result["converged"] = r.converged();
   result["status"] = to_string(r.status);
@@ -50,7 +54,7 @@ void write_outputs(const StaticsArgs& args, const StaticsResult& r, const Scene&
   result["residual"] = r.residual;
   result["energy"] = r.energy;
   result["loads_total"] = vec3_json(scene.loads_total());
-  if (auto contacts = contacts_json(statics.contact(), statics.self_contact(), x);
+  if (auto contacts = contacts_json(contact ? &*contact : nullptr, statics.self_contact(), x);
       !contacts.is_null())
     result["contacts"] = std::move(contacts);
   result["positions"] = positions_json(x);
@@ -86,15 +90,16 @@ void run_statics(const StaticsArgs& args) {
       throw InputError(args.joints, "", "joints given, but the scene has no robot");
     ObjectStatics statics(scene);
     const StaticsResult r = statics.solve(x);
-    write_outputs(args, r, scene, statics, rest, x, nlohmann::json::object(), seconds_since(start));
+    write_outputs(args, r, scene, statics, statics.contact_terms(r.contact_scale).obstacles, rest,
+                  x, nlohmann::json::object(), seconds_since(start));
     return;
   }
   GrippedObject object(scene);
   Eigen::VectorXd joints = object.reference_joints();
   if (!args.joints.empty()) joints = load_joints_file(args.joints, object.robot(), joints);
   const ObjectState state = object.solve_from(joints, x);
-  write_outputs(args, state.statics(), scene, object.statics(), rest, state.positions(),
-                robot_json(scene, joints), seconds_since(start));
+  write_outputs(args, state.statics(), scene, object.statics(), object.contact_at(state), rest,
+                state.positions(), robot_json(scene, joints), seconds_since(start));
 }
 
 }  // namespace

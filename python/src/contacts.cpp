@@ -43,6 +43,7 @@ py::object contacts_dict(const std::optional<ContactsResult>& contacts) {
         std::isfinite(self->min_distance) ? py::object(py::float_(self->min_distance)) : py::none();
     out["self"] = one;
   }
+  if (!contacts->obstacle_names.empty()) out["stiffness"] = s.stiffness;
   return out;
 }
 

@@ -112,7 +112,7 @@ SolveResult solve(const SceneHandle& s, const py::object& targets_in,
   out.limit_violations = violations_at(object.robot(), best.joints());
   out.loads_total = s.scene->loads_total();
   out.positions = best.positions();
-  const auto contact = object.contact_at(best.state->kinematics());
+  const auto contact = object.contact_at(*best.state);
   out.contacts =
       contacts_at(contact ? &*contact : nullptr, object.statics().self_contact(), out.positions);
   out.targets = objective.targets();

@@ -30,7 +30,9 @@ StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in)
     out.positions = s.scene->world_rest_positions();
     const ObjectStatics statics(*s.scene);
     out.result = statics.solve(out.positions);
-    out.contacts = contacts_at(statics.contact(), statics.self_contact(), out.positions);
+    const std::optional<ObstacleContact> contact =
+        statics.contact_terms(out.result.contact_scale).obstacles;
+    out.contacts = contacts_at(contact ? &*contact : nullptr, statics.self_contact(), out.positions);
     return out;
   }
   const GrippedObject& object = *s.object;
@@ -40,7 +42,7 @@ StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in)
       object.solve_from(joints, object.reference_positions(), 0, nullptr, {}, s.workspaces);
   out.result = state.statics();
   out.positions = state.positions();
-  const auto contact = object.contact_at(state.kinematics());
+  const auto contact = object.contact_at(state);
   out.contacts =
       contacts_at(contact ? &*contact : nullptr, object.statics().self_contact(), out.positions);
   out.joints = joints;

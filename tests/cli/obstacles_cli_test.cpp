@@ -63,6 +63,25 @@ TEST(ObstaclesCli, StaticsOnATableReportsTheContacts) {
   for (const auto& p : s.result["positions"]) EXPECT_GT(p[2].get<double>(), -0.0155);
 }
 
+// A given contact.stiffness is where κ starts (docs/contact.md, "Adaptive stiffness"): one far
+// too small for the bar's sag onto the table is raised until no gap is below d̂/100, and the
+// contacts report the κ the result is at.
+TEST(ObstaclesCli, StaticsRaiseATooSmallStiffnessAndReportIt) {
+  TempDir dir;
+  const Statics s =
+      statics(dir, bar_with(kTable + R"(, "contact": {"distance": 0.001, "stiffness": 1e-4})"));
+  ASSERT_EQ(s.run.exit_code, 0) << s.run.err;
+  ASSERT_TRUE(s.result["converged"].get<bool>());
+  EXPECT_NE(s.result["reason"].get<std::string>().find("contact stiffness ×"), std::string::npos)
+      << s.result["reason"];
+  const nlohmann::json& c = s.result["contacts"];
+  EXPECT_GT(c["count"].get<int>(), 0);
+  EXPECT_GT(c["stiffness"].get<double>(), 1e-4);
+  EXPECT_GE(c["min_distance"].get<double>(), 1e-5);
+  // The table still carries part of the weight, upwards.
+  EXPECT_GT(c["force_total"][2].get<double>(), 0.01);
+}
+
 TEST(ObstaclesCli, AnObstacleOutOfReachGivesNoContactsAndNoDistance) {
   TempDir dir;
   const Statics s =

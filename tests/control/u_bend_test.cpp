@@ -151,7 +151,7 @@ TEST(UBend, TheYumiBendsTheBarIntoAUUntilItsEndsTouch) {
   self.hessian_elements(x, pairs);
   const double gap = self.min_distance(x);
   // The robot's spheres as obstacles, placed at the joints reached.
-  const std::optional<ObstacleContact> posed = object.contact_at(with.state.state->kinematics());
+  const std::optional<ObstacleContact> posed = object.contact_at(*with.state.state);
   ASSERT_TRUE(posed.has_value());
   const ContactSummary robot = posed->summary(x);
   std::cout << "  end faces' centres " << ends_apart(ends, rest) * 1e3 << " mm apart at rest, "

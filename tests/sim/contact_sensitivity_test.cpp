@@ -65,7 +65,6 @@ Scene u_bar(double force) {
   scene.loads[0].force = force * Vec3(1, 0, -1).normalized();
   scene.loads[1].force = force * Vec3(-1, 0, -1).normalized();
   scene.contact.self = true;
-  scene.contact.stiffness = 100;
   scene.statics.relative_tolerance = 1e-8;  // FD of equilibria needs them tight
   scene.statics.max_iterations = 300;
   return scene;

@@ -82,7 +82,6 @@ TEST(LinkContact, SensitivityMatchesCentralDifferencesRestingOnALinkBox) {
   // the right arm lowers its end onto it.
   test::LinkBox b =
       test::two_arm_scene_with_link_box({24, 2, 2}, "l_link2", Vec3(0.25, 0.05, 0.02), 0.0005);
-  b.scene.contact.stiffness = 20;  // the arm presses: keep the gaps near d̂/2 (docs/contact.md)
   b.scene.statics.relative_tolerance = 1e-8;
   b.scene.statics.max_iterations = 300;
   GrippedObject object(b.scene);

@@ -23,15 +23,10 @@ struct PushedBar {
 // box and the bar's left end alike; the right end stays, so the box rises into the middle.
 PushedBar pushed_bar() {
   PushedBar s{test::two_arm_scene_with_link_box({24, 2, 2}, "l_link2", Vec3(0.1, 0.05, 0.02), 5e-4),
-              Eigen::VectorXd::Zero(6)};
+              {}};
   // A contact stiff enough for the arm's push (the default suits the bar's weight alone).
   s.box.scene.contact.stiffness = 20;
-  const RobotModel& robot = *s.box.scene.robot->model;
-  Eigen::VectorXd theta = s.box.scene.robot->reference_joints;
-  const double z0 = s.box.shape(forward_kinematics(robot, theta)).pose.translation().z();
-  theta[1] += 1e-3;
-  const double z1 = s.box.shape(forward_kinematics(robot, theta)).pose.translation().z();
-  s.up[1] = z1 > z0 ? 1 : -1;
+  s.up = test::lifting_step(s.box, 1);
   return s;
 }
 

@@ -51,4 +51,17 @@ inline LinkBox two_arm_scene_with_link_box(
   return b;
 }
 
+// The unit step of joint `joint` (±1 in that joint, 0 in the others) that lifts the box at the
+// reference joints.
+inline Eigen::VectorXd lifting_step(const LinkBox& b, int joint) {
+  const RobotModel& robot = *b.scene.robot->model;
+  Eigen::VectorXd theta = b.scene.robot->reference_joints;
+  const double z0 = b.shape(forward_kinematics(robot, theta)).pose.translation().z();
+  theta[joint] += 1e-3;
+  const double z1 = b.shape(forward_kinematics(robot, theta)).pose.translation().z();
+  Eigen::VectorXd up = Eigen::VectorXd::Zero(theta.size());
+  up[joint] = z1 > z0 ? 1 : -1;
+  return up;
+}
+
 }  // namespace shapectl::test

@@ -1,6 +1,7 @@
 #pragma once
 // dx̂/dθ at a converged state against central differences of equilibria re-solved at θ ± h
-// (each warm-started from the state's positions), and the adjoint against (dx̂/dθ)ᵀ v.
+// (each warm-started from the state's positions, at its contact stiffness: the derivative of
+// the equilibrium map at that κ), and the adjoint against (dx̂/dθ)ᵀ v.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -18,8 +19,10 @@ inline void expect_sensitivity_matches(const GrippedObject& object, ObjectState&
   const Eigen::VectorXd theta = state.joints();
   const Eigen::MatrixXd dx = object.sensitivity(state);
   const auto equilibrium = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
-    const ObjectState moved = object.solve_from(t, x);
+    ObjectState moved = object.make_state(t, x, nullptr, state.contact_scale());
+    object.solve(moved, t);
     EXPECT_TRUE(moved.statics().converged()) << moved.statics().reason;
+    EXPECT_EQ(moved.contact_scale(), state.contact_scale()) << "raised again";
     return moved.positions();
   };
   EXPECT_TRUE(derivative_matches(dx, central_difference_jacobian(equilibrium, theta, 1e-5),

@@ -139,7 +139,8 @@ std::shared_ptr<const Equilibrium> fixed_equilibrium(const Scene& placed,
   auto e = std::make_shared<Equilibrium>();
   if (options.with_sensitivity) {
     const StaticsSolver& solver = statics.solver();
-    if (!solver.factor(statics.terms(), ws, x))
+    // At the stiffness the solve ended at (the adaptive contact barrier).
+    if (!solver.factor(statics.terms(nullptr, statics.contact_terms(r.contact_scale)), ws, x))
       throw std::runtime_error("frame " + std::to_string(frame) +
                                ": the fixed scene's equilibrium is unstable (its Hessian is not "
                                "positive definite)");

@@ -675,6 +675,13 @@ ObstacleContact ObstacleContact::posed(const std::vector<Eigen::Isometry3d>& T_w
   return out;
 }
 
+ObstacleContact ObstacleContact::scaled(double factor) const {
+  ObstacleContact out = *this;
+  out.stiffness_ *= factor;
+  check_barrier_parameters("ObstacleContact", distance_, out.stiffness_);
+  return out;
+}
+
 double ObstacleContact::value(const Positions& x) const {
   const Impl& m = *impl_;
   double sum = 0;
@@ -889,6 +896,7 @@ ContactSummary ObstacleContact::summary(const Positions& x) const {
   const Impl& m = *impl_;
   ContactSummary s;
   s.min_distance = kInf;
+  s.stiffness = stiffness_;
   s.by_obstacle.resize(obstacles_->size());
   m.for_each_contact(x, distance_, [&](const Contact& contact) {
     with_element_size(m.element_size(contact), [&](auto k) {

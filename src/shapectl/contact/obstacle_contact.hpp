@@ -48,6 +48,7 @@ struct ContactSummary {
   };
   std::vector<PerObstacle> by_obstacle;  // in obstacle order
   std::vector<ContactPoint> points;      // every pair with d < d̂
+  double stiffness = 0;                  // the term's κ (the adaptive barrier may have raised it)
 };
 
 // One pair in contact at x, as friction (friction.hpp) lags it: the object's closest point is
@@ -86,6 +87,9 @@ class ObstacleContact : public EnergyTerm {
   // The same term with the obstacles on links placed by T_world_link (the surface, hence the
   // Hessian's elements, unchanged); a copy sharing everything if none moves.
   ObstacleContact posed(const std::vector<Eigen::Isometry3d>& T_world_link) const;
+  // The same term with κ multiplied by `factor` > 0 (the adaptive stiffness,
+  // sim/contact_stiffness.hpp), sharing everything else.
+  ObstacleContact scaled(double factor) const;
   // ∂²E/∂x∂p at x for the obstacles on links: visit(node, obstacle, p, B) for each object node
   // and obstacle point p (world, where it is now) of every contact within d̂, B = ∂²E/∂xₙ∂p
   // (3 × 3). p moves rigidly with its link, so ∂F/∂θ = −Σ B ∂p/∂θ.

@@ -278,6 +278,13 @@ SelfContact::SelfContact(const TetMesh& mesh, double distance, double stiffness)
   impl_ = std::move(m);
 }
 
+SelfContact SelfContact::scaled(double factor) const {
+  SelfContact out = *this;
+  out.stiffness_ *= factor;
+  check_barrier_parameters("SelfContact", distance_, out.stiffness_);
+  return out;
+}
+
 double SelfContact::value(const Positions& x) const {
   const Impl& m = *impl_;
   double sum = 0;

@@ -53,6 +53,9 @@ class SelfContact : public EnergyTerm {
   // The surface of `mesh` (its surface_triangles()); its rest positions decide which pairs are
   // neighbours (closer than `distance` at rest). κ = stiffness, J/m².
   SelfContact(const TetMesh& mesh, double distance, double stiffness);
+  // The same term with κ multiplied by `factor` > 0 (the adaptive stiffness,
+  // sim/contact_stiffness.hpp), sharing everything else.
+  SelfContact scaled(double factor) const;
 
   std::string_view name() const override { return "self-contact"; }
   double value(const Positions& x) const override;

@@ -456,6 +456,7 @@ void Controller::State::publish() {
   s->upper_limits = robot.upper_limits();
   s->T_world_link = forward_kinematics(robot, current.joints()).T_world_link;
   s->positions = current.positions();
+  s->contact_scale = current.state->contact_scale();
   s->targets = user_targets;
   s->centerline = centerline;
   s->error = current.error;

@@ -86,6 +86,7 @@ struct ControllerSnapshot {
   Eigen::VectorXd lower_limits, upper_limits;
   std::vector<Eigen::Isometry3d> T_world_link;  // every link of the robot model
   Positions positions;                          // x̂(θ), 3n
+  double contact_scale = 1;      // the factor on the contact stiffness at positions (ObjectState's)
   ShapeTargets targets;          // what is asked for now (the user's, not the corrected ones)
   std::vector<Vec3> centerline;  // the sketched centre-line, if the targets came from one
   ShapeError error;              // of positions against targets

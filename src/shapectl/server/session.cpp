@@ -572,16 +572,18 @@ void Session::update_contacts() {
     contacts_ = contacts_json(none, {}, max_contact_points, self_part);
     return;
   }
+  // The forces at the stiffness the state was solved at (the adaptive barrier).
+  const ObstacleContact scaled = contact->scaled(snapshot_->contact_scale);
   if (contact->moves() &&
       snapshot_->joints.size() == controller_->scene().robot->reference_joints.size()) {
     // Obstacles on links where the snapshot's joints put them.
-    const ObstacleContact posed = contact->posed(
+    const ObstacleContact posed = scaled.posed(
         forward_kinematics(*controller_->scene().robot->model, snapshot_->joints).T_world_link);
     contacts_ = contacts_json(posed.summary(snapshot_->positions), posed.obstacles(),
                               max_contact_points, self_part);
     return;
   }
-  contacts_ = contacts_json(contact->summary(snapshot_->positions), contact->obstacles(),
+  contacts_ = contacts_json(scaled.summary(snapshot_->positions), scaled.obstacles(),
                             max_contact_points, self_part);
 }
 

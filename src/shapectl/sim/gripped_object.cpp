@@ -1,5 +1,6 @@
 #include <shapectl/sim/gripped_object.hpp>
 
+#include <algorithm>
 #include <stdexcept>
 
 #include <shapectl/sim/contact_force_jacobian.hpp>
@@ -45,8 +46,10 @@ GrippedObject::GrippedObject(const Scene& scene) : scene_(scene) {
 }
 
 ObjectState GrippedObject::make_state(const Eigen::VectorXd& joints, const Positions& x,
-                                      std::shared_ptr<WorkspacePool> workspaces) const {
+                                      std::shared_ptr<WorkspacePool> workspaces,
+                                      double contact_scale) const {
   ObjectState s = unsolved_state(x, std::move(workspaces));
+  s.statics_.contact_scale = contact_scale;
   s.joints_ = joints;
   s.kinematics_ = forward_kinematics(robot(), joints);
   return s;
@@ -82,8 +85,9 @@ void GrippedObject::solve_at(ObjectState& state, const Eigen::VectorXd& joints, 
   const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
   // The lagged friction anchors at the warm start (lagged_friction.hpp).
   state.friction_anchor_ = statics_->friction().coefficient > 0 ? state.positions_ : Positions();
+  const double scale = std::max(state.contact_scale(), chord ? chord->contact_scale() : 1.0);
   state.statics_ = statics_->solve(*state.workspace_, state.positions_, &grip, max_iterations,
-                                   chord_ws, stop, contact ? &*contact : nullptr);
+                                   chord_ws, stop, contact ? &*contact : nullptr, scale);
 }
 
 void GrippedObject::solve_swept(ObjectState& state, const Eigen::VectorXd& to, int max_iterations,
@@ -194,16 +198,20 @@ bool GrippedObject::factored(ObjectState& state, double stale_step) const {
   StaticsWorkspace& ws = *state.workspace_;
   if (solver.factor_distance(ws, state.positions_) <= stale_step) return true;
   const GripEnergy grip(*grips_, state.kinematics_);
-  const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
-  EnergyTerms terms = statics_->terms(&grip, contact ? &*contact : nullptr);
+  EnergyTerms terms = statics_->terms(&grip, contact_terms(state));
   const std::optional<FixedPointFriction> friction = friction_at(state);
   if (friction) terms.push_back(&friction->term);
   return solver.factor(terms, ws, state.positions_);
 }
 
+ContactTerms GrippedObject::contact_terms(const ObjectState& state) const {
+  const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_);
+  return statics_->contact_terms(state.contact_scale(), contact ? &*contact : nullptr);
+}
+
 std::optional<FixedPointFriction> GrippedObject::friction_at(const ObjectState& state) const {
   if (state.friction_anchor_.size() == 0) return std::nullopt;
-  return fixed_point_friction(*contact_at(state.kinematics_), statics_->friction(),
+  return fixed_point_friction(*contact_at(state), statics_->friction(),
                               state.friction_anchor_, state.positions_);
 }
 
@@ -222,15 +230,13 @@ std::optional<ObstacleContact> GrippedObject::moving_contact(const KinematicsSta
   return contact->posed(state.T_world_link);
 }
 
-std::optional<ObstacleContact> GrippedObject::contact_at(const KinematicsState& state) const {
-  if (std::optional<ObstacleContact> posed = moving_contact(state)) return posed;
-  if (const ObstacleContact* contact = statics_->contact()) return *contact;
-  return std::nullopt;
+std::optional<ObstacleContact> GrippedObject::contact_at(const ObjectState& state) const {
+  return contact_terms(state).obstacles;
 }
 
 Eigen::MatrixXd GrippedObject::force_jacobian(const ObjectState& state) const {
   Eigen::MatrixXd dF = grips_->force_jacobian(state.kinematics_, node_count());
-  if (const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_))
+  if (const std::optional<ObstacleContact> contact = contact_at(state); contact && contact->moves())
     dF += contact_force_jacobian(*contact, robot(), state.kinematics_, state.positions_);
   return dF;
 }
@@ -263,7 +269,7 @@ Eigen::VectorXd GrippedObject::adjoint(ObjectState& state, const Eigen::VectorXd
   factored(state, stale_step);
   const Eigen::VectorXd lambda = solve_equilibrium(state, v, true);
   Eigen::VectorXd out = grips_->force_jacobian_transpose_times(state.kinematics_, lambda);
-  if (const std::optional<ObstacleContact> contact = moving_contact(state.kinematics_))
+  if (const std::optional<ObstacleContact> contact = contact_at(state); contact && contact->moves())
     add_contact_force_jacobian_transpose_times(*contact, robot(), state.kinematics_,
                                                state.positions_, lambda, out);
   return out;

@@ -41,9 +41,11 @@ class GrippedObject {
   const ObjectStatics& statics() const { return *statics_; }
 
   // A state at θ with positions x (not solved: statics() reports NotConverged, 0 iterations),
-  // its workspace from `workspaces` (null: one of its own).
+  // its workspace from `workspaces` (null: one of its own), its contact stiffness scaled by
+  // `contact_scale` (ObjectState::contact_scale: a solve of it starts there).
   ObjectState make_state(const Eigen::VectorXd& joints, const Positions& x,
-                         std::shared_ptr<WorkspacePool> workspaces = nullptr) const;
+                         std::shared_ptr<WorkspacePool> workspaces = nullptr,
+                         double contact_scale = 1) const;
   // Equilibrium at θ = joints, Newton from the state's positions; `state` then describes it.
   // Newton tries steps with `chord`'s factorization first if it holds one (a nearby state's,
   // e.g. the one the warm start came from; it may be `state` itself). max_iterations > 0
@@ -53,6 +55,8 @@ class GrippedObject {
   // (ObstacleContact::max_obstacle_step); where one would reach the object, the step is
   // split: solved at θ0 + s (θ1 − θ0), the equilibrium carried on, and so on up to `joints`
   // (quasi-static continuation, at most contact.sweep_steps sub-steps, else refused).
+  // The contact stiffness starts at the larger contact_scale() of `state` and `chord` (adaptive
+  // barrier: it only grows along a chain of states).
   const StaticsResult& solve(ObjectState& state, const Eigen::VectorXd& joints,
                              int max_iterations = 0, const ObjectState* chord = nullptr,
                              const StopRequest& stop = {}) const;
@@ -103,8 +107,9 @@ class GrippedObject {
   // The contact term with its obstacles on links placed at `state`; none if no obstacle is on
   // a link (then statics().contact() is the term at every θ).
   std::optional<ObstacleContact> moving_contact(const KinematicsState& state) const;
-  // The contact term with the robot at `state` (for its contacts); none without obstacles.
-  std::optional<ObstacleContact> contact_at(const KinematicsState& state) const;
+  // The contact term at `state` (for its contacts): obstacles on links at its joints, κ at its
+  // contact_scale(); none without obstacles.
+  std::optional<ObstacleContact> contact_at(const ObjectState& state) const;
   // (dx̂/dθ)ᵀ v by the adjoint method, one solve: λ = H⁻¹ v, result = (∂F/∂θ)ᵀ λ.
   Eigen::VectorXd adjoint(ObjectState& state, const Eigen::VectorXd& v,
                           double stale_step = 0) const;
@@ -124,6 +129,8 @@ class GrippedObject {
   // force balance in x: the Hessian, and with friction its lag Jacobian too.
   Eigen::MatrixXd solve_equilibrium(const ObjectState& state, const Eigen::MatrixXd& rhs,
                                     bool transposed) const;
+  // The contact terms at `state`: posed at its joints, κ at its contact_scale().
+  ContactTerms contact_terms(const ObjectState& state) const;
   // Positions and a workspace only.
   ObjectState unsolved_state(const Positions& x, std::shared_ptr<WorkspacePool> workspaces) const;
 

@@ -39,14 +39,6 @@ Slide find_slide(const ObstacleFriction& f, const Positions& x, std::size_t obst
   return s;
 }
 
-// `next` after `sum`: its status and reason, the totals of both.
-void add_solve(StaticsResult& sum, StaticsResult next) {
-  next.iterations += sum.iterations;
-  next.factorizations += sum.factorizations;
-  next.log.insert(next.log.begin(), sum.log.begin(), sum.log.end());
-  sum = std::move(next);
-}
-
 }  // namespace
 
 StaticsResult solve_with_friction(const StaticsSolver& solver, const EnergyTerms& terms,

@@ -25,6 +25,11 @@ class ObjectState {
   const KinematicsState& kinematics() const { return kinematics_; }
   const Positions& positions() const { return positions_; }
   const StaticsResult& statics() const { return statics_; }
+  // The factor on the contact stiffness κ its positions are at (the adaptive barrier,
+  // contact_stiffness.hpp): 1 until a solve raises it. Every derivative at the state (its
+  // factorization, ∂F/∂θ, dx̂/dθ, the contacts' forces) is at that κ, and states solved with
+  // this one as the chord start from it.
+  double contact_scale() const { return statics_.contact_scale; }
   // Whether it holds a factorization (of the Hessian at its positions, or at the last Newton
   // iterate before them).
   bool has_factor() const { return workspace_ && workspace_->has_factor; }

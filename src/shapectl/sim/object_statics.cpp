@@ -212,13 +212,30 @@ EnergyTerms ObjectStatics::terms(const EnergyTerm* extra, const ObstacleContact*
   return t;
 }
 
+ContactTerms ObjectStatics::contact_terms(double scale, const ObstacleContact* posed) const {
+  ContactTerms out;
+  if (contact_) out.obstacles = (posed ? *posed : *contact_).scaled(scale);
+  if (self_contact_) out.self = self_contact_->scaled(scale);
+  return out;
+}
+
+EnergyTerms ObjectStatics::terms(const EnergyTerm* extra, const ContactTerms& contact) const {
+  EnergyTerms t = {&elasticity_, &gravity_};
+  if (loads_) t.push_back(&*loads_);
+  if (contact.obstacles) t.push_back(&*contact.obstacles);
+  if (contact.self) t.push_back(&*contact.self);
+  if (extra) t.push_back(extra);
+  return t;
+}
+
 Eigen::VectorXd ObjectStatics::load_forces() const {
   return loads_ ? loads_->forces() : Eigen::VectorXd::Zero(3 * mesh_->node_count());
 }
 
 StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra,
                                    int max_iterations, const StaticsWorkspace* chord,
-                                   const StopRequest& stop, const ObstacleContact* posed) const {
+                                   const StopRequest& stop, const ObstacleContact* posed,
+                                   double contact_scale) const {
   const auto refused = [](StaticsStatus status, std::string reason) {
     StaticsResult r;
     r.status = status;
@@ -246,10 +263,19 @@ StaticsResult ObjectStatics::solve(StaticsWorkspace& ws, Positions& x, const Ene
                          std::to_string(a) + " and " + std::to_string(b) +
                          "): no equilibrium sought from there");
   }
-  if (contact_ && friction_.coefficient > 0)
-    return solve_with_friction(solver_, terms(extra, posed), posed ? *posed : *contact_, friction_,
-                               ws, x, max_iterations, chord, stop);
-  return solver_.solve(terms(extra, posed), ws, x, max_iterations, chord, stop);
+  const bool with_friction = contact_ && friction_.coefficient > 0;
+  const auto solve_at = [&](double scale, Positions& y, const StaticsWorkspace* from) {
+    const ContactTerms contact = contact_terms(scale, posed);
+    if (with_friction)
+      return solve_with_friction(solver_, terms(extra, contact), *contact.obstacles, friction_, ws,
+                                 y, max_iterations, from, stop);
+    return solver_.solve(terms(extra, contact), ws, y, max_iterations, from, stop);
+  };
+  if (!contact_ && !self_contact_)
+    return solver_.solve(terms(extra), ws, x, max_iterations, chord, stop);
+  const double dhat = contact_ ? contact_->distance() : self_contact_->distance();
+  return solve_adapting_stiffness(solve_at, contact_terms(1, posed), dhat, contact_scale, ws, x,
+                                  chord, with_friction, stop);
 }
 
 StaticsResult ObjectStatics::solve(Positions& x, int max_iterations) const {

@@ -11,6 +11,7 @@
 #include <shapectl/contact/self_contact.hpp>
 #include <shapectl/fem/gravity.hpp>
 #include <shapectl/fem/neo_hookean.hpp>
+#include <shapectl/sim/contact_stiffness.hpp>
 #include <shapectl/sim/lagged_friction.hpp>
 #include <shapectl/sim/scene.hpp>
 #include <shapectl/sim/statics.hpp>
@@ -31,15 +32,23 @@ class ObjectStatics {
   // same term posed at other joint angles (ObstacleContact::posed).
   EnergyTerms terms(const EnergyTerm* extra = nullptr,
                     const ObstacleContact* contact = nullptr) const;
+  // The contact terms at a state: `posed` (null: contact()) and self_contact(), each with κ
+  // multiplied by `scale` (the state's adaptive stiffness, contact_stiffness.hpp).
+  ContactTerms contact_terms(double scale = 1, const ObstacleContact* posed = nullptr) const;
+  // The object's energy terms with `contact`'s contact terms, plus `extra` if given.
+  EnergyTerms terms(const EnergyTerm* extra, const ContactTerms& contact) const;
   StaticsWorkspace make_workspace() const { return solver_.make_workspace(); }
   // Equilibrium from the warm start x (fixed nodes must be at their prescribed positions) with
   // the energy plus `extra`, in `ws` (see StaticsSolver::solve for `chord`). An object that
   // nothing holds is reported as Singular without iterating; a start that touches or intersects
   // an obstacle or itself as Inverted without iterating, naming the obstacle or the triangles.
-  // `contact`: as in terms().
+  // `contact`: as in terms(). The contact stiffness starts at κ × contact_scale and is raised
+  // where a gap ends pressed below d̂/100 (contact_stiffness.hpp): the result's contact_scale
+  // is the scale of x (the same as the workspace's factorization, if it holds one).
   StaticsResult solve(StaticsWorkspace& ws, Positions& x, const EnergyTerm* extra = nullptr,
                       int max_iterations = 0, const StaticsWorkspace* chord = nullptr,
-                      const StopRequest& stop = {}, const ObstacleContact* contact = nullptr) const;
+                      const StopRequest& stop = {}, const ObstacleContact* contact = nullptr,
+                      double contact_scale = 1) const;
   // The same from scratch (a workspace of its own, no earlier factorization).
   StaticsResult solve(Positions& x, int max_iterations = 0) const;
   // The true Hessian of the object's own energy at x (for tests and tools).

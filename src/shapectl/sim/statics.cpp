@@ -591,6 +591,13 @@ StaticsSolver::Outcome StaticsSolver::line_search_step(const EnergyTerms& terms,
   return Outcome::Stepped;
 }
 
+void add_solve(StaticsResult& sum, StaticsResult next) {
+  next.iterations += sum.iterations;
+  next.factorizations += sum.factorizations;
+  next.log.insert(next.log.begin(), sum.log.begin(), sum.log.end());
+  sum = std::move(next);
+}
+
 StaticsResult StaticsSolver::solve(const EnergyTerms& terms, StaticsWorkspace& ws, Positions& x,
                                    int max_iterations, const StaticsWorkspace* chord,
                                    const StopRequest& stop) const {

@@ -113,8 +113,15 @@ struct StaticsResult {
   double residual = 0;     // largest nodal force norm at the returned state, N
   double energy = 0;
   std::vector<NewtonIterate> log;
+  // The factor on the contact stiffness κ the returned state is at (ObjectStatics' adaptive
+  // barrier, sim/contact_stiffness.hpp); 1 unless contact pressed a gap below d̂/100.
+  double contact_scale = 1;
   bool converged() const { return status == StaticsStatus::Converged; }
 };
+
+// A solve made of several Newton runs: `next` after `sum`, with next's status, reason and
+// state, the iterations, factorizations and log of both.
+void add_solve(StaticsResult& sum, StaticsResult next);
 
 // The mutable half of statics: the assembled Hessian, its factorization and the point it
 // belongs to (plus the symbolic analysis and buffers, reused from call to call). Made by
