@@ -32,7 +32,8 @@ StaticsSolution solve_statics(const SceneHandle& s, const py::object& joints_in)
     out.result = statics.solve(out.positions);
     const std::optional<ObstacleContact> contact =
         statics.contact_terms(out.result.contact_scale).obstacles;
-    out.contacts = contacts_at(contact ? &*contact : nullptr, statics.self_contact(), out.positions);
+    out.contacts =
+        contacts_at(contact ? &*contact : nullptr, statics.self_contact(), out.positions);
     return out;
   }
   const GrippedObject& object = *s.object;

@@ -64,7 +64,7 @@ void expect_exact_with_friction(double swing, bool sticking) {
   Dragged d = drag(object, swing);
   ASSERT_TRUE(d.state.statics().converged());
   const FixedPointFriction friction =
-      fixed_point_friction(*object.statics().contact(), object.statics().friction(), d.anchor,
+      fixed_point_friction(*object.contact_at(d.state), object.statics().friction(), d.anchor,
                            d.state.positions());
   int stick = 0, slide = 0;
   for (std::size_t k = 0; k < friction.term.pairs().size(); ++k)
@@ -72,12 +72,19 @@ void expect_exact_with_friction(double swing, bool sticking) {
            ? stick
            : slide);
   std::cout << "swing " << swing << " rad: " << stick << " pairs sticking, " << slide
-            << " sliding; " << d.state.statics().reason << "\n";
-  EXPECT_GT(sticking ? stick : slide, 2 * (sticking ? slide : stick));
+            << " sliding; contact stiffness ×" << d.state.contact_scale() << "; "
+            << d.state.statics().reason << "\n";
+  // Sticking: nearly all; sliding: most (the pairs beside the grips stick, 6 of 17 at the
+  // stiffness the adaptive barrier raises this scene to).
+  if (sticking) EXPECT_GT(stick, 2 * slide);
+  else EXPECT_GT(slide, stick);
 
   const Eigen::MatrixXd dx = object.sensitivity(d.state);
   const auto equilibrium = [&](const Eigen::VectorXd& t) -> Eigen::VectorXd {
-    const ObjectState moved = object.solve_from(t, d.anchor);  // the same anchor
+    // The same anchor, at the state's contact stiffness (the derivative at that κ).
+    ObjectState moved = object.make_state(t, d.anchor, nullptr, d.state.contact_scale());
+    object.solve(moved, t);
+    EXPECT_EQ(moved.contact_scale(), d.state.contact_scale()) << "raised again";
     EXPECT_TRUE(moved.statics().converged()) << moved.statics().reason;
     return moved.positions();
   };
@@ -89,7 +96,8 @@ void expect_exact_with_friction(double swing, bool sticking) {
   EXPECT_TRUE(exact);
 
   // Without friction's Hessian, and with it at fixed lag: the same check fails.
-  const EnergyTerms frictionless = object.statics().terms(nullptr, nullptr);
+  const ContactTerms at_scale = object.statics().contact_terms(d.state.contact_scale());
+  const EnergyTerms frictionless = object.statics().terms(nullptr, at_scale);
   EnergyTerms fixed_lag = frictionless;
   fixed_lag.push_back(&friction.term);
   for (const auto& [what, terms] : {std::pair{"frictionless Hessian", frictionless},

@@ -198,7 +198,8 @@ bool GrippedObject::factored(ObjectState& state, double stale_step) const {
   StaticsWorkspace& ws = *state.workspace_;
   if (solver.factor_distance(ws, state.positions_) <= stale_step) return true;
   const GripEnergy grip(*grips_, state.kinematics_);
-  EnergyTerms terms = statics_->terms(&grip, contact_terms(state));
+  const ContactTerms contact = contact_terms(state);  // `terms` points into it
+  EnergyTerms terms = statics_->terms(&grip, contact);
   const std::optional<FixedPointFriction> friction = friction_at(state);
   if (friction) terms.push_back(&friction->term);
   return solver.factor(terms, ws, state.positions_);
@@ -211,8 +212,8 @@ ContactTerms GrippedObject::contact_terms(const ObjectState& state) const {
 
 std::optional<FixedPointFriction> GrippedObject::friction_at(const ObjectState& state) const {
   if (state.friction_anchor_.size() == 0) return std::nullopt;
-  return fixed_point_friction(*contact_at(state), statics_->friction(),
-                              state.friction_anchor_, state.positions_);
+  return fixed_point_friction(*contact_at(state), statics_->friction(), state.friction_anchor_,
+                              state.positions_);
 }
 
 Eigen::MatrixXd GrippedObject::solve_equilibrium(const ObjectState& state,

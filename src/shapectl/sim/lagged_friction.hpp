@@ -27,7 +27,9 @@ struct FrictionSettings {
   double slip = 0;         // ε, m
   double load = 0;         // the object's load, N (the sticking solve's resistance)
   double size = 0;         // the object's bounding-box diagonal, m (a slide beyond it runs away)
-  int max_lags = 10;       // lagged solves after the sticking one
+  // Lagged solves after the sticking one. Each is a short Newton continuation; the lag settles
+  // linearly, slower the stiffer the barrier (a raised κ: contact_stiffness.hpp).
+  int max_lags = 25;
 };
 
 // Equilibrium of `terms` plus friction on `contact`'s pairs from the warm start x (the anchor);
